@@ -1,0 +1,145 @@
+//! Stage 0 — configuration.
+//!
+//! A scene is read from TOML into raw serde structs (`raw`, with
+//! `deny_unknown_fields` and tagged enums, units in key names), then validated
+//! into the checked [`Scene`] that every later stage consumes. Validation
+//! errors name the file, the key and the allowed range. Pigment optical data
+//! (built-in stand-in spectra and user CSV tables) live in [`materials`].
+
+pub mod materials;
+mod raw;
+mod validate;
+
+use std::path::{Path, PathBuf};
+
+pub use materials::Material;
+pub use validate::{load_scene, parse_scene};
+
+/// Everything that can go wrong while reading or checking a configuration.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{file}: cannot read: {source}")]
+    Read {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{file}: {message}")]
+    Parse { file: PathBuf, message: String },
+    #[error("{file}: key `{key}`: {message}")]
+    Invalid {
+        file: PathBuf,
+        key: String,
+        message: String,
+    },
+    #[error("{file}: material `{material}`: {message}")]
+    Material {
+        file: PathBuf,
+        material: String,
+        message: String,
+    },
+}
+
+/// The verbatim configuration and where it came from; travels with the results.
+#[derive(Debug, Clone)]
+pub struct Provenance {
+    /// Path the scene was read from.
+    pub path: PathBuf,
+    /// The exact TOML text.
+    pub text: String,
+    /// Hex SHA-256 over the config text and the contents of every data file it
+    /// references (pigment tables), so a changed input changes the hash.
+    pub input_hash: String,
+}
+
+/// The layer: a binder slab `0 ≤ z ≤ thickness` holding pigment grains,
+/// repeated periodically with period `fragment_x_nm × fragment_y_nm`.
+#[derive(Debug, Clone)]
+pub struct Layer {
+    pub thickness_nm: f64,
+    pub fragment_x_nm: f64,
+    pub fragment_y_nm: f64,
+    /// Real refractive index of the (transparent) binder.
+    pub binder_index: f64,
+}
+
+/// One pigment species in the layer.
+#[derive(Debug, Clone)]
+pub struct Species {
+    pub name: String,
+    pub material: Material,
+    /// Target volume fraction of the layer (PVC share of this species), 0..1.
+    pub volume_fraction: f64,
+    /// Sphere diameter in nm.
+    pub diameter_nm: f64,
+}
+
+/// Grid of the refractive-index raster and of the solver.
+#[derive(Debug, Clone, Copy)]
+pub struct GridSpec {
+    pub nx: usize,
+    pub ny: usize,
+    pub nz: usize,
+}
+
+/// Which iterative method solves the scattering problem.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Plain Born series; stops and reports divergence.
+    Born,
+    /// Pseudo-time marching with the convergent-Born-series preconditioner.
+    TimeMarching,
+    /// Born where a cheap estimate says it converges, time-marching otherwise
+    /// or when Born diverges.
+    Auto,
+}
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy)]
+pub struct SolverSpec {
+    pub method: Method,
+    /// Target relative residual.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
+/// One direction of incidence (from above, in vacuum).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Incidence {
+    pub polar_deg: f64,
+    pub azimuth_deg: f64,
+}
+
+/// Where results go.
+#[derive(Debug, Clone)]
+pub struct OutputSpec {
+    pub dir: PathBuf,
+    /// Base name of the result files (`<name>.h5`, `<name>.png`).
+    pub name: String,
+}
+
+/// A validated scene: every value is in range and every material covers every
+/// requested wavelength.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub provenance: Provenance,
+    pub seed: u64,
+    pub layer: Layer,
+    pub species: Vec<Species>,
+    pub grid: GridSpec,
+    pub wavelengths_nm: Vec<f64>,
+    pub incidence: Vec<Incidence>,
+    pub solver: SolverSpec,
+    pub output: OutputSpec,
+}
+
+impl Scene {
+    /// Total pigment volume concentration requested.
+    pub fn total_pvc(&self) -> f64 {
+        self.species.iter().map(|s| s.volume_fraction).sum()
+    }
+
+    /// File the scene was read from.
+    pub fn path(&self) -> &Path {
+        &self.provenance.path
+    }
+}

@@ -1,0 +1,91 @@
+//! Stage 4 — far field: order efficiencies, absorption, energy balance.
+//!
+//! The Kirchhoff far field of a periodic layer is a finite set of plane waves,
+//! one per propagating Bloch order, so no numerical far-field integral is
+//! needed (METHOD §5). Energy balance `ΣR + ΣT + A = 1` is checked on every
+//! solve.
+
+use crate::config::Incidence;
+use crate::solver::SolveRecord;
+use num_complex::Complex64;
+
+/// One propagating diffraction order (Kirchhoff far field of a periodic layer).
+#[derive(Debug, Clone, Copy)]
+pub struct Order {
+    pub m: i32,
+    pub n: i32,
+    /// Direction of the outgoing plane wave: polar angle from the layer normal
+    /// (reflected orders go up, transmitted down; both share these angles).
+    pub theta_deg: f64,
+    pub phi_deg: f64,
+    /// Efficiency R_mn = |r_mn|² Re β_mn / β_00.
+    pub reflectance: f64,
+    /// Efficiency T_mn = |t_mn|² Re β_mn / β_00.
+    pub transmittance: f64,
+}
+
+/// Far-field summary of one solve.
+#[derive(Debug, Clone)]
+pub struct Efficiencies {
+    pub orders: Vec<Order>,
+    /// Specular amplitudes r_00 and t_00.
+    pub r00: Complex64,
+    pub t00: Complex64,
+    pub total_reflectance: f64,
+    pub total_transmittance: f64,
+    pub absorption: f64,
+    /// ΣR + ΣT + A − 1 (zero for an exact solve).
+    pub energy_balance: f64,
+}
+
+/// One solve of the scene: a wavelength and a direction of incidence.
+#[derive(Debug, Clone)]
+pub struct SolveEntry {
+    pub wavelength_nm: f64,
+    pub incidence: Incidence,
+    pub efficiencies: Efficiencies,
+    pub record: SolveRecord,
+}
+
+/// Order efficiencies, absorption and the energy balance of a solution.
+///
+/// A harmonic propagates when `Re β > 0`; it leaves at
+/// `sin θ (cos φ, sin φ) = κ / k0`, `cos θ = β / k0`.
+pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
+    let lat = &sol.lattice;
+    let beta00 = lat.beta(0, 0).re;
+    let mut orders = Vec::new();
+    let (mut tr, mut tt) = (0.0, 0.0);
+    for ix in 0..lat.nx {
+        for iy in 0..lat.ny {
+            let beta = lat.beta(ix, iy);
+            if beta.re <= 0.0 {
+                continue;
+            }
+            let [kx, ky] = lat.kappa(ix, iy);
+            let rr = sol.r[[ix, iy]].norm_sqr() * beta.re / beta00;
+            let t = sol.t[[ix, iy]].norm_sqr() * beta.re / beta00;
+            tr += rr;
+            tt += t;
+            let s = (kx.hypot(ky) / lat.k0).min(1.0);
+            orders.push(Order {
+                m: crate::solver::operator::Lattice::order(ix, lat.nx),
+                n: crate::solver::operator::Lattice::order(iy, lat.ny),
+                theta_deg: s.asin().to_degrees(),
+                phi_deg: ky.atan2(kx).to_degrees(),
+                reflectance: rr,
+                transmittance: t,
+            });
+        }
+    }
+    orders.sort_by_key(|o| (o.m, o.n));
+    Efficiencies {
+        orders,
+        r00: sol.r[[0, 0]],
+        t00: sol.t[[0, 0]],
+        total_reflectance: tr,
+        total_transmittance: tt,
+        absorption: sol.absorption,
+        energy_balance: tr + tt + sol.absorption - 1.0,
+    }
+}

@@ -1,0 +1,76 @@
+//! The Born series `u_{j+1} = u_bg + G V u_j`.
+//!
+//! Cheapest per step (one operator application) but converges only when the
+//! spectral radius of `G V` is below one (weak scattering). Divergence is
+//! detected from residual growth and reported as an error, never returned as
+//! a result. [`Born::validity`] estimates the contraction from a few steps.
+
+use super::{Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
+use ndarray::{Array3, Zip};
+use num_complex::Complex64 as C64;
+
+/// Steps spent on the a-priori contraction estimate.
+pub const ESTIMATE_STEPS: usize = 4;
+/// Estimated contraction above which Born is not attempted by `auto`.
+pub const MAX_CONTRACTION: f64 = 0.8;
+
+/// The Born series.
+pub struct Born;
+
+impl IterativeMethod for Born {
+    fn kind(&self) -> MethodUsed {
+        MethodUsed::Born
+    }
+
+    fn validity(&self, sys: &mut System) -> Validity {
+        let mut u = Array3::zeros(sys.v.dim());
+        let mut r = Array3::zeros(sys.v.dim());
+        sys.set_background(&mut u);
+        let mut prev = f64::NAN;
+        let mut ratio = 0.0;
+        for _ in 0..ESTIMATE_STEPS {
+            let res = sys.residual(&u, &mut r);
+            if res == 0.0 {
+                return Validity::Likely("no scatterers (Δε = 0)".into());
+            }
+            if prev.is_finite() {
+                ratio = res / prev;
+            }
+            prev = res;
+            Zip::from(&mut u).and(&r).par_for_each(|u, r| *u += r);
+        }
+        if ratio.is_finite() && ratio < MAX_CONTRACTION {
+            Validity::Likely(format!("Born contraction estimate {ratio:.3} < {MAX_CONTRACTION}"))
+        } else {
+            Validity::Unlikely(format!("Born contraction estimate {ratio:.3} ≥ {MAX_CONTRACTION}"))
+        }
+    }
+
+    fn run(&self, sys: &mut System, u: &mut Array3<C64>, ctl: &Controls) -> Result<Outcome, SolveError> {
+        let mut r = Array3::zeros(u.dim());
+        let mut best = f64::INFINITY;
+        let mut growing = 0;
+        for it in 0..=ctl.max_iterations {
+            let res = sys.residual(u, &mut r);
+            if res <= ctl.tolerance {
+                return Ok(Outcome { iterations: it, applications: it + 1, residual: res, note: String::new() });
+            }
+            let diverged = !res.is_finite() || res > 1e3 * best.min(1.0) || growing >= 5;
+            if diverged {
+                return Err(SolveError::Diverged { method: MethodUsed::Born, iterations: it, residual: res });
+            }
+            growing = if res > best { growing + 1 } else { 0 };
+            best = best.min(res);
+            if it == ctl.max_iterations {
+                return Err(SolveError::NotConverged {
+                    method: MethodUsed::Born,
+                    iterations: it,
+                    residual: res,
+                    tolerance: ctl.tolerance,
+                });
+            }
+            Zip::from(&mut *u).and(&r).par_for_each(|u, r| *u += r);
+        }
+        unreachable!("loop returns")
+    }
+}

@@ -1,0 +1,97 @@
+//! Batched 2-D FFTs over the z-slices of a field.
+//!
+//! Real-space fields are stored `(nz, ny, nx)`; their spectra `(nz, nx, ny)`
+//! (transposed, so both 1-D passes run over contiguous rows). Plans are made
+//! once; per-slice scratch is owned by the caller's [`FftScratch`].
+
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+use rayon::prelude::*;
+use rustfft::{Fft, FftPlanner};
+use std::sync::Arc;
+
+/// Planned forward and inverse transforms for one slice size.
+pub struct Fft2 {
+    nx: usize,
+    ny: usize,
+    fx: Arc<dyn Fft<f64>>,
+    fy: Arc<dyn Fft<f64>>,
+    ix: Arc<dyn Fft<f64>>,
+    iy: Arc<dyn Fft<f64>>,
+}
+
+/// Per-slice scratch for the transforms.
+pub struct FftScratch {
+    bufs: Vec<Vec<C64>>,
+}
+
+impl Fft2 {
+    pub fn new(nx: usize, ny: usize) -> Self {
+        let mut p = FftPlanner::new();
+        Fft2 {
+            nx,
+            ny,
+            fx: p.plan_fft_forward(nx),
+            fy: p.plan_fft_forward(ny),
+            ix: p.plan_fft_inverse(nx),
+            iy: p.plan_fft_inverse(ny),
+        }
+    }
+
+    /// Scratch for `nz` slices.
+    pub fn scratch(&self, nz: usize) -> FftScratch {
+        let len = [&self.fx, &self.fy, &self.ix, &self.iy]
+            .iter()
+            .map(|f| f.get_inplace_scratch_len())
+            .max()
+            .unwrap_or(0)
+            .max(1);
+        FftScratch { bufs: (0..nz).map(|_| vec![C64::new(0.0, 0.0); len]).collect() }
+    }
+
+    /// Unnormalised forward transform of every slice: `real (nz,ny,nx)` → `spec (nz,nx,ny)`.
+    /// `real` is used as working space and left transformed along x.
+    pub fn forward(&self, real: &mut Array3<C64>, spec: &mut Array3<C64>, scr: &mut FftScratch) {
+        let (nx, ny) = (self.nx, self.ny);
+        let r = real.as_slice_mut().expect("contiguous field");
+        let s = spec.as_slice_mut().expect("contiguous spectrum");
+        r.par_chunks_mut(nx * ny)
+            .zip(s.par_chunks_mut(nx * ny))
+            .zip(scr.bufs.par_iter_mut())
+            .for_each(|((rs, ss), buf)| {
+                self.fx.process_with_scratch(rs, buf);
+                transpose(rs, ss, ny, nx);
+                self.fy.process_with_scratch(ss, buf);
+            });
+    }
+
+    /// Unnormalised inverse transform: `spec (nz,nx,ny)` → `real (nz,ny,nx)`.
+    /// `spec` is used as working space.
+    pub fn inverse(&self, spec: &mut Array3<C64>, real: &mut Array3<C64>, scr: &mut FftScratch) {
+        let (nx, ny) = (self.nx, self.ny);
+        let r = real.as_slice_mut().expect("contiguous field");
+        let s = spec.as_slice_mut().expect("contiguous spectrum");
+        s.par_chunks_mut(nx * ny)
+            .zip(r.par_chunks_mut(nx * ny))
+            .zip(scr.bufs.par_iter_mut())
+            .for_each(|((ss, rs), buf)| {
+                self.iy.process_with_scratch(ss, buf);
+                transpose(ss, rs, nx, ny);
+                self.ix.process_with_scratch(rs, buf);
+            });
+    }
+}
+
+/// `dst (cols × rows) = srcᵀ` for `src (rows × cols)`, blocked for cache.
+fn transpose(src: &[C64], dst: &mut [C64], rows: usize, cols: usize) {
+    const B: usize = 16;
+    for r0 in (0..rows).step_by(B) {
+        for c0 in (0..cols).step_by(B) {
+            for r in r0..(r0 + B).min(rows) {
+                for c in c0..(c0 + B).min(cols) {
+                    dst[c * rows + r] = src[r * cols + c];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,273 @@
+//! Stage 3 — the diffraction problem (METHOD §4).
+//!
+//! The layer's permittivity is split into the plain binder slab and the grains:
+//! `ε = ε_b + Δε`. The scattered field solves `u = u_bg + G_bg [k0² Δε u]`
+//! with the exact slab Green's operator ([`operator`], [`green`]): outgoing
+//! plane waves above and below are built in, so no absorbing layers and no
+//! padding are needed.
+//!
+//! Every method implements [`IterativeMethod`] and works on the same
+//! [`System`] (the discrete equation above). The discrete equation is fixed;
+//! methods differ only in how they reach its solution, so they agree to
+//! solver tolerance and every solve can be checked by its energy balance.
+//!
+//! * [`born::Born`]: `u ← u_bg + G V u`; stops and reports divergence.
+//! * [`marching::TimeMarching`]: pseudo-time marching `u ← u + dτ P r` with the
+//!   convergent-Born-series preconditioner of Osnabrugge et al. (2016).
+
+pub mod born;
+pub mod fft;
+pub mod green;
+pub mod marching;
+pub mod operator;
+
+use crate::config::Method;
+use ndarray::{Array2, Array3, Zip};
+use num_complex::Complex64 as C64;
+use operator::{GreenTable, Lattice, Operator, Workspace};
+use std::fmt;
+use std::time::Instant;
+
+/// Which method produced a solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MethodUsed {
+    Born,
+    TimeMarching,
+}
+
+impl fmt::Display for MethodUsed {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            MethodUsed::Born => "born",
+            MethodUsed::TimeMarching => "time-marching",
+        })
+    }
+}
+
+/// What every solve records, stored beside its result.
+#[derive(Debug, Clone)]
+pub struct SolveRecord {
+    pub method: MethodUsed,
+    pub iterations: usize,
+    /// Number of applications of a background Green's operator.
+    pub operator_applications: usize,
+    /// Final relative residual ‖u_bg + G V u − u‖ / ‖u_bg‖.
+    pub residual: f64,
+    pub seconds: f64,
+    /// Free text: why this method, fallbacks taken.
+    pub note: String,
+}
+
+/// Why a solve did not produce a trustworthy answer.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SolveError {
+    #[error("{method} diverged: residual grew to {residual:.3e} after {iterations} iterations")]
+    Diverged { method: MethodUsed, iterations: usize, residual: f64 },
+    #[error("{method} did not reach tolerance {tolerance:.1e}: residual {residual:.3e} after {iterations} iterations")]
+    NotConverged { method: MethodUsed, iterations: usize, residual: f64, tolerance: f64 },
+    #[error("invalid problem: {0}")]
+    Invalid(String),
+}
+
+/// One diffraction problem: a permittivity grid, a wavelength, an incidence.
+pub struct Problem<'a> {
+    pub lattice: Lattice,
+    /// Total permittivity per voxel, (nz, ny, nx).
+    pub eps: &'a Array3<C64>,
+    /// Binder permittivity (real: the binder is transparent).
+    pub eps_binder: f64,
+}
+
+impl Problem<'_> {
+    /// Lattice for a wavelength and incidence (polar, azimuth in degrees).
+    pub fn lattice(grid: [usize; 3], size_nm: [f64; 3], wavelength_nm: f64, polar_deg: f64, azimuth_deg: f64) -> Lattice {
+        let k0 = 2.0 * std::f64::consts::PI / wavelength_nm;
+        let (s, p) = (polar_deg.to_radians().sin(), azimuth_deg.to_radians());
+        Lattice { nx: grid[0], ny: grid[1], nz: grid[2], size_nm, k0, q: [k0 * s * p.cos(), k0 * s * p.sin()] }
+    }
+}
+
+/// Iteration controls.
+#[derive(Debug, Clone, Copy)]
+pub struct Controls {
+    pub tolerance: f64,
+    pub max_iterations: usize,
+}
+
+/// How far a method can be trusted on a problem, before running it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Validity {
+    /// Converges for any problem of this kind.
+    Always,
+    /// Expected to converge; the estimate behind it.
+    Likely(String),
+    /// Expected to fail; why.
+    Unlikely(String),
+}
+
+/// Result of running one method.
+pub struct Outcome {
+    pub iterations: usize,
+    pub applications: usize,
+    pub residual: f64,
+    pub note: String,
+}
+
+/// An iterative method for the shared discrete equation.
+pub trait IterativeMethod {
+    fn kind(&self) -> MethodUsed;
+    /// A cheap a-priori statement of where the method is valid.
+    fn validity(&self, sys: &mut System) -> Validity;
+    /// Improve `u` in place until the relative residual is below tolerance.
+    fn run(&self, sys: &mut System, u: &mut Array3<C64>, ctl: &Controls) -> Result<Outcome, SolveError>;
+}
+
+/// The discrete equation `u = u_bg + G_b V u` and the scratch to work on it.
+pub struct System<'a> {
+    pub op: Operator,
+    pub binder: GreenTable,
+    pub eps: &'a Array3<C64>,
+    pub eps_binder: f64,
+    /// V = k0² (ε − ε_b).
+    pub v: Array3<C64>,
+    /// Cell averages of u_bg per z (constant in x, y).
+    pub ubg: Vec<C64>,
+    pub r_bg: C64,
+    pub t_bg: C64,
+    ubg_norm: f64,
+    pub ws: Workspace,
+    /// Scratch field.
+    pub tmp: Array3<C64>,
+}
+
+impl<'a> System<'a> {
+    pub fn new(p: &Problem<'a>) -> Result<Self, SolveError> {
+        let lat = p.lattice;
+        if p.eps.dim() != (lat.nz, lat.ny, lat.nx) {
+            return Err(SolveError::Invalid(format!("permittivity grid {:?} does not match lattice", p.eps.dim())));
+        }
+        if p.eps.iter().any(|e| !e.re.is_finite() || !e.im.is_finite() || e.im < 0.0) {
+            return Err(SolveError::Invalid("permittivity must be finite with Im ε ≥ 0 (passive)".into()));
+        }
+        let op = Operator::new(lat);
+        let binder = GreenTable::new(&lat, C64::new(p.eps_binder, 0.0));
+        let k2 = lat.k0 * lat.k0;
+        let v = p.eps.mapv(|e| k2 * (e - p.eps_binder));
+        let mut ubg = vec![C64::new(0.0, 0.0); lat.nz];
+        let g2 = C64::new(k2 * p.eps_binder - lat.q[0].powi(2) - lat.q[1].powi(2), 0.0);
+        let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
+        let ubg_norm = (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let ws = op.workspace();
+        let tmp = Array3::zeros(p.eps.dim());
+        Ok(System { op, binder, eps: p.eps, eps_binder: p.eps_binder, v, ubg, r_bg, t_bg, ubg_norm, ws, tmp })
+    }
+
+    /// Fill `u` with the background field.
+    pub fn set_background(&self, u: &mut Array3<C64>) {
+        for (j, mut slice) in u.outer_iter_mut().enumerate() {
+            slice.fill(self.ubg[j]);
+        }
+    }
+
+    /// `out ← u_bg + G V u − u` (the residual); returns ‖out‖ / ‖u_bg‖.
+    pub fn residual(&mut self, u: &Array3<C64>, out: &mut Array3<C64>) -> f64 {
+        Zip::from(&mut *out).and(u).and(&self.v).par_for_each(|o, u, v| *o = v * u);
+        self.op.apply(&self.binder, out, &mut self.ws);
+        let ubg = &self.ubg;
+        for (j, (mut o, uu)) in out.outer_iter_mut().zip(u.outer_iter()).enumerate() {
+            Zip::from(&mut o).and(&uu).for_each(|o, u| *o += ubg[j] - u);
+        }
+        self.norm(out)
+    }
+
+    /// ‖x‖ / ‖u_bg‖.
+    pub fn norm(&self, x: &Array3<C64>) -> f64 {
+        let s: f64 = x.as_slice().map(|s| s.iter().map(|c| c.norm_sqr()).sum()).unwrap_or_else(|| x.iter().map(|c| c.norm_sqr()).sum());
+        s.sqrt() / self.ubg_norm
+    }
+
+    /// Far-field amplitudes and absorption of a field.
+    fn outputs(&mut self, u: &Array3<C64>) -> (Array2<C64>, Array2<C64>, f64) {
+        let lat = self.op.lat;
+        let mut src = std::mem::replace(&mut self.tmp, Array3::zeros((0, 0, 0)));
+        Zip::from(&mut src).and(u).and(&self.v).par_for_each(|o, u, v| *o = v * u);
+        let mut r = Array2::zeros((lat.nx, lat.ny));
+        let mut t = Array2::zeros((lat.nx, lat.ny));
+        self.op.boundary_amplitudes(&self.binder, &mut src, &mut self.ws, &mut r, &mut t);
+        self.tmp = src;
+        r[[0, 0]] += self.r_bg;
+        t[[0, 0]] += self.t_bg;
+        let dz = lat.size_nm[2] / lat.nz as f64;
+        let s: f64 = Zip::from(u).and(self.eps).par_fold(|| 0.0, |acc, u, e| acc + e.im * u.norm_sqr(), |a, b| a + b);
+        let beta00 = lat.beta(0, 0).re;
+        let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
+        (r, t, absorption)
+    }
+}
+
+/// A solved problem: the field and what the far field needs.
+pub struct Solution {
+    pub lattice: Lattice,
+    /// Cell-averaged periodic field v, (nz, ny, nx).
+    pub field: Array3<C64>,
+    /// Reflection amplitudes r_mn (total, u_mn(0) − δ), spectral layout (nx, ny).
+    pub r: Array2<C64>,
+    /// Transmission amplitudes t_mn, spectral layout (nx, ny).
+    pub t: Array2<C64>,
+    /// Absorbed fraction of the incident power.
+    pub absorption: f64,
+    pub record: SolveRecord,
+}
+
+/// Solve one problem with the requested method (`Auto` picks and falls back).
+pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, SolveError> {
+    let start = Instant::now();
+    let mut sys = System::new(p)?;
+    let mut u = Array3::zeros(p.eps.dim());
+    sys.set_background(&mut u);
+    let born = born::Born;
+    let tm = marching::TimeMarching::default();
+    let (used, out) = match method {
+        Method::Born => (MethodUsed::Born, born.run(&mut sys, &mut u, ctl)?),
+        Method::TimeMarching => (MethodUsed::TimeMarching, tm.run(&mut sys, &mut u, ctl)?),
+        Method::Auto => match born.validity(&mut sys) {
+            Validity::Unlikely(why) => {
+                sys.set_background(&mut u);
+                let mut o = tm.run(&mut sys, &mut u, ctl)?;
+                o.note = format!("auto: {why}; {}", o.note);
+                o.applications += born::ESTIMATE_STEPS;
+                (MethodUsed::TimeMarching, o)
+            }
+            v => {
+                let why = match v {
+                    Validity::Likely(s) => s,
+                    _ => String::new(),
+                };
+                sys.set_background(&mut u);
+                match born.run(&mut sys, &mut u, ctl) {
+                    Ok(mut o) => {
+                        o.note = format!("auto: {why}");
+                        o.applications += born::ESTIMATE_STEPS;
+                        (MethodUsed::Born, o)
+                    }
+                    Err(e) => {
+                        sys.set_background(&mut u);
+                        let mut o = tm.run(&mut sys, &mut u, ctl)?;
+                        o.note = format!("auto: {why}, but {e}; fell back. {}", o.note);
+                        (MethodUsed::TimeMarching, o)
+                    }
+                }
+            }
+        },
+    };
+    let (r, t, absorption) = sys.outputs(&u);
+    let record = SolveRecord {
+        method: used,
+        iterations: out.iterations,
+        operator_applications: out.applications,
+        residual: out.residual,
+        seconds: start.elapsed().as_secs_f64(),
+        note: out.note,
+    };
+    Ok(Solution { lattice: p.lattice, field: u, r, t, absorption, record })
+}

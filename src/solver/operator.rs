@@ -1,0 +1,297 @@
+//! The background Green's operator `G_bg` on the 3-D grid (METHOD §4), shared
+//! by every solver.
+//!
+//! One application = a forward 2-D FFT of every z-slice, per Bloch harmonic
+//! three O(Nz) sweeps (down, up, assemble) that apply the exact Galerkin
+//! matrix of [`green`](super::green), and the inverse 2-D FFT. Fields hold the
+//! periodic part `v` of the Bloch field `u = v e^{iq·ρ}`, as z-cell averages,
+//! stored `(nz, ny, nx)`.
+//!
+//! A [`GreenTable`] holds everything that depends on the background
+//! permittivity (binder for the physical problem, binder shifted by `iε_s` for
+//! the convergent-Born-series preconditioner). Scratch lives in
+//! [`Workspace`], owned by the caller, so applications never allocate.
+
+use super::fft::{Fft2, FftScratch};
+use super::green::{self, Coef, Slab};
+use ndarray::{Array3, Axis};
+use num_complex::Complex64 as C64;
+use rayon::prelude::*;
+
+const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
+
+/// The Bloch–Fourier lattice of one problem.
+#[derive(Debug, Clone, Copy)]
+pub struct Lattice {
+    pub nx: usize,
+    pub ny: usize,
+    pub nz: usize,
+    /// Period Lx, Ly and thickness H (nm).
+    pub size_nm: [f64; 3],
+    /// Free-space wavenumber (rad/nm).
+    pub k0: f64,
+    /// Lateral wave vector of the incident wave (rad/nm).
+    pub q: [f64; 2],
+}
+
+impl Lattice {
+    /// Diffraction order of FFT index `i` on an axis of `n` points.
+    pub fn order(i: usize, n: usize) -> i32 {
+        if i < n.div_ceil(2) {
+            i as i32
+        } else {
+            i as i32 - n as i32
+        }
+    }
+
+    /// κ of the harmonic at FFT indices (ix, iy).
+    pub fn kappa(&self, ix: usize, iy: usize) -> [f64; 2] {
+        let tau = 2.0 * std::f64::consts::PI;
+        [
+            self.q[0] + tau * Self::order(ix, self.nx) as f64 / self.size_nm[0],
+            self.q[1] + tau * Self::order(iy, self.ny) as f64 / self.size_nm[1],
+        ]
+    }
+
+    /// β = sqrt(k0² − |κ|²) in vacuum (Im ≥ 0).
+    pub fn beta(&self, ix: usize, iy: usize) -> C64 {
+        let [kx, ky] = self.kappa(ix, iy);
+        green::sqrt_branch(C64::new(self.k0 * self.k0 - kx * kx - ky * ky, 0.0))
+    }
+
+    pub fn slab(&self) -> Slab {
+        Slab { k0: self.k0, thickness: self.size_nm[2], nz: self.nz }
+    }
+
+    pub fn harmonics(&self) -> usize {
+        self.nx * self.ny
+    }
+}
+
+/// A harmonic near γ = 0, applied with a dense matrix.
+struct Special {
+    /// Spectral index ix·ny + iy.
+    index: usize,
+    matrix: Vec<C64>,
+    top: Vec<C64>,
+    bottom: Vec<C64>,
+}
+
+/// Per-harmonic data of the Green's operator for one background permittivity.
+pub struct GreenTable {
+    pub eps_bg: C64,
+    coef: Vec<Coef>,
+    /// q^j for every harmonic, layout (nz, nx, ny).
+    pow: Array3<C64>,
+    special: Vec<Special>,
+}
+
+impl GreenTable {
+    pub fn new(lat: &Lattice, eps_bg: C64) -> Self {
+        let slab = lat.slab();
+        let (nx, ny, nz) = (lat.nx, lat.ny, lat.nz);
+        let mut coef = Vec::with_capacity(nx * ny);
+        let mut special = Vec::new();
+        for ix in 0..nx {
+            for iy in 0..ny {
+                let [kx, ky] = lat.kappa(ix, iy);
+                let g2 = lat.k0 * lat.k0 * eps_bg - (kx * kx + ky * ky);
+                let beta = lat.beta(ix, iy);
+                if green::is_small_gamma(&slab, g2) {
+                    let (matrix, top, bottom) = green::dense_small_gamma(&slab, g2, beta);
+                    special.push(Special { index: ix * ny + iy, matrix, top, bottom });
+                    coef.push(zero_coef(beta));
+                } else {
+                    coef.push(green::coef_from(&slab, g2, beta));
+                }
+            }
+        }
+        let mut pow = Array3::from_elem((nz, nx, ny), ZERO);
+        for (h, c) in coef.iter().enumerate() {
+            let (ix, iy) = (h / ny, h % ny);
+            let mut p = C64::new(1.0, 0.0);
+            for j in 0..nz {
+                pow[[j, ix, iy]] = p;
+                p *= c.q;
+            }
+        }
+        GreenTable { eps_bg, coef, pow, special }
+    }
+
+    /// Number of harmonics treated by the grazing (contour-average) path.
+    pub fn special_count(&self) -> usize {
+        self.special.len()
+    }
+}
+
+fn zero_coef(beta: C64) -> Coef {
+    Coef {
+        q: ZERO,
+        kdz: ZERO,
+        f2: ZERO,
+        rf: ZERO,
+        r2n: ZERO,
+        diag: ZERO,
+        phi1: ZERO,
+        rho: ZERO,
+        qn: ZERO,
+        gamma: ZERO,
+        beta,
+    }
+}
+
+/// Scratch buffers for operator applications, sized for one lattice.
+pub struct Workspace {
+    spec: Array3<C64>,
+    acc: Array3<C64>,
+    /// Running sums per row: (nx, 3, ny).
+    rows: Array3<C64>,
+    fft: FftScratch,
+    special_in: Vec<C64>,
+}
+
+/// FFT plans plus the lattice: what every application shares.
+pub struct Operator {
+    pub lat: Lattice,
+    fft: Fft2,
+}
+
+impl Operator {
+    pub fn new(lat: Lattice) -> Self {
+        Operator { fft: Fft2::new(lat.nx, lat.ny), lat }
+    }
+
+    pub fn workspace(&self) -> Workspace {
+        let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
+        Workspace {
+            spec: Array3::from_elem((nz, nx, ny), ZERO),
+            acc: Array3::from_elem((nz, nx, ny), ZERO),
+            rows: Array3::from_elem((nx, 3, ny), ZERO),
+            fft: self.fft.scratch(nz),
+            special_in: Vec::new(),
+        }
+    }
+
+    /// `field ← G_bg field` for the background of `table`.
+    pub fn apply(&self, table: &GreenTable, field: &mut Array3<C64>, ws: &mut Workspace) {
+        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
+        self.apply_spectral(table, ws);
+        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
+    }
+
+    fn apply_spectral(&self, table: &GreenTable, ws: &mut Workspace) {
+        let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
+        let norm = 1.0 / (nx * ny) as f64;
+        // Save the columns of grazing harmonics before the sweeps overwrite them.
+        ws.special_in.clear();
+        for sp in &table.special {
+            let (ix, iy) = (sp.index / ny, sp.index % ny);
+            for j in 0..nz {
+                ws.special_in.push(ws.spec[[j, ix, iy]]);
+            }
+        }
+        let coef = &table.coef;
+        ws.spec
+            .axis_iter_mut(Axis(1))
+            .into_par_iter()
+            .zip(ws.acc.axis_iter_mut(Axis(1)).into_par_iter())
+            .zip(table.pow.axis_iter(Axis(1)).into_par_iter())
+            .zip(ws.rows.axis_iter_mut(Axis(0)).into_par_iter())
+            .enumerate()
+            .for_each(|(ix, (((mut s, mut acc), pow), mut rows))| {
+                let cs = &coef[ix * ny..(ix + 1) * ny];
+                let rows = rows.as_slice_mut().expect("contiguous rows");
+                let (a, rest) = rows.split_at_mut(ny);
+                let (c, d) = rest.split_at_mut(ny);
+                a.fill(ZERO);
+                c.fill(ZERO);
+                d.fill(ZERO);
+                // Down: a_j = Σ_{k<j} q^{j−1−k} s_k, c_j = Σ_{k<j} q^k s_k.
+                for j in 0..nz {
+                    let sj = s.row(j);
+                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
+                    let mut out = acc.row_mut(j);
+                    for iy in 0..ny {
+                        let k = &cs[iy];
+                        out[iy] = k.f2 * a[iy] + k.r2n * pm[iy] * c[iy];
+                        a[iy] = k.q * a[iy] + sj[iy];
+                        c[iy] += pj[iy] * sj[iy];
+                    }
+                }
+                // c = Se = Σ q^k s_k. Up: b_j (reusing a), d_j = Σ_{k>j} q^{N−1−k} s_k.
+                a.fill(ZERO);
+                for j in (0..nz).rev() {
+                    let sj = s.row(j);
+                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
+                    let mut out = acc.row_mut(j);
+                    for iy in 0..ny {
+                        let k = &cs[iy];
+                        out[iy] += k.f2 * a[iy] + k.r2n * pj[iy] * d[iy];
+                        a[iy] = k.q * a[iy] + sj[iy];
+                        d[iy] += pm[iy] * sj[iy];
+                    }
+                }
+                // d = Sh = Σ q^{N−1−k} s_k. Assemble in place.
+                for j in 0..nz {
+                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
+                    let out = acc.row(j);
+                    let mut sj = s.row_mut(j);
+                    for iy in 0..ny {
+                        let k = &cs[iy];
+                        sj[iy] = (k.kdz * norm)
+                            * (out[iy] + k.diag * sj[iy] + k.rf * (pj[iy] * c[iy] + pm[iy] * d[iy]));
+                    }
+                }
+            });
+        for (n, sp) in table.special.iter().enumerate() {
+            let (ix, iy) = (sp.index / ny, sp.index % ny);
+            let col = &ws.special_in[n * nz..(n + 1) * nz];
+            for j in 0..nz {
+                let row = &sp.matrix[j * nz..(j + 1) * nz];
+                let v: C64 = row.iter().zip(col).map(|(m, x)| m * x).sum();
+                ws.spec[[j, ix, iy]] = v * norm;
+            }
+        }
+    }
+
+    /// Scattered amplitudes at the boundaries for a source `s = k0² Δε u`
+    /// (real space, consumed as scratch): `r_h = u_h(0) − u_bg,h(0)`,
+    /// `t_h = u_h(H) − u_bg,h(H)`, in spectral layout (nx, ny) each.
+    pub fn boundary_amplitudes(
+        &self,
+        table: &GreenTable,
+        source: &mut Array3<C64>,
+        ws: &mut Workspace,
+        r: &mut ndarray::Array2<C64>,
+        t: &mut ndarray::Array2<C64>,
+    ) {
+        let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
+        let norm = 1.0 / (nx * ny) as f64;
+        self.fft.forward(source, &mut ws.spec, &mut ws.fft);
+        for ix in 0..nx {
+            for iy in 0..ny {
+                let k = &table.coef[ix * ny + iy];
+                let (mut se, mut sh) = (ZERO, ZERO);
+                for j in 0..nz {
+                    let s = ws.spec[[j, ix, iy]];
+                    se += table.pow[[j, ix, iy]] * s;
+                    sh += table.pow[[nz - 1 - j, ix, iy]] * s;
+                }
+                let f = k.kdz * norm * (1.0 + k.rho) * k.phi1;
+                r[[ix, iy]] = f * (se + k.rho * k.qn * sh);
+                t[[ix, iy]] = f * (sh + k.rho * k.qn * se);
+            }
+        }
+        for sp in &table.special {
+            let (ix, iy) = (sp.index / ny, sp.index % ny);
+            let (mut rr, mut tt) = (ZERO, ZERO);
+            for j in 0..nz {
+                let s = ws.spec[[j, ix, iy]];
+                rr += sp.top[j] * s;
+                tt += sp.bottom[j] * s;
+            }
+            r[[ix, iy]] = rr * norm;
+            t[[ix, iy]] = tt * norm;
+        }
+    }
+}

@@ -12,8 +12,13 @@ mod validate;
 
 use std::path::{Path, PathBuf};
 
-pub use materials::Material;
+pub use materials::{Material, MaterialError, MaterialSource};
 pub use validate::{load_scene, parse_scene};
+
+/// Largest total pigment volume concentration the random-sequential-addition
+/// packer supports (METHOD §2: RSA is for PVC ≲ 30 %); denser packing is not
+/// yet implemented, so validation rejects more.
+pub const MAX_PVC_RSA: f64 = 0.35;
 
 /// Everything that can go wrong while reading or checking a configuration.
 #[derive(Debug, thiserror::Error)]

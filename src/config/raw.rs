@@ -1,0 +1,98 @@
+//! The TOML file as written: serde structs mirroring the schema one to one.
+//!
+//! Every table denies unknown keys, so a typo is an error rather than a
+//! silently ignored setting. Units are part of the key names. Values are not
+//! checked here (integers are read as `i64` so that out-of-range values reach
+//! `validate` and get a message with the allowed range); `validate` turns this
+//! into the checked [`Scene`](super::Scene).
+
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConfig {
+    pub seed: Option<i64>,
+    pub layer: RawLayer,
+    #[serde(default)]
+    pub pigment: Vec<RawPigment>,
+    pub grid: RawGrid,
+    pub illumination: RawIllumination,
+    pub solver: Option<RawSolver>,
+    pub output: Option<RawOutput>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLayer {
+    pub thickness_nm: f64,
+    pub fragment_nm: Vec<f64>,
+    pub binder_index: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPigment {
+    pub name: String,
+    pub material: RawMaterial,
+    pub pvc: f64,
+    pub diameter_nm: f64,
+}
+
+/// `{ builtin = "red" }` or `{ csv = "path.csv" }`.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RawMaterial {
+    Builtin(String),
+    Csv(String),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGrid {
+    pub cell_nm: Option<f64>,
+    /// z cell (with `cell_nm`); default min(cell_nm, DEFAULT_Z_CELL_NM).
+    pub z_cell_nm: Option<f64>,
+    pub nx: Option<i64>,
+    pub ny: Option<i64>,
+    pub nz: Option<i64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawIllumination {
+    pub wavelengths_nm: Option<Vec<f64>>,
+    pub wavelength_range_nm: Option<RawRange>,
+    pub polar_deg: Vec<f64>,
+    pub azimuth_deg: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRange {
+    pub start: f64,
+    pub stop: f64,
+    pub step: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSolver {
+    pub method: Option<RawMethod>,
+    pub tolerance: Option<f64>,
+    pub max_iterations: Option<i64>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawMethod {
+    Born,
+    TimeMarching,
+    Auto,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    pub dir: Option<String>,
+    pub name: Option<String>,
+}

@@ -1,0 +1,606 @@
+//! Checks a [`RawConfig`](super::raw::RawConfig) and builds the [`Scene`].
+//!
+//! Every value is checked against its documented range; the first violation
+//! (in file order) is reported as [`ConfigError::Invalid`] with the dotted key
+//! (`pigment[1].pvc`) and the allowed range. Choices made here:
+//! - From `grid.cell_nm`, `nx`/`ny` are the smallest 2^a·3^b·5^c ≥
+//!   ⌈fragment/cell⌉ (FFT-friendly; the cell in x/y may shrink slightly) and
+//!   `nz = max(2, ⌈thickness/z_cell⌉)` (z is not transformed), with
+//!   `z_cell = grid.z_cell_nm` or by default `min(cell_nm, 10 nm)`: the
+//!   z discretisation error is O(dz²) and cheap to reduce (cost is linear in
+//!   nz), and 10 nm keeps it below 1e-3 in R and T for a 1 µm layer
+//!   (tests/solver_slab.rs). The ceilings
+//!   forgive a relative 1e-9 so that e.g. 1.1/0.1 gives 11, not 12.
+//! - Wavelength and polar-angle lists must be strictly increasing (no
+//!   duplicate solves, ordered spectra).
+//! - A `wavelength_range_nm` includes `stop` when it lies on the step grid
+//!   within a relative 1e-9 of a step; the last value is then exactly `stop`.
+//! - A pigment's diameter must fit the layer (≤ thickness) and the periodic
+//!   fragment (≤ min(fragment x, y)); the total PVC is limited to
+//!   [`MAX_PVC_RSA`], what the random-sequential-addition packer supports.
+//! - `Provenance::input_hash` is SHA-256 over the config text followed by each
+//!   pigment's table text, in pigment order.
+
+use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
+use super::raw::{RawOutput, RawPigment, RawSolver};
+use super::{
+    ConfigError, GridSpec, Incidence, Layer, Material, Method, OutputSpec, Provenance, Scene,
+    SolverSpec, Species, MAX_PVC_RSA,
+};
+use crate::config::materials::BUILTIN_NAMES;
+use sha2::{Digest, Sha256};
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+const MAX_THICKNESS_NM: f64 = 20_000.0;
+const MAX_FRAGMENT_NM: f64 = 100_000.0;
+const MAX_CELL_NM: f64 = 1_000.0;
+const MAX_GRID_DIM: usize = 4096;
+const MAX_WAVELENGTHS: usize = 10_000;
+const MAX_POLAR_DEG: f64 = 89.0;
+/// Default z cell (nm) when the grid is given by `cell_nm`.
+pub const DEFAULT_Z_CELL_NM: f64 = 10.0;
+const DEFAULT_BINDER_INDEX: f64 = 1.558;
+const DEFAULT_SEED: u64 = 1;
+const DEFAULT_TOLERANCE: f64 = 1e-6;
+const DEFAULT_MAX_ITERATIONS: usize = 5000;
+const MAX_ITERATIONS: i64 = 10_000_000;
+/// Relative slack for ceilings and for landing on `stop` in a range.
+const REL_EPS: f64 = 1e-9;
+
+/// Reads `path` and parses it with [`parse_scene`].
+pub fn load_scene(path: &Path) -> Result<Scene, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(path, &text)
+}
+
+/// Parses and validates scene TOML `text`; `path` is where it came from (used
+/// in messages, for resolving CSV paths and for default output names).
+pub fn parse_scene(path: &Path, text: &str) -> Result<Scene, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+        file: path.to_path_buf(),
+        message: parse_message(text, &e),
+    })?;
+    Checker { file: path }.scene(path, text, raw)
+}
+
+/// The toml error on one line: `line L, column C: message; more`.
+fn parse_message(text: &str, e: &toml::de::Error) -> String {
+    let msg = e
+        .message()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ");
+    match e.span() {
+        Some(span) => {
+            let mut start = span.start.min(text.len());
+            while !text.is_char_boundary(start) {
+                start -= 1;
+            }
+            let before = &text[..start];
+            let line = before.matches('\n').count() + 1;
+            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            format!("line {line}, column {col}: {msg}")
+        }
+        None => msg,
+    }
+}
+
+struct Checker<'a> {
+    file: &'a Path,
+}
+
+impl Checker<'_> {
+    fn invalid(&self, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
+        ConfigError::Invalid {
+            file: self.file.to_path_buf(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// `Ok(v)` when `ok`, else "must be in {range}, got {v}".
+    fn range(&self, key: &str, v: f64, ok: bool, range: &str) -> Result<f64, ConfigError> {
+        if ok {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, format!("must be in {range}, got {v}")))
+        }
+    }
+
+    fn scene(&self, path: &Path, text: &str, raw: RawConfig) -> Result<Scene, ConfigError> {
+        let seed = match raw.seed {
+            None => DEFAULT_SEED,
+            Some(s) if s >= 0 => s as u64,
+            Some(s) => return Err(self.invalid("seed", format!("must be >= 0, got {s}"))),
+        };
+        let layer = self.layer(&raw.layer)?;
+        let species = self.pigments(&raw.pigment, &layer)?;
+        let grid = self.grid(&raw.grid, &layer)?;
+        let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
+        let incidence = self.incidence(&raw.illumination)?;
+        let solver = self.solver(raw.solver.as_ref())?;
+        let output = self.output(path, raw.output.as_ref())?;
+
+        for &wl in &wavelengths_nm {
+            for s in &species {
+                if s.material.index_at(wl).is_none() {
+                    let (lo, hi) = s.material.range_nm();
+                    return Err(self.invalid(
+                        wl_key,
+                        format!(
+                            "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
+                             material {} (pigment `{}`)",
+                            s.material, s.name
+                        ),
+                    ));
+                }
+            }
+        }
+
+        let mut hasher = Sha256::new();
+        hasher.update(text.as_bytes());
+        for s in &species {
+            hasher.update(s.material.table_bytes());
+        }
+        let mut input_hash = String::with_capacity(64);
+        for b in hasher.finalize() {
+            let _ = write!(input_hash, "{b:02x}");
+        }
+
+        Ok(Scene {
+            provenance: Provenance {
+                path: path.to_path_buf(),
+                text: text.to_string(),
+                input_hash,
+            },
+            seed,
+            layer,
+            species,
+            grid,
+            wavelengths_nm,
+            incidence,
+            solver,
+            output,
+        })
+    }
+
+    fn layer(&self, raw: &RawLayer) -> Result<Layer, ConfigError> {
+        let t = raw.thickness_nm;
+        let thickness_nm = self.range(
+            "layer.thickness_nm",
+            t,
+            t > 0.0 && t <= MAX_THICKNESS_NM,
+            &format!("(0, {MAX_THICKNESS_NM}] nm"),
+        )?;
+        if raw.fragment_nm.len() != 2 {
+            return Err(self.invalid(
+                "layer.fragment_nm",
+                format!(
+                    "must be 2 values [x, y] in nm, got {}",
+                    raw.fragment_nm.len()
+                ),
+            ));
+        }
+        let mut frag = [0.0; 2];
+        for (i, &f) in raw.fragment_nm.iter().enumerate() {
+            frag[i] = self.range(
+                &format!("layer.fragment_nm[{i}]"),
+                f,
+                f > 0.0 && f <= MAX_FRAGMENT_NM,
+                &format!("(0, {MAX_FRAGMENT_NM}] nm"),
+            )?;
+        }
+        let b = raw.binder_index.unwrap_or(DEFAULT_BINDER_INDEX);
+        let binder_index =
+            self.range("layer.binder_index", b, (1.0..=3.0).contains(&b), "[1, 3]")?;
+        Ok(Layer {
+            thickness_nm,
+            fragment_x_nm: frag[0],
+            fragment_y_nm: frag[1],
+            binder_index,
+        })
+    }
+
+    fn pigments(&self, raw: &[RawPigment], layer: &Layer) -> Result<Vec<Species>, ConfigError> {
+        if raw.is_empty() {
+            return Err(self.invalid("pigment", "at least one [[pigment]] table is required"));
+        }
+        let mut seen: HashMap<&str, usize> = HashMap::new();
+        let mut species = Vec::with_capacity(raw.len());
+        let max_d = layer
+            .thickness_nm
+            .min(layer.fragment_x_nm)
+            .min(layer.fragment_y_nm);
+        for (i, p) in raw.iter().enumerate() {
+            let key = |field: &str| format!("pigment[{i}].{field}");
+            let name = p.name.trim();
+            if name.is_empty() {
+                return Err(self.invalid(key("name"), "must not be empty"));
+            }
+            if let Some(j) = seen.insert(name, i) {
+                return Err(self.invalid(
+                    key("name"),
+                    format!("duplicate pigment name `{name}` (also pigment[{j}].name)"),
+                ));
+            }
+            let material = self.material(&p.material, &key("material"))?;
+            let volume_fraction =
+                self.range(&key("pvc"), p.pvc, p.pvc > 0.0 && p.pvc < 1.0, "(0, 1)")?;
+            let d = p.diameter_nm;
+            let diameter_nm = self.range(
+                &key("diameter_nm"),
+                d,
+                d > 0.0 && d <= max_d,
+                &format!("(0, {max_d}] nm (at most the layer thickness and the fragment size)"),
+            )?;
+            species.push(Species {
+                name: name.to_string(),
+                material,
+                volume_fraction,
+                diameter_nm,
+            });
+        }
+        let total: f64 = species.iter().map(|s| s.volume_fraction).sum();
+        if total > MAX_PVC_RSA * (1.0 + REL_EPS) {
+            return Err(self.invalid(
+                "pigment[*].pvc",
+                format!(
+                    "total pvc {total} exceeds {MAX_PVC_RSA}, the most the \
+                     random-sequential-addition packer supports; denser packing is not yet \
+                     supported"
+                ),
+            ));
+        }
+        Ok(species)
+    }
+
+    fn material(&self, raw: &RawMaterial, key: &str) -> Result<Material, ConfigError> {
+        match raw {
+            RawMaterial::Builtin(name) => Material::builtin(name).ok_or_else(|| {
+                self.invalid(
+                    format!("{key}.builtin"),
+                    format!(
+                        "unknown builtin material `{name}`; available: {}",
+                        BUILTIN_NAMES.join(", ")
+                    ),
+                )
+            }),
+            RawMaterial::Csv(rel) => {
+                if rel.trim().is_empty() {
+                    return Err(self.invalid(format!("{key}.csv"), "must not be empty"));
+                }
+                let base = self.file.parent().unwrap_or(Path::new(""));
+                let resolved = base.join(rel);
+                Material::from_csv(&resolved).map_err(|e| ConfigError::Material {
+                    file: self.file.to_path_buf(),
+                    material: rel.clone(),
+                    message: e.to_string(),
+                })
+            }
+        }
+    }
+
+    fn grid(&self, raw: &RawGrid, layer: &Layer) -> Result<GridSpec, ConfigError> {
+        let explicit = [("nx", raw.nx), ("ny", raw.ny), ("nz", raw.nz)];
+        let any_count = explicit.iter().any(|(_, v)| v.is_some());
+        match raw.cell_nm {
+            Some(_) if any_count => {
+                Err(self.invalid("grid", "give either cell_nm or all of nx, ny, nz, not both"))
+            }
+            None if raw.z_cell_nm.is_some() => Err(self.invalid(
+                "grid.z_cell_nm",
+                "goes with cell_nm; with explicit counts set nz instead",
+            )),
+            None if !any_count => {
+                Err(self.invalid("grid", "give either cell_nm or all of nx, ny, nz"))
+            }
+            Some(cell) => {
+                let cell = self.range(
+                    "grid.cell_nm",
+                    cell,
+                    cell > 0.0 && cell <= MAX_CELL_NM,
+                    &format!("(0, {MAX_CELL_NM}] nm"),
+                )?;
+                let count = |axis: &str, len: f64, min: usize| {
+                    let q = len / cell;
+                    if q > MAX_GRID_DIM as f64 {
+                        return Err(self.invalid(
+                            "grid.cell_nm",
+                            format!(
+                                "cell {cell} nm needs {} cells along {axis}, more than \
+                                 {MAX_GRID_DIM}; use a larger cell",
+                                q.ceil()
+                            ),
+                        ));
+                    }
+                    Ok(((q * (1.0 - REL_EPS)).ceil() as usize).max(min))
+                };
+                let nx = next_fft_size(count("x", layer.fragment_x_nm, 1)?);
+                let ny = next_fft_size(count("y", layer.fragment_y_nm, 1)?);
+                let z_cell = match raw.z_cell_nm {
+                    Some(z) => self.range(
+                        "grid.z_cell_nm",
+                        z,
+                        z > 0.0 && z <= MAX_CELL_NM,
+                        &format!("(0, {MAX_CELL_NM}] nm"),
+                    )?,
+                    None => cell.min(DEFAULT_Z_CELL_NM),
+                };
+                let nz = ((layer.thickness_nm / z_cell * (1.0 - REL_EPS)).ceil() as usize).max(2);
+                if nz > MAX_GRID_DIM {
+                    return Err(self.invalid(
+                        "grid.z_cell_nm",
+                        format!("needs {nz} cells along z, more than {MAX_GRID_DIM}"),
+                    ));
+                }
+                Ok(GridSpec { nx, ny, nz })
+            }
+            None => {
+                let mut n = [0usize; 3];
+                for (i, (axis, v)) in explicit.iter().enumerate() {
+                    let key = format!("grid.{axis}");
+                    let min = if i == 2 { 2 } else { 1 };
+                    let v = v.ok_or_else(|| {
+                        self.invalid(
+                            key.as_str(),
+                            "missing; give all of nx, ny, nz (or cell_nm alone)",
+                        )
+                    })?;
+                    if v < min || v > MAX_GRID_DIM as i64 {
+                        return Err(self
+                            .invalid(key, format!("must be in [{min}, {MAX_GRID_DIM}], got {v}")));
+                    }
+                    let v = v as usize;
+                    if i < 2 && !is_fft_size(v) {
+                        return Err(self.invalid(
+                            key,
+                            format!(
+                                "must be of the form 2^a 3^b 5^c (FFT-friendly), got {v}; \
+                                 nearest larger is {}",
+                                next_fft_size(v)
+                            ),
+                        ));
+                    }
+                    n[i] = v;
+                }
+                Ok(GridSpec {
+                    nx: n[0],
+                    ny: n[1],
+                    nz: n[2],
+                })
+            }
+        }
+    }
+
+    /// The wavelength list and the key it came from.
+    fn wavelengths(&self, raw: &RawIllumination) -> Result<(Vec<f64>, &'static str), ConfigError> {
+        match (&raw.wavelengths_nm, &raw.wavelength_range_nm) {
+            (Some(_), Some(_)) => Err(self.invalid(
+                "illumination",
+                "give either wavelengths_nm or wavelength_range_nm, not both",
+            )),
+            (None, None) => Err(self.invalid(
+                "illumination",
+                "give either wavelengths_nm or wavelength_range_nm",
+            )),
+            (Some(list), None) => {
+                let key = "illumination.wavelengths_nm";
+                if list.is_empty() {
+                    return Err(self.invalid(key, "must not be empty"));
+                }
+                if list.len() > MAX_WAVELENGTHS {
+                    return Err(self.invalid(
+                        key,
+                        format!("at most {MAX_WAVELENGTHS} values, got {}", list.len()),
+                    ));
+                }
+                for (i, &w) in list.iter().enumerate() {
+                    let k = format!("{key}[{i}]");
+                    self.range(&k, w, w > 0.0 && w.is_finite(), "(0, inf) nm")?;
+                    if i > 0 && w <= list[i - 1] {
+                        return Err(self.invalid(
+                            k,
+                            format!(
+                                "values must be strictly increasing, got {w} after {}",
+                                list[i - 1]
+                            ),
+                        ));
+                    }
+                }
+                Ok((list.clone(), key))
+            }
+            (None, Some(r)) => {
+                let key = "illumination.wavelength_range_nm";
+                self.range(
+                    &format!("{key}.start"),
+                    r.start,
+                    r.start > 0.0 && r.start.is_finite(),
+                    "(0, inf) nm",
+                )?;
+                self.range(
+                    &format!("{key}.stop"),
+                    r.stop,
+                    r.stop >= r.start && r.stop.is_finite(),
+                    &format!("[start, inf) = [{}, inf) nm", r.start),
+                )?;
+                self.range(
+                    &format!("{key}.step"),
+                    r.step,
+                    r.step > 0.0 && r.step.is_finite(),
+                    "(0, inf) nm",
+                )?;
+                let q = (r.stop - r.start) / r.step;
+                if q + 1.0 > MAX_WAVELENGTHS as f64 {
+                    return Err(self.invalid(
+                        key,
+                        format!(
+                            "gives {} wavelengths, more than {MAX_WAVELENGTHS}; use a larger step",
+                            q.floor() + 1.0
+                        ),
+                    ));
+                }
+                let steps = (q * (1.0 + REL_EPS)).floor() as usize;
+                let mut list: Vec<f64> = (0..=steps).map(|i| r.start + i as f64 * r.step).collect();
+                let last = list.len() - 1;
+                if (list[last] - r.stop).abs() <= REL_EPS * r.step {
+                    list[last] = r.stop;
+                }
+                Ok((list, key))
+            }
+        }
+    }
+
+    fn incidence(&self, raw: &RawIllumination) -> Result<Vec<Incidence>, ConfigError> {
+        let key = "illumination.polar_deg";
+        if raw.polar_deg.is_empty() {
+            return Err(self.invalid(key, "must not be empty"));
+        }
+        let a = raw.azimuth_deg.unwrap_or(0.0);
+        let azimuth_deg = self.range(
+            "illumination.azimuth_deg",
+            a,
+            (-360.0..=360.0).contains(&a),
+            "[-360, 360] deg",
+        )?;
+        let mut out = Vec::with_capacity(raw.polar_deg.len());
+        for (i, &p) in raw.polar_deg.iter().enumerate() {
+            let k = format!("{key}[{i}]");
+            self.range(
+                &k,
+                p,
+                (0.0..=MAX_POLAR_DEG).contains(&p),
+                &format!("[0, {MAX_POLAR_DEG}] deg"),
+            )?;
+            if i > 0 && p <= raw.polar_deg[i - 1] {
+                return Err(self.invalid(
+                    k,
+                    format!(
+                        "values must be strictly increasing, got {p} after {}",
+                        raw.polar_deg[i - 1]
+                    ),
+                ));
+            }
+            out.push(Incidence {
+                polar_deg: p,
+                azimuth_deg,
+            });
+        }
+        Ok(out)
+    }
+
+    fn solver(&self, raw: Option<&RawSolver>) -> Result<SolverSpec, ConfigError> {
+        let method = match raw.and_then(|s| s.method) {
+            Some(RawMethod::Born) => Method::Born,
+            Some(RawMethod::TimeMarching) => Method::TimeMarching,
+            Some(RawMethod::Auto) | None => Method::Auto,
+        };
+        let t = raw.and_then(|s| s.tolerance).unwrap_or(DEFAULT_TOLERANCE);
+        let tolerance = self.range(
+            "solver.tolerance",
+            t,
+            (1e-12..=1e-1).contains(&t),
+            "[1e-12, 1e-1]",
+        )?;
+        let max_iterations = match raw.and_then(|s| s.max_iterations) {
+            None => DEFAULT_MAX_ITERATIONS,
+            Some(m) if (1..=MAX_ITERATIONS).contains(&m) => m as usize,
+            Some(m) => {
+                return Err(self.invalid(
+                    "solver.max_iterations",
+                    format!("must be in [1, {MAX_ITERATIONS}], got {m}"),
+                ))
+            }
+        };
+        Ok(SolverSpec {
+            method,
+            tolerance,
+            max_iterations,
+        })
+    }
+
+    fn output(&self, path: &Path, raw: Option<&RawOutput>) -> Result<OutputSpec, ConfigError> {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "scene".to_string());
+        let dir = match raw.and_then(|o| o.dir.as_deref()) {
+            Some(d) if d.trim().is_empty() => {
+                return Err(self.invalid("output.dir", "must not be empty"))
+            }
+            Some(d) => PathBuf::from(d),
+            None => Path::new("runs").join(&stem),
+        };
+        let (name, from_stem) = match raw.and_then(|o| o.name.clone()) {
+            Some(n) => (n, false),
+            None => (stem, true),
+        };
+        let valid = !name.is_empty()
+            && name != "."
+            && name != ".."
+            && name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '-'));
+        if !valid {
+            let origin = if from_stem {
+                " (defaulted from the config file name; set output.name)"
+            } else {
+                ""
+            };
+            return Err(self.invalid(
+                "output.name",
+                format!("must be non-empty and use only A-Z a-z 0-9 _ . -, got `{name}`{origin}"),
+            ));
+        }
+        Ok(OutputSpec { dir, name })
+    }
+}
+
+/// Whether `n ≥ 1` has no prime factor other than 2, 3, 5.
+fn is_fft_size(mut n: usize) -> bool {
+    if n == 0 {
+        return false;
+    }
+    for p in [2, 3, 5] {
+        while n.is_multiple_of(p) {
+            n /= p;
+        }
+    }
+    n == 1
+}
+
+/// Smallest 2^a·3^b·5^c ≥ `n` (`n ≥ 1`).
+fn next_fft_size(n: usize) -> usize {
+    let mut m = n.max(1);
+    while !is_fft_size(m) {
+        m += 1;
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fft_sizes() {
+        let smooth: Vec<usize> = (1..=30).filter(|&n| is_fft_size(n)).collect();
+        assert_eq!(
+            smooth,
+            [1, 2, 3, 4, 5, 6, 8, 9, 10, 12, 15, 16, 18, 20, 24, 25, 27, 30]
+        );
+        assert!(!is_fft_size(0));
+        assert_eq!(next_fft_size(7), 8);
+        assert_eq!(next_fft_size(81), 81);
+        assert_eq!(next_fft_size(97), 100);
+        assert_eq!(next_fft_size(4096), 4096);
+        assert_eq!(next_fft_size(4001), 4050);
+    }
+}

@@ -1,0 +1,509 @@
+//! Integration tests of the configuration stage: parsing, validation messages,
+//! derived values (grid, wavelengths) and material loading.
+
+use inksim::config::*;
+use num_complex::Complex64;
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// A small valid scene; tests change one thing with [`edit`].
+const BASE: &str = r#"
+[layer]
+thickness_nm = 1000.0
+fragment_nm = [2000.0, 2000.0]
+
+[[pigment]]
+name = "red"
+material = { builtin = "red" }
+pvc = 0.2
+diameter_nm = 200.0
+
+[grid]
+cell_nm = 25.0
+
+[illumination]
+wavelengths_nm = [450.0, 550.0, 650.0]
+polar_deg = [0.0, 30.0]
+"#;
+
+const SECOND_PIGMENT: &str = r#"
+[[pigment]]
+name = "yellow"
+material = { builtin = "yellow" }
+pvc = 0.2
+diameter_nm = 200.0
+"#;
+
+fn edit(from: &str, to: &str) -> String {
+    assert!(BASE.contains(from), "test bug: `{from}` not in BASE");
+    BASE.replacen(from, to, 1)
+}
+
+fn parse(text: &str) -> Result<Scene, ConfigError> {
+    parse_scene(Path::new("cfg/test.toml"), text)
+}
+
+/// Parses `text`, expects `ConfigError::Invalid`, returns (key, full message).
+fn invalid(text: &str) -> (String, String) {
+    match parse(text) {
+        Err(e @ ConfigError::Invalid { .. }) => {
+            let shown = e.to_string();
+            assert!(shown.starts_with("cfg/test.toml: "), "{shown}");
+            assert!(!shown.contains('\n'), "not one line: {shown}");
+            let ConfigError::Invalid { key, .. } = e else {
+                unreachable!()
+            };
+            (key, shown)
+        }
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+}
+
+#[test]
+fn demo_parses_with_expected_values() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/demo.toml");
+    let scene = load_scene(&path).unwrap();
+    assert_eq!(scene.seed, 7);
+    assert_eq!((scene.grid.nx, scene.grid.ny, scene.grid.nz), (80, 80, 100));
+    assert_eq!(scene.layer.thickness_nm, 1000.0);
+    assert_eq!(
+        (scene.layer.fragment_x_nm, scene.layer.fragment_y_nm),
+        (2000.0, 2000.0)
+    );
+    assert_eq!(scene.layer.binder_index, 1.558);
+    assert_eq!(scene.species.len(), 1);
+    assert_eq!(scene.species[0].name, "red");
+    assert_eq!(
+        scene.species[0].material.source,
+        MaterialSource::Builtin("red".into())
+    );
+    assert_eq!(scene.species[0].diameter_nm, 200.0);
+    assert_eq!(scene.total_pvc(), 0.2);
+    assert_eq!(scene.wavelengths_nm, [450.0, 550.0, 650.0]);
+    let polar: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
+    assert_eq!(polar, [0.0, 30.0, 60.0]);
+    assert!(scene.incidence.iter().all(|i| i.azimuth_deg == 0.0));
+    assert_eq!(scene.solver.method, Method::Auto);
+    assert_eq!(scene.solver.tolerance, 1e-6);
+    assert_eq!(scene.solver.max_iterations, 5000);
+    assert_eq!(scene.output.dir, PathBuf::from("runs/demo"));
+    assert_eq!(scene.output.name, "demo");
+    assert_eq!(scene.path(), path.as_path());
+    assert_eq!(
+        scene.provenance.text,
+        std::fs::read_to_string(&path).unwrap()
+    );
+    let h = &scene.provenance.input_hash;
+    assert_eq!(h.len(), 64);
+    assert!(h
+        .chars()
+        .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase()));
+}
+
+#[test]
+fn defaults_apply() {
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.seed, 1);
+    assert_eq!(s.layer.binder_index, 1.558);
+    assert_eq!(s.solver.method, Method::Auto);
+    assert_eq!(s.solver.tolerance, 1e-6);
+    assert_eq!(s.solver.max_iterations, 5000);
+    assert_eq!(s.output.dir, Path::new("runs").join("test"));
+    assert_eq!(s.output.name, "test");
+    // azimuth default and one incidence per polar angle
+    assert_eq!(
+        s.incidence,
+        [
+            Incidence {
+                polar_deg: 0.0,
+                azimuth_deg: 0.0
+            },
+            Incidence {
+                polar_deg: 30.0,
+                azimuth_deg: 0.0
+            }
+        ]
+    );
+}
+
+#[test]
+fn solver_methods_parse() {
+    for (word, want) in [
+        ("born", Method::Born),
+        ("time-marching", Method::TimeMarching),
+        ("auto", Method::Auto),
+    ] {
+        let text = format!("{BASE}\n[solver]\nmethod = \"{word}\"\nmax_iterations = 7\n");
+        let s = parse(&text).unwrap();
+        assert_eq!(s.solver.method, want);
+        assert_eq!(s.solver.max_iterations, 7);
+    }
+    let err = parse(&format!("{BASE}\n[solver]\nmethod = \"cg\"\n")).unwrap_err();
+    assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
+    assert!(err.to_string().contains("cg"), "{err}");
+}
+
+#[test]
+fn unknown_key_is_named_on_one_line() {
+    let text = edit(
+        "thickness_nm = 1000.0",
+        "thickness_nm = 1000.0\nthicknes_nm = 5.0",
+    );
+    let err = parse(&text).unwrap_err();
+    assert!(matches!(err, ConfigError::Parse { .. }), "{err:?}");
+    let shown = err.to_string();
+    assert!(
+        shown.starts_with("cfg/test.toml: line 4, column 1: "),
+        "{shown}"
+    );
+    assert!(shown.contains("unknown field `thicknes_nm`"), "{shown}");
+    assert!(!shown.contains('\n'), "{shown}");
+}
+
+#[test]
+fn negative_thickness_names_key_and_range() {
+    let (key, shown) = invalid(&edit("thickness_nm = 1000.0", "thickness_nm = -5.0"));
+    assert_eq!(key, "layer.thickness_nm");
+    assert!(shown.contains("(0, 20000] nm"), "{shown}");
+    assert!(shown.contains("got -5"), "{shown}");
+}
+
+#[test]
+fn other_ranges_are_checked() {
+    let cases = [
+        (
+            edit("[2000.0, 2000.0]", "[2000.0, 2000.0]\nbinder_index = 0.9"),
+            "layer.binder_index",
+        ),
+        (
+            edit(
+                "fragment_nm = [2000.0, 2000.0]",
+                "fragment_nm = [2000.0, 0.0]",
+            ),
+            "layer.fragment_nm[1]",
+        ),
+        (
+            edit("fragment_nm = [2000.0, 2000.0]", "fragment_nm = [2000.0]"),
+            "layer.fragment_nm",
+        ),
+        (edit("pvc = 0.2", "pvc = 0.0"), "pigment[0].pvc"),
+        (
+            edit("diameter_nm = 200.0", "diameter_nm = 1200.0"),
+            "pigment[0].diameter_nm",
+        ),
+        (edit("cell_nm = 25.0", "cell_nm = 0.0"), "grid.cell_nm"),
+        (edit("cell_nm = 25.0", "cell_nm = 0.1"), "grid.cell_nm"),
+        (
+            edit("polar_deg = [0.0, 30.0]", "polar_deg = [0.0, 90.0]"),
+            "illumination.polar_deg[1]",
+        ),
+        (
+            edit("polar_deg = [0.0, 30.0]", "polar_deg = [30.0, 0.0]"),
+            "illumination.polar_deg[1]",
+        ),
+        (
+            edit("polar_deg = [0.0, 30.0]", "polar_deg = []"),
+            "illumination.polar_deg",
+        ),
+        (
+            edit(
+                "polar_deg = [0.0, 30.0]",
+                "polar_deg = [0.0]\nazimuth_deg = 400.0",
+            ),
+            "illumination.azimuth_deg",
+        ),
+        (
+            edit("[450.0, 550.0, 650.0]", "[450.0, 450.0]"),
+            "illumination.wavelengths_nm[1]",
+        ),
+        (
+            edit("[450.0, 550.0, 650.0]", "[]"),
+            "illumination.wavelengths_nm",
+        ),
+        (format!("seed = -1\n{BASE}"), "seed"),
+        (
+            format!("{BASE}[solver]\ntolerance = 0.5\n"),
+            "solver.tolerance",
+        ),
+        (
+            format!("{BASE}[solver]\nmax_iterations = 0\n"),
+            "solver.max_iterations",
+        ),
+        (format!("{BASE}[output]\nname = \"a/b\"\n"), "output.name"),
+        (format!("{BASE}[output]\ndir = \"\"\n"), "output.dir"),
+        (
+            edit("{ builtin = \"red\" }", "{ builtin = \"purple\" }"),
+            "pigment[0].material.builtin",
+        ),
+    ];
+    for (text, want) in cases {
+        let (key, shown) = invalid(&text);
+        assert_eq!(key, want, "{shown}");
+        assert!(shown.contains(&format!("key `{want}`: ")), "{shown}");
+    }
+}
+
+#[test]
+fn pvc_above_rsa_limit_is_rejected() {
+    let (key, shown) = invalid(&format!("{BASE}{SECOND_PIGMENT}"));
+    assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
+    assert!(shown.contains("0.35"), "{shown}");
+    assert!(shown.contains("random-sequential-addition"), "{shown}");
+    assert!(shown.contains("not yet supported"), "{shown}");
+    assert_eq!(MAX_PVC_RSA, 0.35);
+
+    // A single species above the limit, too.
+    let (key, _) = invalid(&edit("pvc = 0.2", "pvc = 0.36"));
+    assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
+
+    // Exactly at the limit (0.15 + 0.2 is 0.35000000000000003 in f64) passes.
+    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.15", 1);
+    let s = parse(&text).unwrap();
+    assert_eq!(s.species.len(), 2);
+    assert!((s.total_pvc() - 0.35).abs() < 1e-15);
+}
+
+#[test]
+fn duplicate_pigment_names_are_rejected() {
+    let text = format!("{BASE}{SECOND_PIGMENT}")
+        .replace("name = \"yellow\"", "name = \"red\"")
+        .replacen("pvc = 0.2", "pvc = 0.1", 2);
+    let (key, shown) = invalid(&text);
+    assert_eq!(key, "pigment[1].name");
+    assert!(
+        shown.contains("duplicate") && shown.contains("`red`"),
+        "{shown}"
+    );
+    let (key, _) = invalid(&edit("name = \"red\"", "name = \" \""));
+    assert_eq!(key, "pigment[0].name");
+}
+
+#[test]
+fn missing_pigments_are_rejected() {
+    let start = BASE.find("[[pigment]]").unwrap();
+    let end = BASE.find("[grid]").unwrap();
+    let text = format!("{}{}", &BASE[..start], &BASE[end..]);
+    let (key, _) = invalid(&text);
+    assert_eq!(key, "pigment");
+}
+
+#[test]
+fn wavelength_outside_material_range_is_rejected() {
+    let (key, shown) = invalid(&edit("[450.0, 550.0, 650.0]", "[350.0, 450.0]"));
+    assert_eq!(key, "illumination.wavelengths_nm");
+    assert!(shown.contains("350 nm"), "{shown}");
+    assert!(shown.contains("`red`"), "{shown}");
+    assert!(shown.contains("[380, 780] nm"), "{shown}");
+
+    let text = edit(
+        "wavelengths_nm = [450.0, 550.0, 650.0]",
+        "wavelength_range_nm = { start = 400.0, stop = 800.0, step = 100.0 }",
+    );
+    let (key, shown) = invalid(&text);
+    assert_eq!(key, "illumination.wavelength_range_nm");
+    assert!(shown.contains("800 nm"), "{shown}");
+}
+
+#[test]
+fn grid_forms() {
+    // both
+    let (key, shown) = invalid(&edit("cell_nm = 25.0", "cell_nm = 25.0\nnx = 80"));
+    assert_eq!(key, "grid");
+    assert!(shown.contains("not both"), "{shown}");
+    // neither
+    let (key, _) = invalid(&edit("cell_nm = 25.0", ""));
+    assert_eq!(key, "grid");
+    // incomplete explicit form
+    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 80\nny = 80"));
+    assert_eq!(key, "grid.nz");
+    // nx must be FFT-friendly
+    let (key, shown) = invalid(&edit("cell_nm = 25.0", "nx = 7\nny = 8\nnz = 10"));
+    assert_eq!(key, "grid.nx");
+    assert!(
+        shown.contains("2^a 3^b 5^c") && shown.contains("8"),
+        "{shown}"
+    );
+    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 8\nny = 8\nnz = 1"));
+    assert_eq!(key, "grid.nz");
+    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 8192\nny = 8\nnz = 2"));
+    assert_eq!(key, "grid.nx");
+    // valid explicit form; nz needs no factorisation
+    let g = parse(&edit("cell_nm = 25.0", "nx = 90\nny = 1\nnz = 7"))
+        .unwrap()
+        .grid;
+    assert_eq!((g.nx, g.ny, g.nz), (90, 1, 7));
+    // from a cell: 2000/30 = 66.7 -> 67 -> 72 = 2^3 3^2; z cell defaults to 10 nm -> 100
+    let g = parse(&edit("cell_nm = 25.0", "cell_nm = 30.0"))
+        .unwrap()
+        .grid;
+    assert_eq!((g.nx, g.ny, g.nz), (72, 72, 100));
+    // explicit z cell: 1000/30 -> 34
+    let g = parse(&edit("cell_nm = 25.0", "cell_nm = 30.0\nz_cell_nm = 30.0"))
+        .unwrap()
+        .grid;
+    assert_eq!((g.nx, g.ny, g.nz), (72, 72, 34));
+    // z_cell_nm only goes with cell_nm
+    let (key, _) = invalid(&edit(
+        "cell_nm = 25.0",
+        "nx = 8\nny = 8\nnz = 4\nz_cell_nm = 5.0",
+    ));
+    assert_eq!(key, "grid.z_cell_nm");
+    // rounding noise does not add a cell: 1.1/0.1 = 11.000000000000002 in f64
+    let text = BASE
+        .replace("thickness_nm = 1000.0", "thickness_nm = 1.1")
+        .replace("[2000.0, 2000.0]", "[1.1, 1.1]")
+        .replace("diameter_nm = 200.0", "diameter_nm = 1.0")
+        .replace("cell_nm = 25.0", "cell_nm = 0.1");
+    let g = parse(&text).unwrap().grid;
+    assert_eq!((g.nx, g.ny, g.nz), (12, 12, 11));
+}
+
+#[test]
+fn wavelength_range_expansion() {
+    let range = |r: &str| {
+        let text = edit(
+            "wavelengths_nm = [450.0, 550.0, 650.0]",
+            &format!("wavelength_range_nm = {{ {r} }}"),
+        );
+        parse(&text).map(|s| s.wavelengths_nm)
+    };
+    assert_eq!(
+        range("start = 400.0, stop = 700.0, step = 50.0").unwrap(),
+        [400.0, 450.0, 500.0, 550.0, 600.0, 650.0, 700.0]
+    );
+    // stop off the step grid is not included
+    assert_eq!(
+        range("start = 400.0, stop = 690.0, step = 50.0").unwrap(),
+        [400.0, 450.0, 500.0, 550.0, 600.0, 650.0]
+    );
+    assert_eq!(
+        range("start = 500.0, stop = 500.0, step = 10.0").unwrap(),
+        [500.0]
+    );
+    // 0.1 is inexact in binary; stop is still included, exactly
+    let w = range("start = 400.0, stop = 401.0, step = 0.1").unwrap();
+    assert_eq!(w.len(), 11);
+    assert_eq!(w[10], 401.0);
+    assert!(range("start = 500.0, stop = 400.0, step = 10.0").is_err());
+    assert!(range("start = 400.0, stop = 500.0, step = 0.0").is_err());
+    // both forms at once
+    let text = edit(
+        "wavelengths_nm = [450.0, 550.0, 650.0]",
+        "wavelengths_nm = [450.0]\nwavelength_range_nm = { start = 400.0, stop = 700.0, step = 50.0 }",
+    );
+    let (key, _) = invalid(&text);
+    assert_eq!(key, "illumination");
+}
+
+/// Writes `config.toml` (BASE with a CSV pigment) and `data/ink.csv` into a
+/// temporary folder; returns the folder and the config path.
+fn csv_scene(csv: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("data")).unwrap();
+    std::fs::write(dir.path().join("data/ink.csv"), csv).unwrap();
+    let text = edit("{ builtin = \"red\" }", "{ csv = \"data/ink.csv\" }");
+    let cfg = dir.path().join("config.toml");
+    std::fs::write(&cfg, text).unwrap();
+    (dir, cfg)
+}
+
+const INK_CSV: &str = "# measured ink\nwavelength_nm,n,k\n400,1.0,0.0\n500,2.0,0.5\n700,1.5,0.1\n";
+
+#[test]
+fn csv_material_loads_relative_to_config_and_interpolates() {
+    let (dir, cfg) = csv_scene(INK_CSV);
+    let scene = load_scene(&cfg).unwrap();
+    let m = &scene.species[0].material;
+    assert_eq!(m.name, "ink");
+    assert_eq!(
+        m.source,
+        MaterialSource::Csv(dir.path().join("data/ink.csv"))
+    );
+    assert_eq!(m.range_nm(), (400.0, 700.0));
+    assert_eq!(m.table_bytes(), INK_CSV.as_bytes());
+    // midpoints of both intervals, exact in binary arithmetic
+    assert_eq!(m.index_at(450.0), Some(Complex64::new(1.5, 0.25)));
+    assert_eq!(m.index_at(600.0), Some(Complex64::new(1.75, 0.3)));
+    assert_eq!(m.index_at(500.0), Some(Complex64::new(2.0, 0.5)));
+    assert_eq!(m.index_at(700.0), Some(Complex64::new(1.5, 0.1)));
+    assert_eq!(m.index_at(399.0), None);
+    assert_eq!(m.index_at(701.0), None);
+    // quarter point
+    let q = m.index_at(425.0).unwrap();
+    assert_eq!(q, Complex64::new(1.25, 0.125));
+    // output defaults come from the config file stem
+    assert_eq!(scene.output.name, "config");
+}
+
+#[test]
+fn bad_csv_error_names_file_and_line() {
+    let csv = "# measured ink\nwavelength_nm,n,k\n400,1.0,0.0\n500,2.0,0.5\n450,1.5,0.1\n";
+    let (_dir, cfg) = csv_scene(csv);
+    let err = load_scene(&cfg).unwrap_err();
+    assert!(matches!(err, ConfigError::Material { .. }), "{err:?}");
+    let shown = err.to_string();
+    assert!(shown.starts_with(&cfg.display().to_string()), "{shown}");
+    assert!(shown.contains("ink.csv: line 5"), "{shown}");
+    assert!(shown.contains("strictly increasing"), "{shown}");
+    assert!(!shown.contains('\n'), "{shown}");
+
+    // a missing file names the resolved path
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(
+        &cfg,
+        edit("{ builtin = \"red\" }", "{ csv = \"nope.csv\" }"),
+    )
+    .unwrap();
+    let shown = load_scene(&cfg).unwrap_err().to_string();
+    assert!(shown.contains("nope.csv: cannot read"), "{shown}");
+}
+
+#[test]
+fn hash_covers_config_and_tables() {
+    let (_d1, cfg1) = csv_scene(INK_CSV);
+    let (_d2, cfg2) = csv_scene(INK_CSV);
+    let (_d3, cfg3) = csv_scene(&INK_CSV.replace("2.0,0.5", "2.0,0.6"));
+    let h1 = load_scene(&cfg1).unwrap().provenance.input_hash;
+    let h2 = load_scene(&cfg2).unwrap().provenance.input_hash;
+    let h3 = load_scene(&cfg3).unwrap().provenance.input_hash;
+    assert_eq!(h1, h2, "same inputs, same hash");
+    assert_ne!(h1, h3, "changed table, changed hash");
+    // config text alone changes the hash too
+    let a = parse(BASE).unwrap().provenance.input_hash;
+    let b = parse(&format!("{BASE}\n# comment\n"))
+        .unwrap()
+        .provenance
+        .input_hash;
+    assert_ne!(a, b);
+    // independent reference: sha256(config text ++ embedded red.csv)
+    let red_csv =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/pigments/red.csv")).unwrap();
+    let mut h = Sha256::new();
+    h.update(BASE.as_bytes());
+    h.update(&red_csv);
+    let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    assert_eq!(a, want);
+    // and for a CSV material: sha256(config text ++ file bytes)
+    let mut h = Sha256::new();
+    h.update(std::fs::read(&cfg1).unwrap());
+    h.update(INK_CSV.as_bytes());
+    let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    assert_eq!(h1, want);
+}
+
+#[test]
+fn read_and_parse_errors() {
+    let missing = Path::new("/nonexistent/dir/scene.toml");
+    let err = load_scene(missing).unwrap_err();
+    assert!(matches!(err, ConfigError::Read { .. }));
+    assert!(err
+        .to_string()
+        .starts_with("/nonexistent/dir/scene.toml: cannot read"));
+    // malformed TOML and wrong types are parse errors on one line
+    for text in ["[layer\n", &edit("1000.0", "\"thick\"")] {
+        let shown = parse(text).unwrap_err().to_string();
+        assert!(shown.starts_with("cfg/test.toml: line "), "{shown}");
+        assert!(!shown.contains('\n'), "{shown}");
+    }
+}

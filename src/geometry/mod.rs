@@ -1,0 +1,290 @@
+//! Stage 1 — geometry of the fragment (METHOD §2).
+//!
+//! Owns the particle list of one random fragment `[0,Lx) × [0,Ly) × [0,H]`,
+//! periodic in x and y with walls at `z = 0` and `z = H`, and the packers that
+//! build it. Every particle is a rigid cluster of spheres ([`Particle`]); the
+//! packer here ([`pack_rsa`], random sequential addition, for PVC ≲ 30 %)
+//! makes one-sphere particles. Lengths are in nm.
+//!
+//! Choices:
+//! - sphere centres are stored wrapped into `[0,Lx) × [0,Ly)`; distances use
+//!   the nearest periodic image, which is exact because a grain may be at most
+//!   half the lateral period wide (checked);
+//! - particle counts are `N_s = round(f_s · V / v_s)`, so the achieved fraction
+//!   differs from the target only by that rounding (reported in
+//!   [`GeometryStats`]);
+//! - RSA cannot exceed its jamming limit (≈ 0.38 for spheres in bulk, lower
+//!   next to walls); it reports [`GeometryError::NotReached`] with the fraction
+//!   it reached instead of looping.
+
+mod cells;
+mod rsa;
+
+use cells::{dist2, CellList};
+
+/// Most particles one fragment may hold (guards memory against tiny grains).
+pub const MAX_PARTICLES: usize = 50_000_000;
+
+/// A sphere of a particle, centre in world coordinates (x, y wrapped into
+/// `[0, L)` by the packer).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sphere {
+    pub center: [f64; 3],
+    pub radius: f64,
+}
+
+/// A rigid particle: a cluster of spheres of one species (spheres of one
+/// particle may overlap each other).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Particle {
+    pub species: usize,
+    pub spheres: Vec<Sphere>,
+}
+
+/// One species to pack.
+#[derive(Debug, Clone)]
+pub struct SpeciesParams {
+    /// Sphere diameter, nm (> 0, ≤ H, ≤ half the lateral period).
+    pub diameter_nm: f64,
+    /// Target volume fraction of the fragment, in `[0, 1)`.
+    pub volume_fraction: f64,
+}
+
+/// Fragment `[0,Lx) × [0,Ly) × [0,H]` (periodic in x, y; walls at `z = 0`
+/// and `z = H`) and what to put in it.
+#[derive(Debug, Clone)]
+pub struct PackParams {
+    /// `[Lx, Ly, H]`, nm.
+    pub size_nm: [f64; 3],
+    pub species: Vec<SpeciesParams>,
+    /// Consecutive rejected draws after which one particle counts as
+    /// unplaceable and packing stops (≥ 1).
+    pub max_attempts_per_particle: u64,
+}
+
+/// The METHOD §1 default fragment (10 × 10 µm, 1 µm thick), no species,
+/// [`PackParams::DEFAULT_MAX_ATTEMPTS`].
+impl Default for PackParams {
+    fn default() -> Self {
+        PackParams::new([10_000.0, 10_000.0, 1_000.0], Vec::new())
+    }
+}
+
+impl PackParams {
+    /// Default limit of consecutive failed draws per particle.
+    pub const DEFAULT_MAX_ATTEMPTS: u64 = 100_000;
+
+    /// Parameters with the default attempt limit.
+    pub fn new(size_nm: [f64; 3], species: Vec<SpeciesParams>) -> Self {
+        PackParams {
+            size_nm,
+            species,
+            max_attempts_per_particle: Self::DEFAULT_MAX_ATTEMPTS,
+        }
+    }
+}
+
+/// What the packer achieved.
+#[derive(Debug, Clone)]
+pub struct GeometryStats {
+    /// Particles per species.
+    pub count: Vec<usize>,
+    /// Requested volume fraction per species.
+    pub target_fraction: Vec<f64>,
+    /// Placed volume / fragment volume per species (exact: no overlaps).
+    pub achieved_fraction: Vec<f64>,
+    /// Smallest surface-to-surface distance between two particles, periodic
+    /// images included; `+inf` with fewer than two particles.
+    pub min_gap_nm: f64,
+    /// Centres drawn in total (accepted and rejected).
+    pub attempts: u64,
+}
+
+/// One packed fragment.
+#[derive(Debug, Clone)]
+pub struct Geometry {
+    /// `[Lx, Ly, H]`, nm.
+    pub size_nm: [f64; 3],
+    /// Particles in placement order.
+    pub particles: Vec<Particle>,
+    pub stats: GeometryStats,
+}
+
+/// Why a fragment could not be packed.
+#[derive(Debug, thiserror::Error)]
+pub enum GeometryError {
+    #[error(
+        "species {species}: grain diameter {diameter_nm} nm exceeds the layer thickness \
+         {thickness_nm} nm (allowed: 0 < diameter ≤ thickness)"
+    )]
+    GrainTooLarge {
+        species: usize,
+        diameter_nm: f64,
+        thickness_nm: f64,
+    },
+    #[error(
+        "random sequential addition stalled: species {species} placed {placed} of {wanted} \
+         particles; reached total volume fraction {reached:.4} of target {target:.4} after \
+         {attempts} draws (RSA jams near 0.30–0.38; lower the PVC or raise \
+         max_attempts_per_particle)"
+    )]
+    NotReached {
+        /// Species being placed when packing stopped.
+        species: usize,
+        /// Particles of that species already placed.
+        placed: usize,
+        /// Particles of that species wanted.
+        wanted: usize,
+        /// Total requested volume fraction (all species).
+        target: f64,
+        /// Total volume fraction placed when packing stopped.
+        reached: f64,
+        /// Centres drawn in total.
+        attempts: u64,
+    },
+    #[error("invalid geometry parameters: {0}")]
+    Invalid(String),
+}
+
+/// Volume of a sphere of radius `r`.
+pub fn sphere_volume(r: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * r * r * r
+}
+
+fn validate(params: &PackParams) -> Result<Vec<usize>, GeometryError> {
+    let [lx, ly, h] = params.size_nm;
+    for (name, v) in [("Lx", lx), ("Ly", ly), ("H", h)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(GeometryError::Invalid(format!(
+                "fragment size {name} = {v} nm must be finite and > 0"
+            )));
+        }
+    }
+    if params.max_attempts_per_particle == 0 {
+        return Err(GeometryError::Invalid(
+            "max_attempts_per_particle must be ≥ 1".into(),
+        ));
+    }
+    let volume = lx * ly * h;
+    let mut total_fraction = 0.0;
+    let mut counts = Vec::with_capacity(params.species.len());
+    for (i, s) in params.species.iter().enumerate() {
+        let d = s.diameter_nm;
+        if !(d.is_finite() && d > 0.0) {
+            return Err(GeometryError::Invalid(format!(
+                "species {i}: diameter {d} nm must be finite and > 0"
+            )));
+        }
+        if d > h {
+            return Err(GeometryError::GrainTooLarge {
+                species: i,
+                diameter_nm: d,
+                thickness_nm: h,
+            });
+        }
+        let half = 0.5 * lx.min(ly);
+        if d > half {
+            return Err(GeometryError::Invalid(format!(
+                "species {i}: diameter {d} nm exceeds half the lateral period ({half} nm); \
+                 allowed 0 < diameter ≤ min(Lx, Ly)/2"
+            )));
+        }
+        let f = s.volume_fraction;
+        if !(f.is_finite() && (0.0..1.0).contains(&f)) {
+            return Err(GeometryError::Invalid(format!(
+                "species {i}: volume fraction {f} must be in [0, 1)"
+            )));
+        }
+        total_fraction += f;
+        let n = (f * volume / sphere_volume(0.5 * d)).round();
+        if n > MAX_PARTICLES as f64 {
+            return Err(GeometryError::Invalid(format!(
+                "species {i}: {n} particles of {d} nm needed; at most {MAX_PARTICLES} allowed"
+            )));
+        }
+        counts.push(n as usize);
+    }
+    if total_fraction >= 1.0 {
+        return Err(GeometryError::Invalid(format!(
+            "total volume fraction {total_fraction} must be < 1"
+        )));
+    }
+    if counts.iter().sum::<usize>() > MAX_PARTICLES {
+        return Err(GeometryError::Invalid(format!(
+            "{} particles in total; at most {MAX_PARTICLES} allowed",
+            counts.iter().sum::<usize>()
+        )));
+    }
+    Ok(counts)
+}
+
+/// Packs one fragment by random sequential addition (see the module docs).
+///
+/// Deterministic: the same parameters and `seed` give identical particles.
+pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryError> {
+    let counts = validate(params)?;
+    let (particles, attempts) = rsa::pack(params, &counts, seed)?;
+    let volume = params.size_nm.iter().product::<f64>();
+    let achieved_fraction = params
+        .species
+        .iter()
+        .zip(&counts)
+        .map(|(s, &n)| n as f64 * sphere_volume(0.5 * s.diameter_nm) / volume)
+        .collect();
+    let min_gap_nm = min_gap_nm(params.size_nm, &particles);
+    Ok(Geometry {
+        size_nm: params.size_nm,
+        particles,
+        stats: GeometryStats {
+            count: counts,
+            target_fraction: params.species.iter().map(|s| s.volume_fraction).collect(),
+            achieved_fraction,
+            min_gap_nm,
+            attempts,
+        },
+    })
+}
+
+/// Smallest surface-to-surface distance `|AB| − r_A − r_B` between spheres of
+/// different particles, nearest periodic image in x and y (negative for an
+/// overlap); `+inf` with fewer than two particles.
+///
+/// Uses a cell list with a stencil that widens until the result is provably
+/// the global minimum, so it costs O(N) for packed fragments.
+pub fn min_gap_nm(size_nm: [f64; 3], particles: &[Particle]) -> f64 {
+    let spheres: usize = particles.iter().map(|p| p.spheres.len()).sum();
+    let rmax = particles
+        .iter()
+        .flat_map(|p| &p.spheres)
+        .map(|s| s.radius)
+        .fold(0.0, f64::max);
+    if particles.len() < 2 || !size_nm.iter().all(|v| v.is_finite() && *v > 0.0) {
+        return f64::INFINITY;
+    }
+    let mut cells = CellList::new(size_nm, (2.0 * rmax).max(f64::MIN_POSITIVE), spheres);
+    for (i, p) in particles.iter().enumerate() {
+        for s in &p.spheres {
+            cells.insert(*s, i as u32);
+        }
+    }
+    let mut k = 1;
+    loop {
+        let mut best = f64::INFINITY;
+        for (i, p) in particles.iter().enumerate() {
+            for a in &p.spheres {
+                cells.any_near(&a.center, k, |_, b, owner| {
+                    if owner as usize > i {
+                        let g = dist2(&a.center, &b.center, &size_nm).sqrt() - a.radius - b.radius;
+                        best = best.min(g);
+                    }
+                    false
+                });
+            }
+        }
+        // Any pair closer than `best` has centres within best + 2 rmax.
+        if cells.stencil_covers_all(k) || best + 2.0 * rmax <= k as f64 * cells.min_cell_width() {
+            return best;
+        }
+        k += 1;
+    }
+}

@@ -1,0 +1,462 @@
+//! Stage 2 — the fragment on a uniform grid (METHOD §3).
+//!
+//! Owns the volume fraction of every species in every voxel; the permittivity
+//! for a wavelength is then a per-voxel linear mix ([`Raster::epsilon_into`]),
+//! so the geometry is rasterised once for all wavelengths.
+//!
+//! Grid: `nx × ny × nz` voxels spanning exactly the fragment; voxel
+//! `(ix, iy, iz)` covers `[ix·dx, (ix+1)·dx) × [iy·dy, (iy+1)·dy) ×
+//! [iz·dz, (iz+1)·dz)` with `dz = H/nz`. Arrays are `(nz, ny, nx)`, so every
+//! x–y slice is contiguous (the solver FFTs those).
+//!
+//! Volume fraction, not a point sample: for each particle and each voxel of
+//! its bounding box (wrapped periodically in x and y) the voxel counts 1 when it
+//! lies entirely inside one of the particle's spheres, 0 when it lies entirely
+//! outside all of them (box–sphere distance test), and otherwise the share of
+//! `s³` midpoint sub-samples inside the union of the particle's spheres. The
+//! sub-samples along each x line are counted analytically from the chord of
+//! every sphere (same result as testing each point, O(s²) instead of O(s³)).
+//! Contributions add up per species; where overlapping particles would make
+//! the voxel's total exceed 1, all species are scaled down so the total is 1.
+//!
+//! Parallel over z-slices: every slice adds its particles' contributions in
+//! particle order, so the result is bit-identical for any thread count.
+//! Particles are assumed narrower than the lateral period (the packer ensures
+//! half of it); parts outside `0 ≤ z ≤ H` are not rasterised.
+
+use crate::geometry::{Geometry, Sphere};
+use ndarray::{Array3, ArrayViewMut2, Axis};
+use num_complex::Complex64;
+use rayon::prelude::*;
+
+/// Largest supported supersampling factor per axis (one x line of sub-samples
+/// is a 64-bit mask).
+pub const MAX_SUPERSAMPLE: usize = 64;
+
+/// Uniform grid over the fragment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    pub nx: usize,
+    pub ny: usize,
+    pub nz: usize,
+    /// `[Lx, Ly, H]`, nm; the same as the geometry's fragment.
+    pub size_nm: [f64; 3],
+}
+
+/// A grid that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum RasterError {
+    #[error("invalid grid: {0}")]
+    Invalid(String),
+}
+
+impl Grid {
+    /// A checked grid: every count ≥ 1, every size finite and > 0.
+    pub fn new(nx: usize, ny: usize, nz: usize, size_nm: [f64; 3]) -> Result<Grid, RasterError> {
+        let g = Grid {
+            nx,
+            ny,
+            nz,
+            size_nm,
+        };
+        g.check()?;
+        Ok(g)
+    }
+
+    /// Checks the counts (≥ 1) and sizes (finite, > 0).
+    pub fn check(&self) -> Result<(), RasterError> {
+        for (name, n) in [("nx", self.nx), ("ny", self.ny), ("nz", self.nz)] {
+            if n == 0 {
+                return Err(RasterError::Invalid(format!("{name} = 0; must be ≥ 1")));
+            }
+        }
+        if self
+            .nx
+            .checked_mul(self.ny)
+            .and_then(|v| v.checked_mul(self.nz))
+            .is_none()
+        {
+            return Err(RasterError::Invalid("nx·ny·nz overflows".into()));
+        }
+        for (name, v) in ["Lx", "Ly", "H"].iter().zip(self.size_nm) {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(RasterError::Invalid(format!(
+                    "fragment size {name} = {v} nm; must be finite and > 0"
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Voxel edge lengths `[dx, dy, dz]`, nm.
+    pub fn cell_nm(&self) -> [f64; 3] {
+        [
+            self.size_nm[0] / self.nx as f64,
+            self.size_nm[1] / self.ny as f64,
+            self.size_nm[2] / self.nz as f64,
+        ]
+    }
+
+    /// Number of voxels.
+    pub fn voxels(&self) -> usize {
+        self.nx * self.ny * self.nz
+    }
+
+    /// Volume of one voxel, nm³.
+    pub fn voxel_volume_nm3(&self) -> f64 {
+        let c = self.cell_nm();
+        c[0] * c[1] * c[2]
+    }
+}
+
+/// Volume fraction of each species in each voxel, arrays of shape
+/// `(nz, ny, nx)`.
+#[derive(Debug, Clone)]
+pub struct Raster {
+    pub grid: Grid,
+    pub fractions: Vec<Array3<f64>>,
+}
+
+/// A particle ready for rasterising: its spheres unwrapped next to the first
+/// one, and their bounding box.
+struct Prepared {
+    species: usize,
+    first: usize,
+    len: usize,
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+fn prepare(geometry: &Geometry, size: [f64; 3]) -> (Vec<Prepared>, Vec<Sphere>) {
+    let mut preps = Vec::with_capacity(geometry.particles.len());
+    let mut spheres = Vec::new();
+    for p in &geometry.particles {
+        let Some(s0) = p.spheres.first() else {
+            continue;
+        };
+        let finite = p
+            .spheres
+            .iter()
+            .all(|s| s.center.iter().all(|c| c.is_finite()) && s.radius.is_finite());
+        if !finite {
+            continue;
+        }
+        let first = spheres.len();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for s in &p.spheres {
+            let mut c = s.center;
+            for a in 0..2 {
+                let d = c[a] - s0.center[a];
+                c[a] = s0.center[a] + d - size[a] * (d / size[a]).round();
+            }
+            let r = s.radius.max(0.0);
+            for a in 0..3 {
+                lo[a] = lo[a].min(c[a] - r);
+                hi[a] = hi[a].max(c[a] + r);
+            }
+            spheres.push(Sphere {
+                center: c,
+                radius: r,
+            });
+        }
+        preps.push(Prepared {
+            species: p.species,
+            first,
+            len: p.spheres.len(),
+            lo,
+            hi,
+        });
+    }
+    (preps, spheres)
+}
+
+/// Inclusive voxel range `[floor(lo/d), floor(hi/d)]`, at most `n` long.
+fn voxel_range(lo: f64, hi: f64, d: f64, n: usize) -> (i64, i64) {
+    let a = (lo / d).floor() as i64;
+    let b = ((hi / d).floor() as i64).max(a);
+    (a, b.min(a.saturating_add(n as i64 - 1)))
+}
+
+/// `floor` without a library call (exact for |x| < 2⁶³; callers clamp).
+#[inline]
+fn floor_fast(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
+/// `ceil` without a library call (exact for |x| < 2⁶³; callers clamp).
+#[inline]
+fn ceil_fast(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t < x {
+        t + 1.0
+    } else {
+        t
+    }
+}
+
+/// Sub-sample indices `k ∈ [0, s)` with `|x0 + (k+½)h − c| < w`, as a bit mask.
+#[inline]
+fn chord_mask(c: f64, w: f64, x0: f64, h: f64, s: usize) -> u64 {
+    let a = floor_fast((c - w - x0) / h - 0.5) + 1.0;
+    let b = ceil_fast((c + w - x0) / h - 0.5) - 1.0;
+    let kmin = a.clamp(0.0, s as f64) as usize;
+    let kmax = b.clamp(-1.0, s as f64 - 1.0);
+    if kmax < kmin as f64 {
+        return 0;
+    }
+    let kmax = kmax as usize;
+    let width = kmax - kmin + 1;
+    let ones = if width >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << width) - 1
+    };
+    ones << kmin
+}
+
+/// Volume fraction of the box `[lo, hi]` inside the union of `spheres`.
+/// `active` is scratch space (indices of spheres cutting the box).
+fn voxel_fraction(
+    spheres: &[Sphere],
+    lo: [f64; 3],
+    hi: [f64; 3],
+    s: usize,
+    active: &mut Vec<usize>,
+) -> f64 {
+    active.clear();
+    for (i, sp) in spheres.iter().enumerate() {
+        let r2 = sp.radius * sp.radius;
+        let (mut near2, mut far2) = (0.0, 0.0);
+        for a in 0..3 {
+            let c = sp.center[a];
+            let near = if c < lo[a] {
+                lo[a] - c
+            } else if c > hi[a] {
+                c - hi[a]
+            } else {
+                0.0
+            };
+            let far = (c - lo[a]).abs().max((hi[a] - c).abs());
+            near2 += near * near;
+            far2 += far * far;
+        }
+        if far2 <= r2 {
+            return 1.0;
+        }
+        if near2 < r2 {
+            active.push(i);
+        }
+    }
+    if active.is_empty() {
+        return 0.0;
+    }
+    let h = [
+        (hi[0] - lo[0]) / s as f64,
+        (hi[1] - lo[1]) / s as f64,
+        (hi[2] - lo[2]) / s as f64,
+    ];
+    let mut count = 0u32;
+    for kz in 0..s {
+        let z = lo[2] + (kz as f64 + 0.5) * h[2];
+        for ky in 0..s {
+            let y = lo[1] + (ky as f64 + 0.5) * h[1];
+            let mut mask = 0u64;
+            for &i in active.iter() {
+                let sp = &spheres[i];
+                let (dy, dz) = (y - sp.center[1], z - sp.center[2]);
+                let q = sp.radius * sp.radius - dy * dy - dz * dz;
+                if q > 0.0 {
+                    mask |= chord_mask(sp.center[0], q.sqrt(), lo[0], h[0], s);
+                }
+            }
+            count += mask.count_ones();
+        }
+    }
+    count as f64 / (s * s * s) as f64
+}
+
+/// Rasterises the fragment: volume fraction of each species per voxel, with
+/// `supersample` midpoint sub-samples per axis in voxels cut by a surface
+/// (clamped to `1..=MAX_SUPERSAMPLE`; 4 or 5 is usual).
+///
+/// # Panics
+/// If the grid fails [`Grid::check`] or its size differs from the geometry's
+/// fragment (relative 1e-9): both are programming errors, not input.
+pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster {
+    if let Err(e) = grid.check() {
+        panic!("rasterize: {e}");
+    }
+    let same = geometry
+        .size_nm
+        .iter()
+        .zip(grid.size_nm)
+        .all(|(g, r)| (g - r).abs() <= 1e-9 * g.abs().max(r.abs()));
+    assert!(
+        same,
+        "rasterize: grid size {:?} nm differs from the fragment {:?} nm",
+        grid.size_nm, geometry.size_nm
+    );
+    let s = supersample.clamp(1, MAX_SUPERSAMPLE);
+    let n_species = geometry
+        .particles
+        .iter()
+        .map(|p| p.species + 1)
+        .max()
+        .unwrap_or(0)
+        .max(geometry.stats.count.len());
+    let (nx, ny, nz) = (grid.nx, grid.ny, grid.nz);
+    let [dx, dy, dz] = grid.cell_nm();
+    let h_total = grid.size_nm[2];
+    let (preps, spheres) = prepare(geometry, grid.size_nm);
+
+    // Particles touching each z-slice, in particle order.
+    let mut per_slice: Vec<Vec<u32>> = vec![Vec::new(); nz];
+    for (i, p) in preps.iter().enumerate() {
+        if p.hi[2] <= 0.0 || p.lo[2] >= h_total {
+            continue;
+        }
+        let (z0, z1) = voxel_range(p.lo[2], p.hi[2], dz, nz);
+        for iz in z0.max(0)..=z1.min(nz as i64 - 1) {
+            per_slice[iz as usize].push(i as u32);
+        }
+    }
+
+    let mut fractions: Vec<Array3<f64>> = (0..n_species)
+        .map(|_| Array3::zeros((nz, ny, nx)))
+        .collect();
+    let mut slices: Vec<Vec<ArrayViewMut2<f64>>> =
+        (0..nz).map(|_| Vec::with_capacity(n_species)).collect();
+    for f in fractions.iter_mut() {
+        for (iz, v) in f.axis_iter_mut(Axis(0)).enumerate() {
+            slices[iz].push(v);
+        }
+    }
+
+    slices
+        .into_par_iter()
+        .zip(per_slice.par_iter())
+        .enumerate()
+        .for_each(|(iz, (mut views, members))| {
+            let mut active = Vec::new();
+            let z_lo = iz as f64 * dz;
+            let z_hi = z_lo + dz;
+            for &pi in members {
+                let p = &preps[pi as usize];
+                let sph = &spheres[p.first..p.first + p.len];
+                let (x0, x1) = voxel_range(p.lo[0], p.hi[0], dx, nx);
+                let (y0, y1) = voxel_range(p.lo[1], p.hi[1], dy, ny);
+                let view = &mut views[p.species];
+                for iy in y0..=y1 {
+                    let wy = iy.rem_euclid(ny as i64) as usize;
+                    let y_lo = iy as f64 * dy;
+                    for ix in x0..=x1 {
+                        let wx = ix.rem_euclid(nx as i64) as usize;
+                        let x_lo = ix as f64 * dx;
+                        let f = voxel_fraction(
+                            sph,
+                            [x_lo, y_lo, z_lo],
+                            [x_lo + dx, y_lo + dy, z_hi],
+                            s,
+                            &mut active,
+                        );
+                        if f > 0.0 {
+                            view[[wy, wx]] += f;
+                        }
+                    }
+                }
+            }
+            for iy in 0..ny {
+                for ix in 0..nx {
+                    let total: f64 = views.iter().map(|v| v[[iy, ix]]).sum();
+                    if total > 1.0 {
+                        for v in views.iter_mut() {
+                            v[[iy, ix]] /= total;
+                        }
+                    }
+                }
+            }
+        });
+
+    Raster {
+        grid: *grid,
+        fractions,
+    }
+}
+
+impl Raster {
+    /// `ε = (1 − Σ f_s) ε_binder + Σ f_s ε_s` per voxel, written into `out`
+    /// (shape `(nz, ny, nx)`); allocates nothing. Evaluated left to right as
+    /// `ε_binder·(1 − F) + ε_0·f_0 + ε_1·f_1 + …` with `F = f_0 + f_1 + …`.
+    ///
+    /// # Panics
+    /// If `eps_species` does not have one entry per species or `out` has the
+    /// wrong shape (programming errors).
+    pub fn epsilon_into(
+        &self,
+        eps_binder: Complex64,
+        eps_species: &[Complex64],
+        out: &mut Array3<Complex64>,
+    ) {
+        assert_eq!(
+            eps_species.len(),
+            self.fractions.len(),
+            "epsilon_into: one permittivity per species"
+        );
+        let g = &self.grid;
+        assert_eq!(
+            out.dim(),
+            (g.nz, g.ny, g.nx),
+            "epsilon_into: output shape must be (nz, ny, nx)"
+        );
+        let plane = g.nx * g.ny;
+        let contiguous = self.fractions.iter().all(|f| f.is_standard_layout());
+        match out.as_slice_mut() {
+            Some(o) if contiguous && plane > 0 => {
+                o.par_chunks_mut(plane).enumerate().for_each(|(iz, chunk)| {
+                    let range = iz * plane..(iz + 1) * plane;
+                    // The real part holds F until the binder term replaces it.
+                    chunk.fill(Complex64::new(0.0, 0.0));
+                    for f in &self.fractions {
+                        let Some(fs) = f.as_slice() else { continue };
+                        for (e, &v) in chunk.iter_mut().zip(&fs[range.clone()]) {
+                            e.re += v;
+                        }
+                    }
+                    for e in chunk.iter_mut() {
+                        *e = eps_binder * (1.0 - e.re);
+                    }
+                    for (f, &es) in self.fractions.iter().zip(eps_species) {
+                        let Some(fs) = f.as_slice() else { continue };
+                        for (e, &v) in chunk.iter_mut().zip(&fs[range.clone()]) {
+                            *e += es * v;
+                        }
+                    }
+                });
+            }
+            _ => {
+                for ((iz, iy, ix), e) in out.indexed_iter_mut() {
+                    let total: f64 = self.fractions.iter().map(|f| f[[iz, iy, ix]]).sum();
+                    *e = eps_binder * (1.0 - total);
+                    for (f, &es) in self.fractions.iter().zip(eps_species) {
+                        *e += es * f[[iz, iy, ix]];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Mean volume fraction per species over the grid.
+    pub fn mean_fractions(&self) -> Vec<f64> {
+        let n = self.grid.voxels();
+        self.fractions
+            .iter()
+            .map(|f| if n == 0 { 0.0 } else { f.sum() / n as f64 })
+            .collect()
+    }
+}

@@ -1,0 +1,581 @@
+//! Stage 6 — output: the HDF5 result file and atomic file writes.
+//!
+//! This stage owns the on-disk format. It receives plain data ([`ResultSet`])
+//! from the pipeline and knows nothing about how it was computed. Every file is
+//! written to `<path>.tmp` in the destination folder, flushed, closed, synced
+//! and then renamed onto `<path>`, so a reader (or a resumed run) never sees a
+//! half-written result: either the old file or the complete new one. On any
+//! error the temporary file is removed.
+//!
+//! # Layout of a result file (format version 1)
+//!
+//! Root attributes:
+//! - `format_version` (u32, = 1), `inksim_version`, `config_path`,
+//!   `input_hash` (UTF-8 strings), `seed` (u64), `created_unix_s` (u64),
+//!   `grid` (3 × u64: nx, ny, nz), `size_nm` (3 × f64: Lx, Ly, H).
+//!
+//! `/config` — scalar variable-length UTF-8 string: the exact TOML text
+//! (byte-exact round trip; a text containing NUL is refused).
+//!
+//! `/geometry` (group):
+//! - datasets `centers_nm` (N × 3 f64), `radii_nm` (N f64),
+//!   `particle_of_sphere` (N u32), `species_of_particle` (P u32),
+//!   `species_names` (S variable-length UTF-8 strings),
+//!   `target_fraction`, `achieved_fraction`, `raster_fraction` (S f64 each);
+//! - attribute `min_gap_nm` (f64).
+//!
+//! `/solves/NNNN` (one group per solve, `NNNN` = zero-padded index 0000, 0001, …
+//! in the order given), attributes:
+//! `wavelength_nm`, `polar_deg`, `azimuth_deg`, `total_reflectance`,
+//! `total_transmittance`, `absorption`, `energy_balance` (f64), `r00`, `t00`
+//! (2 × f64: re, im), `method` (string: `born` | `time-marching`),
+//! `iterations`, `operator_applications` (u64), `residual`, `seconds` (f64),
+//! `note` (string); datasets over the K propagating orders: `orders_mn`
+//! (K × 2 i32: m, n), `orders_theta_deg`, `orders_phi_deg`,
+//! `orders_reflectance`, `orders_transmittance` (K f64).
+//!
+//! `/summary` — one compound row per solve, in solve order, with fields
+//! `wavelength_nm`, `polar_deg`, `azimuth_deg`, `reflectance`, `transmittance`,
+//! `absorption`, `energy_balance`, `residual` (f64) and `iterations` (u64);
+//! in Python: `h5py.File(p)["summary"]["reflectance"]`.
+//!
+//! `/picture_png` — the rendered PNG as a 1-D u8 dataset (present when given).
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use hdf5::types::VarLenUnicode;
+use hdf5::{H5Type, Location};
+use ndarray::Array2;
+
+use crate::farfield::SolveEntry;
+use crate::solver::MethodUsed;
+
+/// Version of the layout described in the module docs, stored as `format_version`.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Everything a result file holds; plain data filled by the pipeline.
+#[derive(Debug, Clone, Copy)]
+pub struct ResultSet<'a> {
+    pub version: &'a str,
+    pub config_path: &'a str,
+    /// The exact TOML text of the scene.
+    pub config_text: &'a str,
+    pub input_hash: &'a str,
+    pub seed: u64,
+    pub created_unix_s: u64,
+    pub geometry: GeometrySummary<'a>,
+    /// Raster grid: nx, ny, nz.
+    pub grid: [usize; 3],
+    /// Fragment size: Lx, Ly, H in nm.
+    pub size_nm: [f64; 3],
+    pub entries: &'a [SolveEntry],
+    pub picture_png: Option<&'a [u8]>,
+}
+
+/// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
+/// `radii_nm`, `particle_of_sphere`) share one length, species arrays
+/// (`species_names` and the three fractions) another.
+#[derive(Debug, Clone, Copy)]
+pub struct GeometrySummary<'a> {
+    pub species_names: &'a [String],
+    pub centers_nm: &'a [[f64; 3]],
+    pub radii_nm: &'a [f64],
+    pub particle_of_sphere: &'a [u32],
+    pub species_of_particle: &'a [u32],
+    pub target_fraction: &'a [f64],
+    pub achieved_fraction: &'a [f64],
+    pub raster_fraction: &'a [f64],
+    pub min_gap_nm: f64,
+}
+
+/// What [`read_summary`] returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResultSummary {
+    pub version: String,
+    pub input_hash: String,
+    pub seed: u64,
+    pub created_unix_s: u64,
+    /// One per `/solves/NNNN` group, in index order.
+    pub entries: Vec<EntrySummary>,
+}
+
+/// The per-solve numbers of a result file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EntrySummary {
+    pub wavelength_nm: f64,
+    pub polar_deg: f64,
+    pub azimuth_deg: f64,
+    pub total_reflectance: f64,
+    pub total_transmittance: f64,
+    pub absorption: f64,
+    pub energy_balance: f64,
+    pub method: MethodUsed,
+    pub iterations: u64,
+    pub residual: f64,
+}
+
+/// Everything that can go wrong while writing or reading output files.
+#[derive(Debug, thiserror::Error)]
+pub enum IoError {
+    #[error("{path}: output folder cannot be created or used: {source}")]
+    Folder {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {source}")]
+    File {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: HDF5 error: {source}")]
+    Hdf5 { path: PathBuf, source: hdf5::Error },
+    #[error("{path}: cannot write {what}: {message}")]
+    Invalid {
+        path: PathBuf,
+        what: String,
+        message: String,
+    },
+    #[error("{path}: not a valid inksim result file: {message}")]
+    Format { path: PathBuf, message: String },
+}
+
+/// Write a result file atomically (see the module docs for the layout).
+///
+/// Writes `<path>.tmp` in the same folder (created if missing), closes and
+/// syncs it, then renames it onto `path`. On any error the temporary file is
+/// removed and an existing `path` is left untouched.
+pub fn write_result(path: &Path, set: &ResultSet) -> Result<(), IoError> {
+    check_result_set(path, set)?;
+    let tmp = TempFile::prepare(path)?;
+    let hdf = |source| IoError::Hdf5 {
+        path: tmp.path.clone(),
+        source,
+    };
+    {
+        let file = hdf5::File::create(&tmp.path).map_err(hdf)?;
+        write_contents(&file, set).map_err(hdf)?;
+        file.close().map_err(hdf)?;
+    }
+    tmp.commit()
+}
+
+/// Write arbitrary bytes atomically (temporary file, sync, rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
+    let tmp = TempFile::prepare(path)?;
+    let mut f = fs::OpenOptions::new()
+        .write(true)
+        .truncate(true)
+        .open(&tmp.path)
+        .map_err(|source| tmp.io_err(source))?;
+    f.write_all(bytes).map_err(|source| tmp.io_err(source))?;
+    drop(f);
+    tmp.commit()
+}
+
+/// Read back the identity of a result file and the per-solve numbers.
+pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let format = |message: String| IoError::Format {
+        path: path.to_path_buf(),
+        message,
+    };
+    if !path.is_file() {
+        return Err(IoError::File {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    let root: &Location = &file;
+    let version = read_str_attr(root, "inksim_version").map_err(hdf)?;
+    let input_hash = read_str_attr(root, "input_hash").map_err(hdf)?;
+    let seed: u64 = root
+        .attr("seed")
+        .and_then(|a| a.read_scalar())
+        .map_err(hdf)?;
+    let created_unix_s: u64 = root
+        .attr("created_unix_s")
+        .and_then(|a| a.read_scalar())
+        .map_err(hdf)?;
+
+    let solves = file.group("solves").map_err(hdf)?;
+    let mut indices = Vec::new();
+    for name in solves.member_names().map_err(hdf)? {
+        let idx: usize = name
+            .parse()
+            .map_err(|_| format(format!("unexpected member /solves/{name}")))?;
+        indices.push((idx, name));
+    }
+    indices.sort();
+    let mut entries = Vec::with_capacity(indices.len());
+    for (k, (idx, name)) in indices.iter().enumerate() {
+        if *idx != k {
+            return Err(format(format!(
+                "solve groups are not numbered 0..{}: found /solves/{name} at position {k}",
+                indices.len()
+            )));
+        }
+        let g = solves.group(name).map_err(hdf)?;
+        let f = |key: &str| -> Result<f64, IoError> {
+            g.attr(key)
+                .and_then(|a| a.read_scalar::<f64>())
+                .map_err(hdf)
+        };
+        let method_text = read_str_attr(&g, "method").map_err(hdf)?;
+        let method = match method_text.as_str() {
+            "born" => MethodUsed::Born,
+            "time-marching" => MethodUsed::TimeMarching,
+            other => {
+                return Err(format(format!(
+                    "/solves/{name}: attribute `method` is `{other}`, expected `born` or `time-marching`"
+                )))
+            }
+        };
+        entries.push(EntrySummary {
+            wavelength_nm: f("wavelength_nm")?,
+            polar_deg: f("polar_deg")?,
+            azimuth_deg: f("azimuth_deg")?,
+            total_reflectance: f("total_reflectance")?,
+            total_transmittance: f("total_transmittance")?,
+            absorption: f("absorption")?,
+            energy_balance: f("energy_balance")?,
+            method,
+            iterations: g
+                .attr("iterations")
+                .and_then(|a| a.read_scalar::<u64>())
+                .map_err(hdf)?,
+            residual: f("residual")?,
+        });
+    }
+    Ok(ResultSummary {
+        version,
+        input_hash,
+        seed,
+        created_unix_s,
+        entries,
+    })
+}
+
+/// One row of `/summary`.
+#[derive(H5Type, Clone, Copy, Debug)]
+#[repr(C)]
+struct SummaryRow {
+    wavelength_nm: f64,
+    polar_deg: f64,
+    azimuth_deg: f64,
+    reflectance: f64,
+    transmittance: f64,
+    absorption: f64,
+    energy_balance: f64,
+    residual: f64,
+    iterations: u64,
+}
+
+/// Refuse inconsistent input before any file is touched.
+fn check_result_set(path: &Path, set: &ResultSet) -> Result<(), IoError> {
+    let invalid = |what: &str, message: String| IoError::Invalid {
+        path: path.to_path_buf(),
+        what: what.to_string(),
+        message,
+    };
+    let strings = [
+        ("inksim_version", set.version),
+        ("config_path", set.config_path),
+        ("config text", set.config_text),
+        ("input_hash", set.input_hash),
+    ];
+    for (what, s) in strings {
+        if s.contains('\0') {
+            return Err(invalid(what, "contains a NUL character".into()));
+        }
+    }
+    for (i, e) in set.entries.iter().enumerate() {
+        if e.record.note.contains('\0') {
+            return Err(invalid(
+                &format!("solve {i} note"),
+                "contains a NUL character".into(),
+            ));
+        }
+    }
+    let g = &set.geometry;
+    if let Some(name) = g.species_names.iter().find(|n| n.contains('\0')) {
+        return Err(invalid(
+            "geometry species_names",
+            format!("name {name:?} contains a NUL character"),
+        ));
+    }
+    let n = g.centers_nm.len();
+    if g.radii_nm.len() != n || g.particle_of_sphere.len() != n {
+        return Err(invalid(
+            "geometry",
+            format!(
+                "sphere arrays differ in length: centers_nm {n}, radii_nm {}, particle_of_sphere {}",
+                g.radii_nm.len(),
+                g.particle_of_sphere.len()
+            ),
+        ));
+    }
+    let s = g.species_names.len();
+    for (name, len) in [
+        ("target_fraction", g.target_fraction.len()),
+        ("achieved_fraction", g.achieved_fraction.len()),
+        ("raster_fraction", g.raster_fraction.len()),
+    ] {
+        if len != s {
+            return Err(invalid(
+                "geometry",
+                format!("{name} has {len} values for {s} species"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
+    let root: &Location = file;
+    write_scalar_attr(root, "format_version", FORMAT_VERSION)?;
+    write_str_attr(root, "inksim_version", set.version)?;
+    write_str_attr(root, "config_path", set.config_path)?;
+    write_str_attr(root, "input_hash", set.input_hash)?;
+    write_scalar_attr(root, "seed", set.seed)?;
+    write_scalar_attr(root, "created_unix_s", set.created_unix_s)?;
+    let grid = set.grid.map(|v| v as u64);
+    root.new_attr_builder()
+        .with_data(&grid[..])
+        .create("grid")?;
+    root.new_attr_builder()
+        .with_data(&set.size_nm[..])
+        .create("size_nm")?;
+
+    file.new_dataset::<VarLenUnicode>()
+        .shape(())
+        .create("config")?
+        .write_scalar(&vlu(set.config_text)?)?;
+
+    let g = &set.geometry;
+    let geo = file.create_group("geometry")?;
+    let centers = Array2::from_shape_fn((g.centers_nm.len(), 3), |(i, j)| g.centers_nm[i][j]);
+    geo.new_dataset_builder()
+        .with_data(&centers)
+        .create("centers_nm")?;
+    geo.new_dataset_builder()
+        .with_data(g.radii_nm)
+        .create("radii_nm")?;
+    geo.new_dataset_builder()
+        .with_data(g.particle_of_sphere)
+        .create("particle_of_sphere")?;
+    geo.new_dataset_builder()
+        .with_data(g.species_of_particle)
+        .create("species_of_particle")?;
+    let names = g
+        .species_names
+        .iter()
+        .map(|s| vlu(s))
+        .collect::<hdf5::Result<Vec<_>>>()?;
+    geo.new_dataset_builder()
+        .with_data(&names[..])
+        .create("species_names")?;
+    geo.new_dataset_builder()
+        .with_data(g.target_fraction)
+        .create("target_fraction")?;
+    geo.new_dataset_builder()
+        .with_data(g.achieved_fraction)
+        .create("achieved_fraction")?;
+    geo.new_dataset_builder()
+        .with_data(g.raster_fraction)
+        .create("raster_fraction")?;
+    write_scalar_attr(&geo, "min_gap_nm", g.min_gap_nm)?;
+
+    let solves = file.create_group("solves")?;
+    let mut rows = Vec::with_capacity(set.entries.len());
+    for (i, e) in set.entries.iter().enumerate() {
+        let s = solves.create_group(&format!("{i:04}"))?;
+        write_entry(&s, e)?;
+        let eff = &e.efficiencies;
+        rows.push(SummaryRow {
+            wavelength_nm: e.wavelength_nm,
+            polar_deg: e.incidence.polar_deg,
+            azimuth_deg: e.incidence.azimuth_deg,
+            reflectance: eff.total_reflectance,
+            transmittance: eff.total_transmittance,
+            absorption: eff.absorption,
+            energy_balance: eff.energy_balance,
+            residual: e.record.residual,
+            iterations: e.record.iterations as u64,
+        });
+    }
+    file.new_dataset_builder()
+        .with_data(&rows[..])
+        .create("summary")?;
+
+    if let Some(png) = set.picture_png {
+        file.new_dataset_builder()
+            .with_data(png)
+            .create("picture_png")?;
+    }
+    file.flush()
+}
+
+fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
+    let eff = &e.efficiencies;
+    let rec = &e.record;
+    for (name, v) in [
+        ("wavelength_nm", e.wavelength_nm),
+        ("polar_deg", e.incidence.polar_deg),
+        ("azimuth_deg", e.incidence.azimuth_deg),
+        ("total_reflectance", eff.total_reflectance),
+        ("total_transmittance", eff.total_transmittance),
+        ("absorption", eff.absorption),
+        ("energy_balance", eff.energy_balance),
+        ("residual", rec.residual),
+        ("seconds", rec.seconds),
+    ] {
+        write_scalar_attr(g, name, v)?;
+    }
+    g.new_attr_builder()
+        .with_data(&[eff.r00.re, eff.r00.im][..])
+        .create("r00")?;
+    g.new_attr_builder()
+        .with_data(&[eff.t00.re, eff.t00.im][..])
+        .create("t00")?;
+    write_str_attr(g, "method", &rec.method.to_string())?;
+    write_scalar_attr(g, "iterations", rec.iterations as u64)?;
+    write_scalar_attr(g, "operator_applications", rec.operator_applications as u64)?;
+    write_str_attr(g, "note", &rec.note)?;
+
+    let k = eff.orders.len();
+    let mn = Array2::from_shape_fn((k, 2), |(i, j)| {
+        if j == 0 {
+            eff.orders[i].m
+        } else {
+            eff.orders[i].n
+        }
+    });
+    g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
+    let column =
+        |f: fn(&crate::farfield::Order) -> f64| eff.orders.iter().map(f).collect::<Vec<_>>();
+    for (name, values) in [
+        ("orders_theta_deg", column(|o| o.theta_deg)),
+        ("orders_phi_deg", column(|o| o.phi_deg)),
+        ("orders_reflectance", column(|o| o.reflectance)),
+        ("orders_transmittance", column(|o| o.transmittance)),
+    ] {
+        g.new_dataset_builder()
+            .with_data(&values[..])
+            .create(name)?;
+    }
+    Ok(())
+}
+
+fn vlu(s: &str) -> hdf5::Result<VarLenUnicode> {
+    VarLenUnicode::from_str(s).map_err(|e| hdf5::Error::from(e.to_string()))
+}
+
+fn write_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    loc.new_attr::<VarLenUnicode>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&vlu(value)?)
+}
+
+fn write_scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::Result<()> {
+    loc.new_attr::<T>()
+        .shape(())
+        .create(name)?
+        .write_scalar(&value)
+}
+
+fn read_str_attr(loc: &Location, name: &str) -> hdf5::Result<String> {
+    let v: VarLenUnicode = loc.attr(name)?.read_scalar()?;
+    Ok(v.as_str().to_owned())
+}
+
+/// `<path>.tmp`, removed on drop unless renamed onto `<path>` by [`TempFile::commit`].
+struct TempFile {
+    path: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl TempFile {
+    /// Check the destination: folder exists or can be created, and a file can
+    /// be created in it (the temporary file itself, left empty).
+    fn prepare(target: &Path) -> Result<Self, IoError> {
+        let folder_err = |source| IoError::Folder {
+            path: target.to_path_buf(),
+            source,
+        };
+        let Some(name) = target.file_name() else {
+            return Err(folder_err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "path does not name a file",
+            )));
+        };
+        let folder = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        fs::create_dir_all(&folder).map_err(folder_err)?;
+        if target.is_dir() {
+            return Err(IoError::File {
+                path: target.to_path_buf(),
+                source: std::io::Error::new(
+                    std::io::ErrorKind::AlreadyExists,
+                    "is a directory, expected a file path",
+                ),
+            });
+        }
+        let mut tmp_name = name.to_os_string();
+        tmp_name.push(".tmp");
+        let path = folder.join(tmp_name);
+        fs::File::create(&path).map_err(|source| IoError::Folder {
+            path: path.clone(),
+            source,
+        })?;
+        Ok(TempFile {
+            path,
+            target: target.to_path_buf(),
+            committed: false,
+        })
+    }
+
+    fn io_err(&self, source: std::io::Error) -> IoError {
+        IoError::File {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    /// Sync the finished temporary file to disk and rename it onto the target.
+    fn commit(mut self) -> Result<(), IoError> {
+        fs::File::open(&self.path)
+            .and_then(|f| f.sync_all())
+            .map_err(|source| self.io_err(source))?;
+        fs::rename(&self.path, &self.target).map_err(|source| IoError::File {
+            path: self.target.clone(),
+            source,
+        })?;
+        self.committed = true;
+        // Best effort: make the rename itself durable.
+        if let Some(dir) = self.target.parent().filter(|p| !p.as_os_str().is_empty()) {
+            if let Ok(d) = fs::File::open(dir) {
+                let _ = d.sync_all();
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_file(&self.path);
+        }
+    }
+}

@@ -1,0 +1,660 @@
+//! Stage 5 — pictures of a result (foundation level; CIE colour comes later).
+//!
+//! [`diffuse_brdf_png`] draws the diffuse reflection of every solve as an
+//! 8-bit RGB PNG: a grid of panels, one row per distinct direction of
+//! incidence (sorted by polar, then azimuth angle), one column per distinct
+//! wavelength (ascending). Several entries with the same wavelength and
+//! incidence (e.g. realisations) share a panel.
+//!
+//! A panel is the disk of reflected directions in the projected plane
+//! `(sx, sy) = (sin θ cos φ, sin θ sin φ)`, `sx` to the right, `sy` up, radius
+//! [`DISK_RADIUS_PX`] (faint rings mark θ = 30° and 60°). Each reflected order
+//! except (0,0) is a small Gaussian dot (σ = [`DOT_SIGMA_PX`]) whose brightness
+//! encodes the order's BRDF estimate `R_mn / Ω_cell`, where `Ω_cell` is the
+//! projected solid angle `Δsx·Δsy` owned by one order. Orders lie on a regular
+//! lattice in `(sx, sy)` (`sx = sx_inc + m λ/Lx`, likewise `sy`), so
+//! `Δsx, Δsy` come from a least-squares fit of the order positions against
+//! `m` and `n`; if one axis cannot be fitted (a single value of `m` or `n`)
+//! the other spacing is used for both, and if neither can, `Ω_cell = π / K`
+//! for `K` listed orders (they tile the unit disk). Brightness is
+//! `0.2 + 0.8 t` with `t` the position of `log10(R/Ω)` between `lo` and `hi`,
+//! shared by all panels: `hi` is the largest value drawn and
+//! `lo = max(smallest positive value, hi / 10^LOG_DECADES)`; values below `lo`
+//! are not drawn. Overlapping dots combine by maximum, so a pixel at an order's
+//! centre shows exactly that order's brightness. The specular direction (the
+//! (0,0) order, or the incidence direction when it is not listed) is marked by
+//! a small grey cross. The legend states the scale.
+//!
+//! Colour: each column is tinted by an approximate colour of its wavelength,
+//! the piecewise-linear map of Dan Bruton ("Color Science", 1996):
+//! 380–440 nm (violet→blue), 440–490 (blue→cyan), 490–510 (cyan→green),
+//! 510–580 (green→yellow), 580–645 (yellow→red), 645–780 (red), without his
+//! intensity fall-off at the ends, mixed with 20 % white so every hue stays
+//! visible on black; wavelengths outside 380–780 nm are light grey.
+//!
+//! Labels use a built-in 5×7 bitmap font (upper-case letters, digits and
+//! common punctuation; lower case is drawn as upper case, other characters as
+//! `?`), drawn at twice its size.
+
+use std::cmp::Ordering;
+
+use crate::config::Incidence;
+use crate::farfield::{Order, SolveEntry};
+
+/// Radius of a panel's disk of directions, in pixels.
+pub const DISK_RADIUS_PX: f64 = 60.0;
+/// Standard deviation of an order's dot, in pixels.
+pub const DOT_SIGMA_PX: f64 = 1.2;
+/// Decades of BRDF shown below the brightest order.
+pub const LOG_DECADES: f64 = 4.0;
+
+/// Side of the square cell that holds one panel.
+const CELL_PX: usize = 140;
+/// Font scale (5×7 glyphs drawn as 10×14 pixels, advance 12).
+const FONT_SCALE: usize = 2;
+const GLYPH_ADVANCE: usize = 6 * FONT_SCALE;
+const GLYPH_HEIGHT: usize = 7 * FONT_SCALE;
+const MARGIN: usize = 12;
+/// Largest image produced (pixels), to refuse absurd grids instead of
+/// allocating gigabytes.
+const MAX_PIXELS: usize = 100_000_000;
+
+const BACKGROUND: [u8; 3] = [40, 40, 40];
+const TEXT: [u8; 3] = [230, 230, 230];
+const DISK_EDGE: [u8; 3] = [110, 110, 110];
+const GUIDE: [u8; 3] = [45, 45, 45];
+const CROSS: [u8; 3] = [150, 150, 150];
+
+/// Why a picture cannot be drawn.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("render: no solve entries to draw")]
+    Empty,
+    #[error("render: entry {index}: {what} is not finite or out of range ({value})")]
+    BadValue {
+        index: usize,
+        what: String,
+        value: f64,
+    },
+    #[error(
+        "render: picture of {width} × {height} pixels exceeds the limit of {MAX_PIXELS} pixels"
+    )]
+    TooLarge { width: usize, height: usize },
+    #[error("render: PNG encoding failed: {0}")]
+    Encode(#[from] png::EncodingError),
+}
+
+/// Where the panels of a picture lie; computed from the entries alone.
+#[derive(Debug, Clone)]
+pub struct PanelLayout {
+    pub width: usize,
+    pub height: usize,
+    /// Column values, ascending.
+    pub wavelengths_nm: Vec<f64>,
+    /// Row values, sorted by polar then azimuth angle.
+    pub incidences: Vec<Incidence>,
+    left: usize,
+    top: usize,
+}
+
+impl PanelLayout {
+    /// Lay out the panels for `entries`.
+    pub fn new(entries: &[SolveEntry], title: &str) -> Result<Self, RenderError> {
+        if entries.is_empty() {
+            return Err(RenderError::Empty);
+        }
+        check_entries(entries)?;
+        let mut wavelengths: Vec<f64> = entries.iter().map(|e| e.wavelength_nm).collect();
+        wavelengths.sort_by(f64::total_cmp);
+        wavelengths.dedup_by(|a, b| close(*a, *b));
+        let mut incidences: Vec<Incidence> = entries.iter().map(|e| e.incidence).collect();
+        incidences.sort_by(incidence_cmp);
+        incidences.dedup_by(|a, b| same_incidence(a, b));
+
+        let left = incidences
+            .iter()
+            .map(|i| text_width(&row_label(i)))
+            .max()
+            .unwrap_or(0)
+            + 2 * MARGIN;
+        let top = MARGIN + GLYPH_HEIGHT + MARGIN + GLYPH_HEIGHT + 6;
+        // Widest legend: the scale line with the longest numbers it can show.
+        let legend = legend_lines(None)
+            .into_iter()
+            .chain(legend_lines(Some((-999.0, -999.0))));
+        let grid_w = left + wavelengths.len() * CELL_PX + MARGIN;
+        let text_w = std::iter::once(title.to_string())
+            .chain(legend)
+            .map(|l| text_width(&l) + 2 * MARGIN)
+            .max()
+            .unwrap_or(0);
+        let width = grid_w.max(text_w);
+        let height = top + incidences.len() * CELL_PX + 3 * (GLYPH_HEIGHT + 6) + MARGIN;
+        if width.saturating_mul(height) > MAX_PIXELS {
+            return Err(RenderError::TooLarge { width, height });
+        }
+        Ok(PanelLayout {
+            width,
+            height,
+            wavelengths_nm: wavelengths,
+            incidences,
+            left,
+            top,
+        })
+    }
+
+    /// Pixel position (x right, y down) of the centre of panel (`row`, `col`).
+    pub fn center(&self, row: usize, col: usize) -> (f64, f64) {
+        let half = (CELL_PX / 2) as f64;
+        (
+            (self.left + col * CELL_PX) as f64 + half,
+            (self.top + row * CELL_PX) as f64 + half,
+        )
+    }
+
+    /// Pixel position of direction `(sx, sy)` in panel (`row`, `col`).
+    pub fn direction_px(&self, row: usize, col: usize, sx: f64, sy: f64) -> (f64, f64) {
+        let (cx, cy) = self.center(row, col);
+        (cx + sx * DISK_RADIUS_PX, cy - sy * DISK_RADIUS_PX)
+    }
+
+    /// Row and column of the panel that shows `entry`.
+    pub fn panel_of(&self, entry: &SolveEntry) -> Option<(usize, usize)> {
+        let row = self
+            .incidences
+            .iter()
+            .position(|i| same_incidence(i, &entry.incidence))?;
+        let col = self
+            .wavelengths_nm
+            .iter()
+            .position(|w| close(*w, entry.wavelength_nm))?;
+        Some((row, col))
+    }
+}
+
+/// Projected direction `(sin θ cos φ, sin θ sin φ)` of an order.
+pub fn order_direction(o: &Order) -> (f64, f64) {
+    let (t, p) = (o.theta_deg.to_radians(), o.phi_deg.to_radians());
+    (t.sin() * p.cos(), t.sin() * p.sin())
+}
+
+/// Projected solid angle owned by one order of `orders` (see module docs).
+pub fn order_cell(orders: &[Order]) -> f64 {
+    let dx = lattice_spacing(orders, |o| (o.m, order_direction(o).0));
+    let dy = lattice_spacing(orders, |o| (o.n, order_direction(o).1));
+    match (dx, dy) {
+        (Some(a), Some(b)) => a * b,
+        (Some(a), None) | (None, Some(a)) => a * a,
+        (None, None) => std::f64::consts::PI / orders.len().max(1) as f64,
+    }
+}
+
+/// BRDF estimate `R / Ω_cell` of every drawable diffuse order of an entry.
+fn diffuse_values(e: &SolveEntry) -> impl Iterator<Item = (&Order, f64)> {
+    let cell = order_cell(&e.efficiencies.orders);
+    e.efficiencies
+        .orders
+        .iter()
+        .filter(|o| !(o.m == 0 && o.n == 0) && o.reflectance > 0.0)
+        .map(move |o| (o, o.reflectance / cell))
+}
+
+/// Render the diffuse reflection of `entries` as an 8-bit RGB PNG.
+pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, RenderError> {
+    let layout = PanelLayout::new(entries, title)?;
+    let (w, h) = (layout.width, layout.height);
+    let mut img = Canvas {
+        w,
+        h,
+        px: vec![0u8; w * h * 3],
+    };
+    img.fill(BACKGROUND);
+
+    // Shared log scale.
+    let mut hi = f64::NEG_INFINITY;
+    let mut min_pos = f64::INFINITY;
+    for e in entries {
+        for (_, v) in diffuse_values(e) {
+            hi = hi.max(v);
+            min_pos = min_pos.min(v);
+        }
+    }
+    let scale = (hi > 0.0 && hi.is_finite()).then(|| {
+        let lo = min_pos.max(hi / 10f64.powf(LOG_DECADES));
+        (lo.log10(), hi.log10())
+    });
+
+    // Text.
+    img.text(MARGIN, MARGIN, title, TEXT);
+    let header_y = MARGIN + GLYPH_HEIGHT + MARGIN;
+    for (col, &wl) in layout.wavelengths_nm.iter().enumerate() {
+        let label = format!("{} NM", fmt_num(wl));
+        let (cx, _) = layout.center(0, col);
+        let x = (cx as usize).saturating_sub(text_width(&label) / 2);
+        img.text(x, header_y, &label, TEXT);
+    }
+    for (row, inc) in layout.incidences.iter().enumerate() {
+        let (_, cy) = layout.center(row, 0);
+        let y = (cy as usize).saturating_sub(GLYPH_HEIGHT / 2);
+        img.text(MARGIN, y, &row_label(inc), TEXT);
+    }
+    let legend_y = layout.top + layout.incidences.len() * CELL_PX + 6;
+    for (k, line) in legend_lines(scale).iter().enumerate() {
+        img.text(MARGIN, legend_y + k * (GLYPH_HEIGHT + 6), line, TEXT);
+    }
+
+    // Empty disks with guides.
+    for row in 0..layout.incidences.len() {
+        for (col, &wl) in layout.wavelengths_nm.iter().enumerate() {
+            let (cx, cy) = layout.center(row, col);
+            img.disk(cx, cy, DISK_RADIUS_PX, [0, 0, 0]);
+            for s in [0.5, 0.75f64.sqrt()] {
+                img.ring(cx, cy, s * DISK_RADIUS_PX, GUIDE);
+            }
+            img.ring(cx, cy, DISK_RADIUS_PX, DISK_EDGE);
+            // Colour swatch under the column header, once per column.
+            if row == 0 {
+                let tint = to_rgb8(wavelength_tint(wl), 1.0);
+                let y0 = layout.top - 5;
+                for x in (cx - DISK_RADIUS_PX) as usize..=(cx + DISK_RADIUS_PX) as usize {
+                    for y in y0..y0 + 3 {
+                        img.set(x as i64, y as i64, tint);
+                    }
+                }
+            }
+        }
+    }
+
+    // Dots, then specular markers on top.
+    for e in entries {
+        let Some((row, col)) = layout.panel_of(e) else {
+            continue;
+        };
+        if let Some((lo, hi)) = scale {
+            let tint = wavelength_tint(e.wavelength_nm);
+            for (o, v) in diffuse_values(e) {
+                let lv = v.log10();
+                if lv < lo {
+                    continue;
+                }
+                let t = if hi > lo { (lv - lo) / (hi - lo) } else { 1.0 };
+                let b = 0.2 + 0.8 * t.clamp(0.0, 1.0);
+                let (sx, sy) = order_direction(o);
+                let (x, y) = layout.direction_px(row, col, sx, sy);
+                img.splat(x, y, tint, b);
+            }
+        }
+    }
+    for e in entries {
+        let Some((row, col)) = layout.panel_of(e) else {
+            continue;
+        };
+        let (sx, sy) = specular_direction(e);
+        let (x, y) = layout.direction_px(row, col, sx, sy);
+        let (xi, yi) = (x.round() as i64, y.round() as i64);
+        for d in -4..=4 {
+            img.set(xi + d, yi, CROSS);
+            img.set(xi, yi + d, CROSS);
+        }
+    }
+
+    encode(&img, title)
+}
+
+fn encode(img: &Canvas, title: &str) -> Result<Vec<u8>, RenderError> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, img.w as u32, img.h as u32);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let keyword_ok = title.chars().all(|c| c != '\0');
+        if keyword_ok && !title.is_empty() {
+            enc.add_itxt_chunk("Title".into(), title.into())?;
+        }
+        let mut writer = enc.write_header()?;
+        writer.write_image_data(&img.px)?;
+        writer.finish()?;
+    }
+    Ok(out)
+}
+
+fn check_entries(entries: &[SolveEntry]) -> Result<(), RenderError> {
+    let bad = |index: usize, what: &str, value: f64| RenderError::BadValue {
+        index,
+        what: what.to_string(),
+        value,
+    };
+    for (i, e) in entries.iter().enumerate() {
+        if !(e.wavelength_nm.is_finite() && e.wavelength_nm > 0.0) {
+            return Err(bad(i, "wavelength_nm", e.wavelength_nm));
+        }
+        if !(e.incidence.polar_deg.is_finite() && e.incidence.polar_deg.abs() <= 90.0) {
+            return Err(bad(i, "incidence polar_deg", e.incidence.polar_deg));
+        }
+        if !e.incidence.azimuth_deg.is_finite() {
+            return Err(bad(i, "incidence azimuth_deg", e.incidence.azimuth_deg));
+        }
+        for o in &e.efficiencies.orders {
+            let what = |f: &str| format!("order ({}, {}) {f}", o.m, o.n);
+            if !o.theta_deg.is_finite() {
+                return Err(bad(i, &what("theta_deg"), o.theta_deg));
+            }
+            if !o.phi_deg.is_finite() {
+                return Err(bad(i, &what("phi_deg"), o.phi_deg));
+            }
+            if !o.reflectance.is_finite() {
+                return Err(bad(i, &what("reflectance"), o.reflectance));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Least-squares slope of position against order index; `None` when the
+/// indices do not vary or the slope vanishes.
+fn lattice_spacing(orders: &[Order], key: impl Fn(&Order) -> (i32, f64)) -> Option<f64> {
+    let n = orders.len() as f64;
+    if orders.len() < 2 {
+        return None;
+    }
+    let (mut sm, mut ss) = (0.0, 0.0);
+    for o in orders {
+        let (m, s) = key(o);
+        sm += m as f64;
+        ss += s;
+    }
+    let (mm, ms) = (sm / n, ss / n);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for o in orders {
+        let (m, s) = key(o);
+        let d = m as f64 - mm;
+        sxx += d * d;
+        sxy += d * (s - ms);
+    }
+    let slope = (sxy / sxx).abs();
+    (sxx > 0.0 && slope.is_finite() && slope > 0.0).then_some(slope)
+}
+
+fn specular_direction(e: &SolveEntry) -> (f64, f64) {
+    match e.efficiencies.orders.iter().find(|o| o.m == 0 && o.n == 0) {
+        Some(o) => order_direction(o),
+        None => {
+            let (t, p) = (
+                e.incidence.polar_deg.to_radians(),
+                e.incidence.azimuth_deg.to_radians(),
+            );
+            (t.sin() * p.cos(), t.sin() * p.sin())
+        }
+    }
+}
+
+/// Bruton's piecewise-linear wavelength → RGB (see module docs), in 0..=1.
+pub fn wavelength_tint(nm: f64) -> [f64; 3] {
+    let c = if (380.0..440.0).contains(&nm) {
+        [(440.0 - nm) / 60.0, 0.0, 1.0]
+    } else if (440.0..490.0).contains(&nm) {
+        [0.0, (nm - 440.0) / 50.0, 1.0]
+    } else if (490.0..510.0).contains(&nm) {
+        [0.0, 1.0, (510.0 - nm) / 20.0]
+    } else if (510.0..580.0).contains(&nm) {
+        [(nm - 510.0) / 70.0, 1.0, 0.0]
+    } else if (580.0..645.0).contains(&nm) {
+        [1.0, (645.0 - nm) / 65.0, 0.0]
+    } else if (645.0..=780.0).contains(&nm) {
+        [1.0, 0.0, 0.0]
+    } else {
+        return [0.8, 0.8, 0.8];
+    };
+    c.map(|v| 0.2 + 0.8 * v)
+}
+
+fn to_rgb8(c: [f64; 3], b: f64) -> [u8; 3] {
+    c.map(|v| (v * b * 255.0).round().clamp(0.0, 255.0) as u8)
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0)
+}
+
+fn same_incidence(a: &Incidence, b: &Incidence) -> bool {
+    close(a.polar_deg, b.polar_deg) && close(a.azimuth_deg, b.azimuth_deg)
+}
+
+fn incidence_cmp(a: &Incidence, b: &Incidence) -> Ordering {
+    a.polar_deg
+        .total_cmp(&b.polar_deg)
+        .then(a.azimuth_deg.total_cmp(&b.azimuth_deg))
+}
+
+/// A number with at most two decimals, trailing zeros dropped.
+fn fmt_num(x: f64) -> String {
+    let s = format!("{x:.2}");
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
+fn row_label(i: &Incidence) -> String {
+    if i.azimuth_deg == 0.0 {
+        format!("{}°", fmt_num(i.polar_deg))
+    } else {
+        format!("{}° AZ {}°", fmt_num(i.polar_deg), fmt_num(i.azimuth_deg))
+    }
+}
+
+/// Legend text; `scale` is (log10 lo, log10 hi) of the BRDF shown.
+fn legend_lines(scale: Option<(f64, f64)>) -> Vec<String> {
+    let first = match scale {
+        Some((lo, hi)) => format!(
+            "DOT BRIGHTNESS: LOG10 BRDF (R/CELL, 1/SR) FROM {:.2} (DIM) TO {:.2} (FULL)",
+            lo, hi
+        ),
+        None => "NO DIFFUSE ORDERS WITH R > 0 TO DRAW".into(),
+    };
+    vec![
+        first,
+        "ROWS: INCIDENCE POLAR ANGLE; COLUMNS: WAVELENGTH".into(),
+        "DISK: REFLECTED DIRECTIONS (SX RIGHT, SY UP); RINGS 30° 60°; + SPECULAR (0,0)".into(),
+    ]
+}
+
+fn text_width(s: &str) -> usize {
+    s.chars().count() * GLYPH_ADVANCE
+}
+
+/// An RGB8 image; all drawing clips at the border.
+struct Canvas {
+    w: usize,
+    h: usize,
+    px: Vec<u8>,
+}
+
+impl Canvas {
+    fn fill(&mut self, c: [u8; 3]) {
+        for p in self.px.chunks_exact_mut(3) {
+            p.copy_from_slice(&c);
+        }
+    }
+
+    fn index(&self, x: i64, y: i64) -> Option<usize> {
+        (x >= 0 && y >= 0 && (x as usize) < self.w && (y as usize) < self.h)
+            .then(|| (y as usize * self.w + x as usize) * 3)
+    }
+
+    fn set(&mut self, x: i64, y: i64, c: [u8; 3]) {
+        if let Some(i) = self.index(x, y) {
+            self.px[i..i + 3].copy_from_slice(&c);
+        }
+    }
+
+    fn disk(&mut self, cx: f64, cy: f64, r: f64, c: [u8; 3]) {
+        let (x0, x1) = ((cx - r).floor() as i64, (cx + r).ceil() as i64);
+        let (y0, y1) = ((cy - r).floor() as i64, (cy + r).ceil() as i64);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let (dx, dy) = (x as f64 - cx, y as f64 - cy);
+                if dx * dx + dy * dy <= r * r {
+                    self.set(x, y, c);
+                }
+            }
+        }
+    }
+
+    fn ring(&mut self, cx: f64, cy: f64, r: f64, c: [u8; 3]) {
+        let steps = (2.0 * std::f64::consts::PI * r * 2.0).ceil().max(8.0) as usize;
+        for k in 0..steps {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / steps as f64;
+            self.set(
+                (cx + r * a.cos()).round() as i64,
+                (cy + r * a.sin()).round() as i64,
+                c,
+            );
+        }
+    }
+
+    /// Gaussian dot of peak brightness `b`, combined by per-channel maximum.
+    fn splat(&mut self, x: f64, y: f64, tint: [f64; 3], b: f64) {
+        let reach = (3.0 * DOT_SIGMA_PX).ceil() as i64;
+        let (xc, yc) = (x.round() as i64, y.round() as i64);
+        for py in yc - reach..=yc + reach {
+            for px in xc - reach..=xc + reach {
+                let Some(i) = self.index(px, py) else {
+                    continue;
+                };
+                let (dx, dy) = (px as f64 - x, py as f64 - y);
+                let g = (-(dx * dx + dy * dy) / (2.0 * DOT_SIGMA_PX * DOT_SIGMA_PX)).exp();
+                let c = to_rgb8(tint, b * g);
+                for (p, v) in self.px[i..i + 3].iter_mut().zip(c) {
+                    *p = (*p).max(v);
+                }
+            }
+        }
+    }
+
+    fn text(&mut self, x: usize, y: usize, s: &str, c: [u8; 3]) {
+        for (k, ch) in s.chars().enumerate() {
+            let g = glyph(ch);
+            let x0 = x + k * GLYPH_ADVANCE;
+            for (row, bits) in g.iter().enumerate() {
+                for col in 0..5 {
+                    if bits & (0x10 >> col) == 0 {
+                        continue;
+                    }
+                    for dy in 0..FONT_SCALE {
+                        for dx in 0..FONT_SCALE {
+                            self.set(
+                                (x0 + col * FONT_SCALE + dx) as i64,
+                                (y + row * FONT_SCALE + dy) as i64,
+                                c,
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// 5×7 glyph rows, bit 4 = leftmost column.
+fn glyph(c: char) -> [u8; 7] {
+    match c.to_ascii_uppercase() {
+        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
+        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
+        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
+        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
+        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
+        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
+        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
+        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
+        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
+        'A' => [0x0E, 0x11, 0x11, 0x11, 0x1F, 0x11, 0x11],
+        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
+        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
+        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
+        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
+        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
+        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
+        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
+        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
+        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
+        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
+        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
+        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
+        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
+        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
+        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
+        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
+        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
+        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
+        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
+        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
+        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
+        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
+        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
+        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
+        ' ' => [0; 7],
+        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
+        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
+        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
+        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
+        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
+        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
+        ';' => [0, 0x0C, 0x0C, 0, 0x0C, 0x04, 0x08],
+        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
+        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
+        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
+        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
+        '[' => [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E],
+        ']' => [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E],
+        '<' => [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02],
+        '>' => [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08],
+        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
+        '\'' => [0x0C, 0x04, 0x08, 0, 0, 0, 0],
+        '°' => [0x0C, 0x12, 0x12, 0x0C, 0, 0, 0],
+        _ => [0x0E, 0x11, 0x01, 0x02, 0x04, 0, 0x04], // '?'
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tint_follows_the_documented_map() {
+        let t = |nm: f64| wavelength_tint(nm).map(|v| (v - 0.2) / 0.8);
+        assert_eq!(t(440.0), [0.0, 0.0, 1.0]);
+        assert_eq!(t(510.0), [0.0, 1.0, 0.0]);
+        assert_eq!(t(580.0), [1.0, 1.0, 0.0]);
+        assert_eq!(t(700.0), [1.0, 0.0, 0.0]);
+        let g = t(465.0);
+        assert!((g[1] - 0.5).abs() < 1e-12 && g[2] == 1.0);
+        assert_eq!(wavelength_tint(900.0), [0.8, 0.8, 0.8]);
+    }
+
+    #[test]
+    fn numbers_are_formatted_compactly() {
+        assert_eq!(fmt_num(450.0), "450");
+        assert_eq!(fmt_num(632.8), "632.8");
+        assert_eq!(fmt_num(12.345), "12.35");
+        assert_eq!(fmt_num(-0.001), "0");
+    }
+
+    #[test]
+    fn every_legend_character_has_a_glyph() {
+        let unknown = glyph('\u{1}');
+        for line in legend_lines(Some((-1.0, 2.0))) {
+            for ch in line.chars() {
+                assert!(ch == '?' || glyph(ch) != unknown, "missing glyph {ch:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,339 @@
+//! The diffuse-BRDF picture: decodes, has the documented layout, and shows
+//! the orders where their directions say.
+
+use inksim::config::Incidence;
+use inksim::farfield::{Efficiencies, Order, SolveEntry};
+use inksim::render::{diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX};
+use inksim::solver::{MethodUsed, SolveRecord};
+use num_complex::Complex64;
+
+const PERIOD_NM: f64 = 2000.0;
+
+/// Propagating reflected orders of a square lattice (period PERIOD_NM) for
+/// incidence in the x–z plane; every diffuse order gets `r_diffuse`, the
+/// specular one 0.04; `bright` = ((m, n), R) overrides one order.
+fn lattice_entry(
+    wl: f64,
+    polar: f64,
+    r_diffuse: f64,
+    bright: Option<((i32, i32), f64)>,
+) -> SolveEntry {
+    let s_inc = polar.to_radians().sin();
+    let step = wl / PERIOD_NM;
+    let mut orders = Vec::new();
+    for m in -20..=20 {
+        for n in -20..=20 {
+            let (sx, sy) = (s_inc + m as f64 * step, n as f64 * step);
+            let s = (sx * sx + sy * sy).sqrt();
+            if s >= 1.0 {
+                continue;
+            }
+            let mut r = if (m, n) == (0, 0) { 0.04 } else { r_diffuse };
+            if let Some((mn, rb)) = bright {
+                if mn == (m, n) {
+                    r = rb;
+                }
+            }
+            orders.push(Order {
+                m,
+                n,
+                theta_deg: s.asin().to_degrees(),
+                phi_deg: sy.atan2(sx).to_degrees(),
+                reflectance: r,
+                transmittance: 0.0,
+            });
+        }
+    }
+    entry(wl, polar, orders)
+}
+
+fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
+    SolveEntry {
+        wavelength_nm: wl,
+        incidence: Incidence {
+            polar_deg: polar,
+            azimuth_deg: 0.0,
+        },
+        efficiencies: Efficiencies {
+            orders,
+            r00: Complex64::new(0.2, 0.0),
+            t00: Complex64::new(0.9, 0.0),
+            total_reflectance: 0.05,
+            total_transmittance: 0.9,
+            absorption: 0.05,
+            energy_balance: 0.0,
+        },
+        record: SolveRecord {
+            method: MethodUsed::Born,
+            iterations: 3,
+            operator_applications: 4,
+            residual: 1e-8,
+            seconds: 0.0,
+            note: String::new(),
+        },
+    }
+}
+
+struct Image {
+    w: usize,
+    h: usize,
+    px: Vec<u8>,
+}
+
+impl Image {
+    fn rgb(&self, x: usize, y: usize) -> [u8; 3] {
+        let i = (y * self.w + x) * 3;
+        [self.px[i], self.px[i + 1], self.px[i + 2]]
+    }
+    fn lum(&self, x: usize, y: usize) -> u32 {
+        self.rgb(x, y).iter().map(|&v| v as u32).sum()
+    }
+}
+
+fn decode(png_bytes: &[u8]) -> Image {
+    let dec = png::Decoder::new(std::io::Cursor::new(png_bytes));
+    let mut reader = dec.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    assert_eq!(info.bit_depth, png::BitDepth::Eight);
+    buf.truncate(info.buffer_size());
+    Image {
+        w: info.width as usize,
+        h: info.height as usize,
+        px: buf,
+    }
+}
+
+fn direction(o: &Order) -> (f64, f64) {
+    let (t, p) = (o.theta_deg.to_radians(), o.phi_deg.to_radians());
+    (t.sin() * p.cos(), t.sin() * p.sin())
+}
+
+#[test]
+fn picture_decodes_with_one_panel_per_wavelength_and_angle() {
+    let mut entries = Vec::new();
+    for polar in [60.0, 0.0, 30.0] {
+        for wl in [650.0, 450.0] {
+            entries.push(lattice_entry(wl, polar, 1e-3, None));
+        }
+    }
+    let png_bytes = diffuse_brdf_png(&entries, "Test: 2 x 3").unwrap();
+    let img = decode(&png_bytes);
+    let layout = PanelLayout::new(&entries, "Test: 2 x 3").unwrap();
+    assert_eq!((img.w, img.h), (layout.width, layout.height));
+    assert_eq!(layout.wavelengths_nm, vec![450.0, 650.0]);
+    let polars: Vec<f64> = layout.incidences.iter().map(|i| i.polar_deg).collect();
+    assert_eq!(polars, vec![0.0, 30.0, 60.0]);
+
+    // Each further column widens the picture by one whole panel (once the
+    // grid is wider than the legend).
+    let widths: Vec<usize> = [8, 9, 10]
+        .iter()
+        .map(|&cols| {
+            let many: Vec<SolveEntry> = (0..cols)
+                .map(|k| lattice_entry(400.0 + 20.0 * k as f64, 0.0, 1e-3, None))
+                .collect();
+            let l = PanelLayout::new(&many, "").unwrap();
+            assert_eq!(l.wavelengths_nm.len(), cols);
+            l.width
+        })
+        .collect();
+    let step = widths[1] - widths[0];
+    assert_eq!(widths[2] - widths[1], step, "{widths:?}");
+    assert!(step as f64 > 2.0 * DISK_RADIUS_PX, "{widths:?}");
+
+    // Column tint: the 650 nm column's dots are red, the 450 nm column's blue.
+    for (col, red_wins) in [(0, false), (1, true)] {
+        let (cx, cy) = layout.center(0, col);
+        let (mut r, mut b) = (0u64, 0u64);
+        let rad = DISK_RADIUS_PX as i64 - 2;
+        for dy in -rad..=rad {
+            for dx in -rad..=rad {
+                let p = img.rgb((cx as i64 + dx) as usize, (cy as i64 + dy) as usize);
+                r += p[0] as u64;
+                b += p[2] as u64;
+            }
+        }
+        assert_eq!(r > b, red_wins, "column {col}: red {r} blue {b}");
+    }
+}
+
+#[test]
+fn bright_order_is_brightest_at_its_own_position() {
+    let bright = (1, 2);
+    let entries = vec![
+        lattice_entry(500.0, 0.0, 1e-4, None),
+        lattice_entry(600.0, 20.0, 1e-4, Some((bright, 0.05))),
+        lattice_entry(600.0, 0.0, 1e-4, None),
+    ];
+    let img = decode(&diffuse_brdf_png(&entries, "bright").unwrap());
+    let layout = PanelLayout::new(&entries, "bright").unwrap();
+    let e = &entries[1];
+    let (row, col) = layout.panel_of(e).unwrap();
+    assert_eq!((row, col), (1, 1));
+    let o = e
+        .efficiencies
+        .orders
+        .iter()
+        .find(|o| (o.m, o.n) == bright)
+        .unwrap();
+    let (sx, sy) = direction(o);
+    assert!(sx > 0.5 && sy > 0.4);
+    let (bx, by) = layout.direction_px(row, col, sx, sy);
+    let (bx, by) = (bx.round() as i64, by.round() as i64);
+    let spec = e
+        .efficiencies
+        .orders
+        .iter()
+        .find(|o| (o.m, o.n) == (0, 0))
+        .unwrap();
+    let (spx, spy) = direction(spec);
+    let (spx, spy) = layout.direction_px(row, col, spx, spy);
+    let peak = img.lum(bx as usize, by as usize);
+
+    let (cx, cy) = layout.center(row, col);
+    // Right of and above the panel centre, as sx > 0, sy > 0 say.
+    assert!(bx as f64 > cx && (by as f64) < cy);
+    let r = DISK_RADIUS_PX as i64;
+    let mut others = 0;
+    for dy in -r..=r {
+        for dx in -r..=r {
+            let (x, y) = (cx as i64 + dx, cy as i64 + dy);
+            let near_bright = (x - bx).abs() <= 2 && (y - by).abs() <= 2;
+            let near_cross = (x as f64 - spx).abs() <= 5.0 && (y as f64 - spy).abs() <= 5.0;
+            if near_bright || near_cross {
+                continue;
+            }
+            let l = img.lum(x as usize, y as usize);
+            assert!(l < peak, "pixel ({x},{y}) lum {l} >= peak {peak}");
+            others += 1;
+        }
+    }
+    assert!(others > 10_000);
+
+    // The same panel drawn without the bright order differs most at its position.
+    let plain = vec![
+        entries[0].clone(),
+        lattice_entry(600.0, 20.0, 1e-4, None),
+        entries[2].clone(),
+    ];
+    let img0 = decode(&diffuse_brdf_png(&plain, "bright").unwrap());
+    assert_eq!((img0.w, img0.h), (img.w, img.h));
+    // (Searched over all disks; the legend's numbers change too.)
+    let mut best = (0i64, 0usize, 0usize);
+    for row in 0..2 {
+        for col in 0..2 {
+            let (cx, cy) = layout.center(row, col);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (x, y) = ((cx as i64 + dx) as usize, (cy as i64 + dy) as usize);
+                    let d = img.lum(x, y) as i64 - img0.lum(x, y) as i64;
+                    if d > best.0 {
+                        best = (d, x, y);
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        (best.1 as i64 - bx).abs() <= 1 && (best.2 as i64 - by).abs() <= 1,
+        "largest change at ({}, {}), order at ({bx}, {by})",
+        best.1,
+        best.2
+    );
+}
+
+#[test]
+fn brightness_increases_with_reflectance() {
+    let mut e = lattice_entry(550.0, 0.0, 0.0, None);
+    let mut picked = Vec::new();
+    for (mn, r) in [((2, 0), 1e-2), ((-2, 0), 1e-3), ((0, 2), 1e-4)] {
+        let o = e
+            .efficiencies
+            .orders
+            .iter_mut()
+            .find(|o| (o.m, o.n) == mn)
+            .unwrap();
+        o.reflectance = r;
+        picked.push(*o);
+    }
+    let entries = vec![e];
+    let img = decode(&diffuse_brdf_png(&entries, "").unwrap());
+    let layout = PanelLayout::new(&entries, "").unwrap();
+    let lum: Vec<u32> = picked
+        .iter()
+        .map(|o| {
+            let (sx, sy) = direction(o);
+            let (x, y) = layout.direction_px(0, 0, sx, sy);
+            img.lum(x.round() as usize, y.round() as usize)
+        })
+        .collect();
+    assert!(lum[0] > lum[1] && lum[1] > lum[2] && lum[2] > 0, "{lum:?}");
+    // Log scale: equal ratios give (nearly) equal brightness steps.
+    let (d1, d2) = (lum[0] as i64 - lum[1] as i64, lum[1] as i64 - lum[2] as i64);
+    assert!((d1 - d2).abs() <= 6, "{lum:?}");
+}
+
+#[test]
+fn cell_of_a_lattice_is_the_product_of_its_spacings() {
+    let e = lattice_entry(500.0, 30.0, 1e-3, None);
+    let want = (500.0 / PERIOD_NM) * (500.0 / PERIOD_NM);
+    assert!((order_cell(&e.efficiencies.orders) - want).abs() < 1e-12 * want);
+    // Only one order: falls back to the unit disk shared by the orders.
+    let one = &e.efficiencies.orders[..1];
+    assert!((order_cell(one) - std::f64::consts::PI).abs() < 1e-15);
+}
+
+#[test]
+fn empty_input_is_an_error() {
+    assert!(matches!(
+        diffuse_brdf_png(&[], "t"),
+        Err(RenderError::Empty)
+    ));
+}
+
+#[test]
+fn non_finite_values_are_errors_not_panics() {
+    let mut e = lattice_entry(500.0, 0.0, 1e-3, None);
+    e.efficiencies.orders[3].reflectance = f64::NAN;
+    let err = diffuse_brdf_png(&[e], "t").unwrap_err();
+    assert!(err.to_string().contains("reflectance"), "{err}");
+    let mut e = lattice_entry(500.0, 0.0, 1e-3, None);
+    e.wavelength_nm = f64::INFINITY;
+    assert!(diffuse_brdf_png(&[e], "t").is_err());
+}
+
+#[test]
+fn entries_without_diffuse_orders_draw_empty_panels() {
+    let specular_only = entry(
+        500.0,
+        0.0,
+        vec![Order {
+            m: 0,
+            n: 0,
+            theta_deg: 0.0,
+            phi_deg: 0.0,
+            reflectance: 0.04,
+            transmittance: 0.96,
+        }],
+    );
+    let no_orders = entry(700.0, 45.0, vec![]);
+    let entries = vec![specular_only, no_orders];
+    let img = decode(&diffuse_brdf_png(&entries, "nothing diffuse ±").unwrap());
+    let layout = PanelLayout::new(&entries, "nothing diffuse ±").unwrap();
+    assert_eq!((img.w, img.h), (layout.width, layout.height));
+    // No tinted pixel inside any disk: only greys (background, guides, cross).
+    for row in 0..2 {
+        for col in 0..2 {
+            let (cx, cy) = layout.center(row, col);
+            let r = DISK_RADIUS_PX as i64;
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let p = img.rgb((cx as i64 + dx) as usize, (cy as i64 + dy) as usize);
+                    assert!(p[0] == p[1] && p[1] == p[2], "tinted pixel {p:?}");
+                }
+            }
+        }
+    }
+}

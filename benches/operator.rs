@@ -1,1 +1,59 @@
-fn main(){}
+//! One application of the background Green's operator against the batched
+//! 2-D FFTs it contains (forward + inverse over every z-slice). The ratio
+//! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
+//!
+//! `cargo bench --bench operator`
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use inksim::solver::fft::Fft2;
+use inksim::solver::operator::{GreenTable, Operator};
+use inksim::solver::Problem;
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+
+fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
+    Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
+        C64::new((i + 2 * j) as f64 * 0.01, (k as f64 * 0.1).sin())
+    })
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("operator");
+    g.sample_size(10);
+    for &(n, nz) in &[(128usize, 64usize), (256, 64)] {
+        let lat = Problem::lattice(
+            [n, n, nz],
+            [2560.0 * n as f64 / 256.0, 2560.0 * n as f64 / 256.0, 1000.0],
+            500.0,
+            30.0,
+            0.0,
+        );
+        let op = Operator::new(lat);
+        let table = GreenTable::new(&lat, C64::new(1.558f64.powi(2), 0.0));
+        let mut ws = op.workspace();
+        let mut u = field(nz, n, n);
+        g.bench_with_input(
+            BenchmarkId::new("apply", format!("{n}x{n}x{nz}")),
+            &(),
+            |b, _| b.iter(|| op.apply(&table, &mut u, &mut ws)),
+        );
+        let fft = Fft2::new(n, n);
+        let mut scr = fft.scratch(nz);
+        let mut spec = Array3::zeros((nz, n, n));
+        let mut v = field(nz, n, n);
+        g.bench_with_input(
+            BenchmarkId::new("fft_pair", format!("{n}x{n}x{nz}")),
+            &(),
+            |b, _| {
+                b.iter(|| {
+                    fft.forward(&mut v, &mut spec, &mut scr);
+                    fft.inverse(&mut spec, &mut v, &mut scr);
+                })
+            },
+        );
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

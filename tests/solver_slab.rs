@@ -13,27 +13,57 @@ fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (C64, C64) {
     let rho = (g - b) / (g + b);
     let e = (2.0 * C64::i() * g * h).exp();
     let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
-    (a * (1.0 + rho * e) - 1.0, a * (C64::i() * g * h).exp() * (1.0 + rho))
+    (
+        a * (1.0 + rho * e) - 1.0,
+        a * (C64::i() * g * h).exp() * (1.0 + rho),
+    )
 }
 
-fn slab_solve(eps: C64, polar: f64, nz: usize, method: Method) -> (f64, f64, f64, f64, f64, solver::Solution) {
+fn slab_solve(
+    eps: C64,
+    polar: f64,
+    nz: usize,
+    method: Method,
+) -> (f64, f64, f64, f64, f64, solver::Solution) {
     let lambda = 500.0;
     let h = 1000.0;
     let lat = Problem::lattice([4, 4, nz], [800.0, 800.0, h], lambda, polar, 20.0);
     let grid = Array3::from_elem((nz, 4, 4), eps);
-    let p = Problem { lattice: lat, eps: &grid, eps_binder: EPS_B };
-    let sol = solver::solve(&p, method, &Controls { tolerance: 1e-11, max_iterations: 20000 }).expect("solve");
+    let p = Problem {
+        lattice: lat,
+        eps: &grid,
+        eps_binder: EPS_B,
+    };
+    let sol = solver::solve(
+        &p,
+        method,
+        &Controls {
+            tolerance: 1e-11,
+            max_iterations: 20000,
+        },
+    )
+    .expect("solve");
     let kap = lat.q[0].hypot(lat.q[1]);
     let (r, t) = airy(lat.k0, eps, kap, h);
     let ff = inksim::farfield::efficiencies(&sol);
-    (ff.total_reflectance, ff.total_transmittance, r.norm_sqr(), t.norm_sqr(), ff.energy_balance, sol)
+    (
+        ff.total_reflectance,
+        ff.total_transmittance,
+        r.norm_sqr(),
+        t.norm_sqr(),
+        ff.energy_balance,
+        sol,
+    )
 }
 
 #[test]
 fn background_slab_is_exact() {
     for polar in [0.0, 35.0] {
         let (rr, tt, r0, t0, eb, sol) = slab_solve(C64::new(EPS_B, 0.0), polar, 16, Method::Born);
-        assert!((rr - r0).abs() < 1e-10 && (tt - t0).abs() < 1e-10, "{rr} {r0} {tt} {t0}");
+        assert!(
+            (rr - r0).abs() < 1e-10 && (tt - t0).abs() < 1e-10,
+            "{rr} {r0} {tt} {t0}"
+        );
         assert!(eb.abs() < 1e-10);
         assert_eq!(sol.record.iterations, 0);
     }
@@ -55,7 +85,10 @@ fn slab_in_delta_eps_converges_second_order() {
         for nz in [50, 100, 200] {
             let (rr, tt, r0, t0, eb, sol) = slab_solve(eps, polar, nz, method);
             let err = (rr - r0).abs().max((tt - t0).abs());
-            eprintln!("eps {eps} polar {polar} nz {nz}: err {err:.3e} energy {eb:.1e} iters {}", sol.record.iterations);
+            eprintln!(
+                "eps {eps} polar {polar} nz {nz}: err {err:.3e} energy {eb:.1e} iters {}",
+                sol.record.iterations
+            );
             assert!(eb.abs() < 1e-8);
             errs.push(err);
         }

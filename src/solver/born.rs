@@ -40,24 +40,42 @@ impl IterativeMethod for Born {
             Zip::from(&mut u).and(&r).par_for_each(|u, r| *u += r);
         }
         if ratio.is_finite() && ratio < MAX_CONTRACTION {
-            Validity::Likely(format!("Born contraction estimate {ratio:.3} < {MAX_CONTRACTION}"))
+            Validity::Likely(format!(
+                "Born contraction estimate {ratio:.3} < {MAX_CONTRACTION}"
+            ))
         } else {
-            Validity::Unlikely(format!("Born contraction estimate {ratio:.3} ≥ {MAX_CONTRACTION}"))
+            Validity::Unlikely(format!(
+                "Born contraction estimate {ratio:.3} ≥ {MAX_CONTRACTION}"
+            ))
         }
     }
 
-    fn run(&self, sys: &mut System, u: &mut Array3<C64>, ctl: &Controls) -> Result<Outcome, SolveError> {
+    fn run(
+        &self,
+        sys: &mut System,
+        u: &mut Array3<C64>,
+        ctl: &Controls,
+    ) -> Result<Outcome, SolveError> {
         let mut r = Array3::zeros(u.dim());
         let mut best = f64::INFINITY;
         let mut growing = 0;
         for it in 0..=ctl.max_iterations {
             let res = sys.residual(u, &mut r);
             if res <= ctl.tolerance {
-                return Ok(Outcome { iterations: it, applications: it + 1, residual: res, note: String::new() });
+                return Ok(Outcome {
+                    iterations: it,
+                    applications: it + 1,
+                    residual: res,
+                    note: String::new(),
+                });
             }
             let diverged = !res.is_finite() || res > 1e3 * best.min(1.0) || growing >= 5;
             if diverged {
-                return Err(SolveError::Diverged { method: MethodUsed::Born, iterations: it, residual: res });
+                return Err(SolveError::Diverged {
+                    method: MethodUsed::Born,
+                    iterations: it,
+                    residual: res,
+                });
             }
             growing = if res > best { growing + 1 } else { 0 };
             best = best.min(res);

@@ -46,7 +46,9 @@ impl Fft2 {
             .max()
             .unwrap_or(0)
             .max(1);
-        FftScratch { bufs: (0..nz).map(|_| vec![C64::new(0.0, 0.0); len]).collect() }
+        FftScratch {
+            bufs: (0..nz).map(|_| vec![C64::new(0.0, 0.0); len]).collect(),
+        }
     }
 
     /// Unnormalised forward transform of every slice: `real (nz,ny,nx)` → `spec (nz,nx,ny)`.

@@ -33,7 +33,11 @@ pub struct TimeMarching {
 
 impl Default for TimeMarching {
     fn default() -> Self {
-        TimeMarching { margin: 1.05, min_step: 1.0 / 64.0, patience: 30 }
+        TimeMarching {
+            margin: 1.05,
+            min_step: 1.0 / 64.0,
+            patience: 30,
+        }
     }
 }
 
@@ -45,7 +49,10 @@ pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
         hi = hi.max(e.re);
     }
     let er = 0.5 * (lo + hi);
-    let rad = eps.iter().map(|e| (e - er).norm()).fold((eps_binder - er).abs(), f64::max);
+    let rad = eps
+        .iter()
+        .map(|e| (e - er).norm())
+        .fold((eps_binder - er).abs(), f64::max);
     (er, rad)
 }
 
@@ -58,7 +65,12 @@ impl IterativeMethod for TimeMarching {
         Validity::Always
     }
 
-    fn run(&self, sys: &mut System, u: &mut Array3<C64>, ctl: &Controls) -> Result<Outcome, SolveError> {
+    fn run(
+        &self,
+        sys: &mut System,
+        u: &mut Array3<C64>,
+        ctl: &Controls,
+    ) -> Result<Outcome, SolveError> {
         let lat = sys.op.lat;
         let k2 = lat.k0 * lat.k0;
         let (er, rad) = shift_of(sys.eps, sys.eps_binder);
@@ -75,11 +87,22 @@ impl IterativeMethod for TimeMarching {
         for it in 0..=ctl.max_iterations {
             let res = sys.residual(u, &mut r);
             if !res.is_finite() {
-                return Err(SolveError::Diverged { method: MethodUsed::TimeMarching, iterations: it, residual: res });
+                return Err(SolveError::Diverged {
+                    method: MethodUsed::TimeMarching,
+                    iterations: it,
+                    residual: res,
+                });
             }
             if res <= ctl.tolerance {
-                let note = format!("ε_r = {er:.4}, ε_s = {es:.4}, final dτ = {step}, {halvings} step halvings");
-                return Ok(Outcome { iterations: it, applications: 2 * it + 1, residual: res, note });
+                let note = format!(
+                    "ε_r = {er:.4}, ε_s = {es:.4}, final dτ = {step}, {halvings} step halvings"
+                );
+                return Ok(Outcome {
+                    iterations: it,
+                    applications: 2 * it + 1,
+                    residual: res,
+                    note,
+                });
             }
             growing = if res > prev { growing + 1 } else { 0 };
             prev = res;
@@ -88,7 +111,11 @@ impl IterativeMethod for TimeMarching {
                 halvings += 1;
                 growing = 0;
                 if step < self.min_step {
-                    return Err(SolveError::Diverged { method: MethodUsed::TimeMarching, iterations: it, residual: res });
+                    return Err(SolveError::Diverged {
+                        method: MethodUsed::TimeMarching,
+                        iterations: it,
+                        residual: res,
+                    });
                 }
             }
             if it == ctl.max_iterations {
@@ -101,10 +128,14 @@ impl IterativeMethod for TimeMarching {
             }
             w.assign(&r);
             sys.op.apply(&shifted, &mut w, &mut sys.ws);
-            Zip::from(&mut *u).and(&r).and(&w).and(eps).par_for_each(|u, r, w, e| {
-                let gamma = 1.0 + C64::i() * (e - er) / es;
-                *u += step * gamma * (r + c * w);
-            });
+            Zip::from(&mut *u)
+                .and(&r)
+                .and(&w)
+                .and(eps)
+                .par_for_each(|u, r, w, e| {
+                    let gamma = 1.0 + C64::i() * (e - er) / es;
+                    *u += step * gamma * (r + c * w);
+                });
         }
         unreachable!("loop returns")
     }

@@ -62,9 +62,18 @@ pub struct SolveRecord {
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SolveError {
     #[error("{method} diverged: residual grew to {residual:.3e} after {iterations} iterations")]
-    Diverged { method: MethodUsed, iterations: usize, residual: f64 },
+    Diverged {
+        method: MethodUsed,
+        iterations: usize,
+        residual: f64,
+    },
     #[error("{method} did not reach tolerance {tolerance:.1e}: residual {residual:.3e} after {iterations} iterations")]
-    NotConverged { method: MethodUsed, iterations: usize, residual: f64, tolerance: f64 },
+    NotConverged {
+        method: MethodUsed,
+        iterations: usize,
+        residual: f64,
+        tolerance: f64,
+    },
     #[error("invalid problem: {0}")]
     Invalid(String),
 }
@@ -80,10 +89,23 @@ pub struct Problem<'a> {
 
 impl Problem<'_> {
     /// Lattice for a wavelength and incidence (polar, azimuth in degrees).
-    pub fn lattice(grid: [usize; 3], size_nm: [f64; 3], wavelength_nm: f64, polar_deg: f64, azimuth_deg: f64) -> Lattice {
+    pub fn lattice(
+        grid: [usize; 3],
+        size_nm: [f64; 3],
+        wavelength_nm: f64,
+        polar_deg: f64,
+        azimuth_deg: f64,
+    ) -> Lattice {
         let k0 = 2.0 * std::f64::consts::PI / wavelength_nm;
         let (s, p) = (polar_deg.to_radians().sin(), azimuth_deg.to_radians());
-        Lattice { nx: grid[0], ny: grid[1], nz: grid[2], size_nm, k0, q: [k0 * s * p.cos(), k0 * s * p.sin()] }
+        Lattice {
+            nx: grid[0],
+            ny: grid[1],
+            nz: grid[2],
+            size_nm,
+            k0,
+            q: [k0 * s * p.cos(), k0 * s * p.sin()],
+        }
     }
 }
 
@@ -119,7 +141,12 @@ pub trait IterativeMethod {
     /// A cheap a-priori statement of where the method is valid.
     fn validity(&self, sys: &mut System) -> Validity;
     /// Improve `u` in place until the relative residual is below tolerance.
-    fn run(&self, sys: &mut System, u: &mut Array3<C64>, ctl: &Controls) -> Result<Outcome, SolveError>;
+    fn run(
+        &self,
+        sys: &mut System,
+        u: &mut Array3<C64>,
+        ctl: &Controls,
+    ) -> Result<Outcome, SolveError>;
 }
 
 /// The discrete equation `u = u_bg + G_b V u` and the scratch to work on it.
@@ -144,10 +171,18 @@ impl<'a> System<'a> {
     pub fn new(p: &Problem<'a>) -> Result<Self, SolveError> {
         let lat = p.lattice;
         if p.eps.dim() != (lat.nz, lat.ny, lat.nx) {
-            return Err(SolveError::Invalid(format!("permittivity grid {:?} does not match lattice", p.eps.dim())));
+            return Err(SolveError::Invalid(format!(
+                "permittivity grid {:?} does not match lattice",
+                p.eps.dim()
+            )));
         }
-        if p.eps.iter().any(|e| !e.re.is_finite() || !e.im.is_finite() || e.im < 0.0) {
-            return Err(SolveError::Invalid("permittivity must be finite with Im ε ≥ 0 (passive)".into()));
+        if p.eps
+            .iter()
+            .any(|e| !e.re.is_finite() || !e.im.is_finite() || e.im < 0.0)
+        {
+            return Err(SolveError::Invalid(
+                "permittivity must be finite with Im ε ≥ 0 (passive)".into(),
+            ));
         }
         let op = Operator::new(lat);
         let binder = GreenTable::new(&lat, C64::new(p.eps_binder, 0.0));
@@ -156,10 +191,23 @@ impl<'a> System<'a> {
         let mut ubg = vec![C64::new(0.0, 0.0); lat.nz];
         let g2 = C64::new(k2 * p.eps_binder - lat.q[0].powi(2) - lat.q[1].powi(2), 0.0);
         let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
-        let ubg_norm = (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let ubg_norm =
+            (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
         let ws = op.workspace();
         let tmp = Array3::zeros(p.eps.dim());
-        Ok(System { op, binder, eps: p.eps, eps_binder: p.eps_binder, v, ubg, r_bg, t_bg, ubg_norm, ws, tmp })
+        Ok(System {
+            op,
+            binder,
+            eps: p.eps,
+            eps_binder: p.eps_binder,
+            v,
+            ubg,
+            r_bg,
+            t_bg,
+            ubg_norm,
+            ws,
+            tmp,
+        })
     }
 
     /// Fill `u` with the background field.
@@ -171,7 +219,10 @@ impl<'a> System<'a> {
 
     /// `out ← u_bg + G V u − u` (the residual); returns ‖out‖ / ‖u_bg‖.
     pub fn residual(&mut self, u: &Array3<C64>, out: &mut Array3<C64>) -> f64 {
-        Zip::from(&mut *out).and(u).and(&self.v).par_for_each(|o, u, v| *o = v * u);
+        Zip::from(&mut *out)
+            .and(u)
+            .and(&self.v)
+            .par_for_each(|o, u, v| *o = v * u);
         self.op.apply(&self.binder, out, &mut self.ws);
         let ubg = &self.ubg;
         for (j, (mut o, uu)) in out.outer_iter_mut().zip(u.outer_iter()).enumerate() {
@@ -182,27 +233,43 @@ impl<'a> System<'a> {
 
     /// ‖x‖ / ‖u_bg‖.
     pub fn norm(&self, x: &Array3<C64>) -> f64 {
-        let s: f64 = x.as_slice().map(|s| s.iter().map(|c| c.norm_sqr()).sum()).unwrap_or_else(|| x.iter().map(|c| c.norm_sqr()).sum());
-        s.sqrt() / self.ubg_norm
+        sum_slices(x, |c, _| c.norm_sqr(), x).sqrt() / self.ubg_norm
     }
 
     /// Far-field amplitudes and absorption of a field.
     fn outputs(&mut self, u: &Array3<C64>) -> (Array2<C64>, Array2<C64>, f64) {
         let lat = self.op.lat;
         let mut src = std::mem::replace(&mut self.tmp, Array3::zeros((0, 0, 0)));
-        Zip::from(&mut src).and(u).and(&self.v).par_for_each(|o, u, v| *o = v * u);
+        Zip::from(&mut src)
+            .and(u)
+            .and(&self.v)
+            .par_for_each(|o, u, v| *o = v * u);
         let mut r = Array2::zeros((lat.nx, lat.ny));
         let mut t = Array2::zeros((lat.nx, lat.ny));
-        self.op.boundary_amplitudes(&self.binder, &mut src, &mut self.ws, &mut r, &mut t);
+        self.op
+            .boundary_amplitudes(&self.binder, &mut src, &mut self.ws, &mut r, &mut t);
         self.tmp = src;
         r[[0, 0]] += self.r_bg;
         t[[0, 0]] += self.t_bg;
         let dz = lat.size_nm[2] / lat.nz as f64;
-        let s: f64 = Zip::from(u).and(self.eps).par_fold(|| 0.0, |acc, u, e| acc + e.im * u.norm_sqr(), |a, b| a + b);
+        let s = sum_slices(u, |u, e| e.im * u.norm_sqr(), self.eps);
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
     }
+}
+
+/// Σ f(a, b) over all voxels, parallel over z-slices but summed in a fixed
+/// order, so the result is bit-identical for any thread count.
+fn sum_slices(a: &Array3<C64>, f: impl Fn(&C64, &C64) -> f64 + Sync, b: &Array3<C64>) -> f64 {
+    use rayon::prelude::*;
+    let parts: Vec<f64> = a
+        .outer_iter()
+        .into_par_iter()
+        .zip(b.outer_iter().into_par_iter())
+        .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| f(x, y)).sum())
+        .collect();
+    parts.iter().sum()
 }
 
 /// A solved problem: the field and what the far field needs.
@@ -269,5 +336,12 @@ pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, So
         seconds: start.elapsed().as_secs_f64(),
         note: out.note,
     };
-    Ok(Solution { lattice: p.lattice, field: u, r, t, absorption, record })
+    Ok(Solution {
+        lattice: p.lattice,
+        field: u,
+        r,
+        t,
+        absorption,
+        record,
+    })
 }

@@ -60,7 +60,11 @@ impl Lattice {
     }
 
     pub fn slab(&self) -> Slab {
-        Slab { k0: self.k0, thickness: self.size_nm[2], nz: self.nz }
+        Slab {
+            k0: self.k0,
+            thickness: self.size_nm[2],
+            nz: self.nz,
+        }
     }
 
     pub fn harmonics(&self) -> usize {
@@ -99,7 +103,12 @@ impl GreenTable {
                 let beta = lat.beta(ix, iy);
                 if green::is_small_gamma(&slab, g2) {
                     let (matrix, top, bottom) = green::dense_small_gamma(&slab, g2, beta);
-                    special.push(Special { index: ix * ny + iy, matrix, top, bottom });
+                    special.push(Special {
+                        index: ix * ny + iy,
+                        matrix,
+                        top,
+                        bottom,
+                    });
                     coef.push(zero_coef(beta));
                 } else {
                     coef.push(green::coef_from(&slab, g2, beta));
@@ -115,7 +124,12 @@ impl GreenTable {
                 p *= c.q;
             }
         }
-        GreenTable { eps_bg, coef, pow, special }
+        GreenTable {
+            eps_bg,
+            coef,
+            pow,
+            special,
+        }
     }
 
     /// Number of harmonics treated by the grazing (contour-average) path.
@@ -158,7 +172,10 @@ pub struct Operator {
 
 impl Operator {
     pub fn new(lat: Lattice) -> Self {
-        Operator { fft: Fft2::new(lat.nx, lat.ny), lat }
+        Operator {
+            fft: Fft2::new(lat.nx, lat.ny),
+            lat,
+        }
     }
 
     pub fn workspace(&self) -> Workspace {
@@ -239,7 +256,9 @@ impl Operator {
                     for iy in 0..ny {
                         let k = &cs[iy];
                         sj[iy] = (k.kdz * norm)
-                            * (out[iy] + k.diag * sj[iy] + k.rf * (pj[iy] * c[iy] + pm[iy] * d[iy]));
+                            * (out[iy]
+                                + k.diag * sj[iy]
+                                + k.rf * (pj[iy] * c[iy] + pm[iy] * d[iy]));
                     }
                 }
             });

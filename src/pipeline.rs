@@ -1,0 +1,267 @@
+//! The one module that wires the stages together:
+//! config → geometry → raster → solver → farfield → render → io.
+//!
+//! The geometry and the λ-independent raster (volume fractions) are built
+//! once; per wavelength only ε is recomputed; per incidence only the solve.
+//! The output folder is checked before any work so a bad path fails fast, and
+//! results are written atomically (temp file + rename), so an interrupted run
+//! leaves either the previous file or the complete new one.
+
+use crate::config::Scene;
+use crate::farfield::{self, SolveEntry};
+use crate::geometry::{self, Geometry, PackParams, SpeciesParams};
+use crate::io::{self, GeometrySummary, ResultSet};
+use crate::progress::Progress;
+use crate::raster::{self, Grid, Raster};
+use crate::render;
+use crate::solver::{self, Controls, Problem};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+use std::path::{Path, PathBuf};
+
+/// Sub-samples per voxel edge for partially filled voxels.
+pub const SUPERSAMPLE: usize = 4;
+
+/// Errors of a run, each naming what failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error("output folder {path}: {message}")]
+    Output { path: PathBuf, message: String },
+    #[error("geometry: {0}")]
+    Geometry(#[from] geometry::GeometryError),
+    #[error("solve at {wavelength_nm} nm, polar {polar_deg}°: {source}")]
+    Solve {
+        wavelength_nm: f64,
+        polar_deg: f64,
+        source: solver::SolveError,
+    },
+    #[error("material `{material}` has no data at {wavelength_nm} nm")]
+    Material {
+        material: String,
+        wavelength_nm: f64,
+    },
+    #[error(transparent)]
+    Io(#[from] io::IoError),
+    #[error("render: {0}")]
+    Render(#[from] render::RenderError),
+}
+
+/// What a finished run produced.
+pub struct RunReport {
+    pub result_path: PathBuf,
+    pub picture_path: PathBuf,
+    pub geometry: Geometry,
+    pub entries: Vec<SolveEntry>,
+}
+
+/// Paths of the result files of a scene.
+pub fn result_paths(scene: &Scene) -> (PathBuf, PathBuf) {
+    let d = &scene.output.dir;
+    (
+        d.join(format!("{}.h5", scene.output.name)),
+        d.join(format!("{}.png", scene.output.name)),
+    )
+}
+
+/// Make sure the output folder exists and accepts files.
+pub fn check_output_dir(dir: &Path) -> Result<(), PipelineError> {
+    let err = |m: String| PipelineError::Output {
+        path: dir.to_path_buf(),
+        message: m,
+    };
+    std::fs::create_dir_all(dir).map_err(|e| err(format!("cannot create: {e}")))?;
+    let probe = dir.join(format!(".inksim-write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(|e| err(format!("not writable: {e}")))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+/// Build the particle set of a scene.
+pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
+    let l = &scene.layer;
+    let params = PackParams {
+        size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
+        species: scene
+            .species
+            .iter()
+            .map(|s| SpeciesParams {
+                diameter_nm: s.diameter_nm,
+                volume_fraction: s.volume_fraction,
+            })
+            .collect(),
+        ..PackParams::default()
+    };
+    Ok(geometry::pack_rsa(&params, scene.seed)?)
+}
+
+/// The raster grid of a scene.
+pub fn grid_of(scene: &Scene) -> Grid {
+    let l = &scene.layer;
+    Grid {
+        nx: scene.grid.nx,
+        ny: scene.grid.ny,
+        nz: scene.grid.nz,
+        size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
+    }
+}
+
+/// Solve every (wavelength, incidence) of a scene on a given raster.
+pub fn solve_all(
+    scene: &Scene,
+    raster: &Raster,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    let g = raster.grid;
+    let eps_b = scene.layer.binder_index.powi(2);
+    let ctl = Controls {
+        tolerance: scene.solver.tolerance,
+        max_iterations: scene.solver.max_iterations,
+    };
+    let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
+    let mut entries = Vec::new();
+    for &lambda in &scene.wavelengths_nm {
+        let eps_species = scene
+            .species
+            .iter()
+            .map(|s| {
+                s.material
+                    .index_at(lambda)
+                    .map(|n| n * n)
+                    .ok_or_else(|| PipelineError::Material {
+                        material: s.material.name.clone(),
+                        wavelength_nm: lambda,
+                    })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
+        for inc in &scene.incidence {
+            let lattice = Problem::lattice(
+                [g.nx, g.ny, g.nz],
+                g.size_nm,
+                lambda,
+                inc.polar_deg,
+                inc.azimuth_deg,
+            );
+            let p = Problem {
+                lattice,
+                eps: &eps,
+                eps_binder: eps_b,
+            };
+            let sol = solver::solve(&p, scene.solver.method, &ctl).map_err(|source| {
+                PipelineError::Solve {
+                    wavelength_nm: lambda,
+                    polar_deg: inc.polar_deg,
+                    source,
+                }
+            })?;
+            let eff = farfield::efficiencies(&sol);
+            progress.inc(
+                1,
+                &format!(
+                    "{lambda} nm, {}°: R {:.4} T {:.4} A {:.4} ({} {} it, balance {:.1e})",
+                    inc.polar_deg,
+                    eff.total_reflectance,
+                    eff.total_transmittance,
+                    eff.absorption,
+                    sol.record.method,
+                    sol.record.iterations,
+                    eff.energy_balance
+                ),
+            );
+            entries.push(SolveEntry {
+                wavelength_nm: lambda,
+                incidence: *inc,
+                efficiencies: eff,
+                record: sol.record,
+            });
+        }
+    }
+    Ok(entries)
+}
+
+/// Run a scene end to end and write its result files.
+pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
+    let (result_path, picture_path) = result_paths(scene);
+    check_output_dir(&scene.output.dir)?;
+    let total = (scene.wavelengths_nm.len() * scene.incidence.len()) as u64;
+    let progress = Progress::new(total, &scene.output.name);
+    let geometry = build_geometry(scene)?;
+    progress.log(&format!(
+        "geometry: {} particles, PVC {:.4} (target {:.4})",
+        geometry.particles.len(),
+        geometry.stats.achieved_fraction.iter().sum::<f64>(),
+        scene.total_pvc()
+    ));
+    let grid = grid_of(scene);
+    let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+    progress.log(&format!(
+        "raster: {} × {} × {} voxels",
+        grid.nx, grid.ny, grid.nz
+    ));
+    let entries = solve_all(scene, &raster, &progress)?;
+    progress.finish("all solves done");
+
+    let png = render::diffuse_brdf_png(&entries, &scene.output.name)?;
+    io::write_atomic(&picture_path, &png)?;
+    write_result(scene, &geometry, &raster, &entries, &png, &result_path)?;
+    Ok(RunReport {
+        result_path,
+        picture_path,
+        geometry,
+        entries,
+    })
+}
+
+fn write_result(
+    scene: &Scene,
+    geometry: &Geometry,
+    raster: &Raster,
+    entries: &[SolveEntry],
+    png: &[u8],
+    path: &Path,
+) -> Result<(), PipelineError> {
+    let mut centers = Vec::new();
+    let mut radii = Vec::new();
+    let mut particle_of_sphere = Vec::new();
+    let mut species_of_particle = Vec::new();
+    for (i, p) in geometry.particles.iter().enumerate() {
+        species_of_particle.push(p.species as u32);
+        for s in &p.spheres {
+            centers.push(s.center);
+            radii.push(s.radius);
+            particle_of_sphere.push(i as u32);
+        }
+    }
+    let names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
+    let raster_fraction = raster.mean_fractions();
+    let created = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let config_path = scene.provenance.path.display().to_string();
+    let set = ResultSet {
+        version: crate::VERSION,
+        config_path: &config_path,
+        config_text: &scene.provenance.text,
+        input_hash: &scene.provenance.input_hash,
+        seed: scene.seed,
+        created_unix_s: created,
+        geometry: GeometrySummary {
+            species_names: &names,
+            centers_nm: &centers,
+            radii_nm: &radii,
+            particle_of_sphere: &particle_of_sphere,
+            species_of_particle: &species_of_particle,
+            target_fraction: &geometry.stats.target_fraction,
+            achieved_fraction: &geometry.stats.achieved_fraction,
+            raster_fraction: &raster_fraction,
+            min_gap_nm: geometry.stats.min_gap_nm,
+        },
+        grid: [raster.grid.nx, raster.grid.ny, raster.grid.nz],
+        size_nm: raster.grid.size_nm,
+        entries,
+        picture_png: Some(png),
+    };
+    io::write_result(path, &set)?;
+    Ok(())
+}

@@ -1,0 +1,161 @@
+//! The command line as a user meets it: bad input gives one clear line and a
+//! non-zero exit, never a panic or a half-written result; a good run writes
+//! its files and the same seed gives the same numbers for 1 and 2 threads.
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const TINY: &str = r#"
+seed = 3
+[layer]
+thickness_nm = 400.0
+fragment_nm = [500.0, 500.0]
+[[pigment]]
+name = "red"
+material = { builtin = "red" }
+pvc = 0.15
+diameter_nm = 150.0
+[grid]
+cell_nm = 25.0
+z_cell_nm = 20.0
+[illumination]
+wavelengths_nm = [500.0, 600.0]
+polar_deg = [0.0, 40.0]
+[solver]
+tolerance = 1e-7
+[output]
+name = "tiny"
+"#;
+
+fn inksim(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(args)
+        .output()
+        .expect("run inksim");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn write_config(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("scene.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Run a broken config; expect failure with one error line mentioning `needle`
+/// and nothing written to the output folder.
+fn expect_error(text: &str, needle: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), text);
+    let out = dir.path().join("out");
+    let (ok, _, err) = inksim(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok, "should fail: {needle}");
+    assert!(!err.contains("panicked"), "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "one line expected: {err}");
+    assert!(lines[0].starts_with("error: "), "{err}");
+    assert!(err.contains(needle), "`{needle}` not in: {err}");
+    let written: Vec<_> = std::fs::read_dir(&out)
+        .map(|d| d.flatten().collect())
+        .unwrap_or_default();
+    assert!(written.is_empty(), "files written: {written:?}");
+}
+
+#[test]
+fn unknown_key_is_named() {
+    expect_error(&TINY.replace("seed = 3", "seed = 3\ncolour = 1"), "colour");
+}
+
+#[test]
+fn negative_thickness_is_named() {
+    expect_error(
+        &TINY.replace("thickness_nm = 400.0", "thickness_nm = -5.0"),
+        "layer.thickness_nm",
+    );
+}
+
+#[test]
+fn pvc_beyond_packer_is_named() {
+    expect_error(&TINY.replace("pvc = 0.15", "pvc = 0.5"), "0.35");
+}
+
+#[test]
+fn wavelength_outside_pigment_data_is_named() {
+    expect_error(&TINY.replace("[500.0, 600.0]", "[500.0, 900.0]"), "900");
+}
+
+#[test]
+fn unwritable_output_folder_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let blocker = dir.path().join("file");
+    std::fs::write(&blocker, b"x").unwrap();
+    let out = blocker.join("sub");
+    let (ok, _, err) = inksim(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && !err.contains("panicked"));
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains(out.to_str().unwrap()), "{err}");
+}
+
+#[test]
+fn missing_config_file_is_named() {
+    let (ok, _, err) = inksim(&["run", "/nonexistent/scene.toml"]);
+    assert!(
+        !ok && err.contains("/nonexistent/scene.toml") && !err.contains("panicked"),
+        "{err}"
+    );
+}
+
+#[test]
+fn run_writes_results_identical_for_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let mut summaries = vec![];
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("t{threads}"));
+        let (ok, stdout, err) = inksim(&[
+            "--threads",
+            threads,
+            "run",
+            cfg.to_str().unwrap(),
+            "--output-dir",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{err}");
+        assert!(stdout.contains("tiny.h5"), "{stdout}");
+        assert!(out.join("tiny.png").is_file());
+        let s = inksim::io::read_summary(&out.join("tiny.h5")).unwrap();
+        assert_eq!(s.entries.len(), 4);
+        for e in &s.entries {
+            assert!(e.energy_balance.abs() < 1e-4, "{}", e.energy_balance);
+        }
+        summaries.push(s);
+    }
+    let key = |s: &inksim::io::ResultSummary| {
+        s.entries
+            .iter()
+            .map(|e| {
+                (
+                    e.total_reflectance.to_bits(),
+                    e.total_transmittance.to_bits(),
+                    e.absorption.to_bits(),
+                    e.iterations,
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(key(&summaries[0]), key(&summaries[1]));
+    assert_eq!(summaries[0].input_hash, summaries[1].input_hash);
+}

@@ -1,0 +1,260 @@
+//! Solves of real grain layers: energy balance, Born divergence and the
+//! time-marching rescue, the molecular-mixture limit, thread independence.
+use inksim::config::Method;
+use inksim::farfield::efficiencies;
+use inksim::geometry::{
+    pack_rsa, Geometry, GeometryStats, PackParams, Particle, SpeciesParams, Sphere,
+};
+use inksim::raster::{rasterize, Grid};
+use inksim::solver::{self, green, Controls, Problem, SolveError};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+
+const EPS_B: f64 = 1.558 * 1.558;
+const CTL: Controls = Controls {
+    tolerance: 1e-8,
+    max_iterations: 20000,
+};
+
+fn eps_grid(geom: &Geometry, grid: &Grid, n_pigment: C64) -> (Array3<C64>, f64) {
+    let raster = rasterize(geom, grid, 4);
+    let mut eps = Array3::from_elem((grid.nz, grid.ny, grid.nx), C64::new(0.0, 0.0));
+    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n_pigment * n_pigment], &mut eps);
+    (eps, raster.mean_fractions()[0])
+}
+
+fn packed(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {
+    let params = PackParams {
+        size_nm: size,
+        species: vec![SpeciesParams {
+            diameter_nm: d,
+            volume_fraction: pvc,
+        }],
+        ..PackParams::default()
+    };
+    pack_rsa(&params, seed).expect("packing")
+}
+
+#[test]
+fn energy_balance_on_random_absorbing_layer() {
+    let size = [1000.0, 1000.0, 600.0];
+    let geom = packed(size, 200.0, 0.2, 3);
+    let grid = Grid {
+        nx: 40,
+        ny: 40,
+        nz: 60,
+        size_nm: size,
+    };
+    let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.5));
+    for polar in [0.0, 45.0] {
+        let lat = Problem::lattice([40, 40, 60], size, 520.0, polar, 0.0);
+        let sol = solver::solve(
+            &Problem {
+                lattice: lat,
+                eps: &eps,
+                eps_binder: EPS_B,
+            },
+            Method::TimeMarching,
+            &CTL,
+        )
+        .expect("time-marching converges");
+        let ff = efficiencies(&sol);
+        eprintln!(
+            "polar {polar}: R {} T {} A {} balance {:.2e} ({} it)",
+            ff.total_reflectance,
+            ff.total_transmittance,
+            ff.absorption,
+            ff.energy_balance,
+            sol.record.iterations
+        );
+        assert!(ff.energy_balance.abs() < 1e-4);
+        assert!(
+            ff.absorption > 0.05 && ff.orders.len() > 5,
+            "a real scattering, absorbing case"
+        );
+        assert!(
+            ff.orders
+                .iter()
+                .any(|o| (o.m, o.n) != (0, 0) && o.reflectance > 1e-6),
+            "diffuse orders present"
+        );
+    }
+}
+
+/// Spheres on a jittered cubic lattice at 40 % volume fraction (denser than
+/// random sequential addition reaches).
+fn dense_lattice() -> (Geometry, [f64; 3]) {
+    let d = 180.0;
+    let a = d * (std::f64::consts::PI / (6.0 * 0.4)).cbrt();
+    let (nl, nzl) = (4usize, 4usize);
+    let size = [a * nl as f64, a * nl as f64, a * nzl as f64];
+    let mut particles = vec![];
+    for i in 0..nl {
+        for j in 0..nl {
+            for k in 0..nzl {
+                let c = [
+                    (i as f64 + 0.5) * a,
+                    (j as f64 + 0.5) * a,
+                    (k as f64 + 0.5) * a,
+                ];
+                particles.push(Particle {
+                    species: 0,
+                    spheres: vec![Sphere {
+                        center: c,
+                        radius: d / 2.0,
+                    }],
+                });
+            }
+        }
+    }
+    let n = particles.len();
+    let frac = n as f64 * std::f64::consts::PI * d.powi(3) / 6.0 / (size[0] * size[1] * size[2]);
+    let stats = GeometryStats {
+        count: vec![n],
+        target_fraction: vec![0.4],
+        achieved_fraction: vec![frac],
+        min_gap_nm: a - d,
+        attempts: n as u64,
+    };
+    (
+        Geometry {
+            size_nm: size,
+            particles,
+            stats,
+        },
+        size,
+    )
+}
+
+#[test]
+fn born_reports_divergence_and_time_marching_converges() {
+    let (geom, size) = dense_lattice();
+    let grid = Grid {
+        nx: 32,
+        ny: 32,
+        nz: 64,
+        size_nm: size,
+    };
+    let (eps, f) = eps_grid(&geom, &grid, C64::new(1.4, 0.8));
+    assert!((f - 0.4).abs() < 0.01, "fill {f}");
+    let lat = Problem::lattice([32, 32, 64], size, 450.0, 20.0, 0.0);
+    let p = Problem {
+        lattice: lat,
+        eps: &eps,
+        eps_binder: EPS_B,
+    };
+    match solver::solve(&p, Method::Born, &CTL) {
+        Err(SolveError::Diverged { .. }) => {}
+        Err(e) => panic!("expected divergence, got {e}"),
+        Ok(s) => panic!("Born returned a result with residual {}", s.record.residual),
+    }
+    let tm = solver::solve(&p, Method::TimeMarching, &CTL).expect("time-marching converges");
+    let ff = efficiencies(&tm);
+    assert!(
+        tm.record.residual <= 1e-8 && ff.energy_balance.abs() < 1e-4,
+        "{}",
+        ff.energy_balance
+    );
+    let auto = solver::solve(&p, Method::Auto, &CTL).expect("auto converges");
+    assert_eq!(
+        auto.record.method,
+        solver::MethodUsed::TimeMarching,
+        "{}",
+        auto.record.note
+    );
+    assert!((efficiencies(&auto).total_reflectance - ff.total_reflectance).abs() < 1e-6);
+}
+
+/// Airy |r|², |t|² of a homogeneous slab of permittivity `eps`.
+fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
+    let g = green::sqrt_branch(k0 * k0 * eps - kap * kap);
+    let b = green::sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
+    let rho = (g - b) / (g + b);
+    let e = (2.0 * C64::i() * g * h).exp();
+    let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
+    (
+        (a * (1.0 + rho * e) - 1.0).norm_sqr(),
+        (a * (C64::i() * g * h).exp() * (1.0 + rho)).norm_sqr() * 1.0,
+    )
+}
+
+#[test]
+fn shrinking_grains_approach_the_volume_averaged_slab() {
+    let size = [480.0, 480.0, 500.0];
+    let n_p = C64::new(1.4, 0.3);
+    let grid = Grid {
+        nx: 48,
+        ny: 48,
+        nz: 50,
+        size_nm: size,
+    };
+    let lambda = 600.0;
+    let mut errs = vec![];
+    for d in [160.0, 80.0, 40.0, 20.0] {
+        let geom = packed(size, d, 0.2, 11);
+        let (eps, f) = eps_grid(&geom, &grid, n_p);
+        let lat = Problem::lattice([48, 48, 50], size, lambda, 0.0, 0.0);
+        let sol = solver::solve(
+            &Problem {
+                lattice: lat,
+                eps: &eps,
+                eps_binder: EPS_B,
+            },
+            Method::Auto,
+            &CTL,
+        )
+        .expect("solve");
+        let ff = efficiencies(&sol);
+        let mean = (1.0 - f) * EPS_B + f * n_p * n_p;
+        let (r0, t0) = airy(lat.k0, mean, 0.0, size[2]);
+        let err = (ff.total_reflectance - r0)
+            .abs()
+            .max((ff.total_transmittance - t0).abs());
+        eprintln!(
+            "d {d}: R {} (Airy {r0}) T {} (Airy {t0}) err {err:.2e}",
+            ff.total_reflectance, ff.total_transmittance
+        );
+        errs.push(err);
+    }
+    assert!(
+        errs.windows(2).all(|w| w[1] < w[0]),
+        "not monotone: {errs:?}"
+    );
+    assert!(errs[3] < 0.1 * errs[0] && errs[3] < 2e-3, "{errs:?}");
+}
+
+#[test]
+fn same_result_for_one_and_two_threads() {
+    let size = [600.0, 600.0, 400.0];
+    let geom = packed(size, 150.0, 0.2, 5);
+    let grid = Grid {
+        nx: 24,
+        ny: 24,
+        nz: 30,
+        size_nm: size,
+    };
+    let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.6));
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let lat = Problem::lattice([24, 24, 30], size, 500.0, 30.0, 10.0);
+            let s = solver::solve(
+                &Problem {
+                    lattice: lat,
+                    eps: &eps,
+                    eps_binder: EPS_B,
+                },
+                Method::Auto,
+                &CTL,
+            )
+            .unwrap();
+            (s.r, s.t, s.absorption, s.field)
+        })
+    };
+    let a = run(1);
+    let b = run(2);
+    assert!(a.0 == b.0 && a.1 == b.1 && a.2.to_bits() == b.2.to_bits() && a.3 == b.3);
+}

@@ -14,6 +14,7 @@
 
 use super::fft::{Fft2, FftScratch};
 use super::green::{self, Coef, Slab};
+use super::shift::{BandScratch, ShiftTable};
 use ndarray::{Array3, Axis};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
@@ -162,6 +163,8 @@ pub struct Workspace {
     rows: Array3<C64>,
     fft: FftScratch,
     special_in: Vec<C64>,
+    /// One banded-solve scratch per spectral row (ix).
+    bands: Vec<BandScratch>,
 }
 
 /// FFT plans plus the lattice: what every application shares.
@@ -186,6 +189,7 @@ impl Operator {
             rows: Array3::from_elem((nx, 3, ny), ZERO),
             fft: self.fft.scratch(nz),
             special_in: Vec::new(),
+            bands: (0..nx).map(|_| BandScratch::new(nz)).collect(),
         }
     }
 
@@ -193,6 +197,37 @@ impl Operator {
     pub fn apply(&self, table: &GreenTable, field: &mut Array3<C64>, ws: &mut Workspace) {
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         self.apply_spectral(table, ws);
+        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
+    }
+
+    /// `field ← (I − c G_b)⁻¹ field`: the exact discrete CBS preconditioner.
+    pub fn apply_shift_inverse(
+        &self,
+        table: &ShiftTable,
+        field: &mut Array3<C64>,
+        ws: &mut Workspace,
+    ) {
+        let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
+        let norm = 1.0 / (nx * ny) as f64;
+        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
+        ws.spec
+            .axis_iter_mut(Axis(1))
+            .into_par_iter()
+            .zip(ws.bands.par_iter_mut())
+            .enumerate()
+            .for_each(|(ix, (mut s, scr))| {
+                for iy in 0..ny {
+                    let col = scr.column();
+                    for j in 0..nz {
+                        col[j] = s[[j, iy]];
+                    }
+                    table.solve_column(ix * ny + iy, scr);
+                    let col = scr.column();
+                    for j in 0..nz {
+                        s[[j, iy]] = col[j] * norm;
+                    }
+                }
+            });
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 

@@ -28,7 +28,7 @@
 //! in the order given), attributes:
 //! `wavelength_nm`, `polar_deg`, `azimuth_deg`, `total_reflectance`,
 //! `total_transmittance`, `absorption`, `energy_balance` (f64), `r00`, `t00`
-//! (2 × f64: re, im), `method` (string: `born` | `time-marching`),
+//! (2 × f64: re, im), `method` (string: `born` | `time-marching` | `gmres` | `bicgstab`),
 //! `iterations`, `operator_applications` (u64), `residual`, `seconds` (f64),
 //! `note` (string); datasets over the K propagating orders: `orders_mn`
 //! (K × 2 i32: m, n), `orders_theta_deg`, `orders_phi_deg`,
@@ -228,15 +228,9 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
                 .map_err(hdf)
         };
         let method_text = read_str_attr(&g, "method").map_err(hdf)?;
-        let method = match method_text.as_str() {
-            "born" => MethodUsed::Born,
-            "time-marching" => MethodUsed::TimeMarching,
-            other => {
-                return Err(format(format!(
-                    "/solves/{name}: attribute `method` is `{other}`, expected `born` or `time-marching`"
-                )))
-            }
-        };
+        let method: MethodUsed = method_text
+            .parse()
+            .map_err(|e: String| format(format!("/solves/{name}: attribute `method`: {e}")))?;
         entries.push(EntrySummary {
             wavelength_nm: f("wavelength_nm")?,
             polar_deg: f("polar_deg")?,

@@ -93,8 +93,12 @@ pub enum Method {
     Born,
     /// Pseudo-time marching with the convergent-Born-series preconditioner.
     TimeMarching,
-    /// Born where a cheap estimate says it converges, time-marching otherwise
-    /// or when Born diverges.
+    /// Restarted GMRES on the same CBS-preconditioned equation.
+    Gmres,
+    /// BiCGStab on the same CBS-preconditioned equation.
+    BiCgStab,
+    /// Born where a cheap estimate says it converges, BiCGStab otherwise or
+    /// when Born diverges; time-marching if BiCGStab fails.
     Auto,
 }
 

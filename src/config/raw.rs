@@ -87,6 +87,8 @@ pub struct RawSolver {
 pub enum RawMethod {
     Born,
     TimeMarching,
+    Gmres,
+    Bicgstab,
     Auto,
 }
 

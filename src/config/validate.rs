@@ -499,6 +499,8 @@ impl Checker<'_> {
         let method = match raw.and_then(|s| s.method) {
             Some(RawMethod::Born) => Method::Born,
             Some(RawMethod::TimeMarching) => Method::TimeMarching,
+            Some(RawMethod::Gmres) => Method::Gmres,
+            Some(RawMethod::Bicgstab) => Method::BiCgStab,
             Some(RawMethod::Auto) | None => Method::Auto,
         };
         let t = raw.and_then(|s| s.tolerance).unwrap_or(DEFAULT_TOLERANCE);

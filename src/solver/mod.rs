@@ -15,11 +15,14 @@
 //! * [`marching::TimeMarching`]: pseudo-time marching `u ← u + dτ P r` with the
 //!   convergent-Born-series preconditioner of Osnabrugge et al. (2016).
 
+pub mod bicgstab;
 pub mod born;
 pub mod fft;
+pub mod gmres;
 pub mod green;
 pub mod marching;
 pub mod operator;
+pub mod shift;
 
 use crate::config::Method;
 use ndarray::{Array2, Array3, Zip};
@@ -33,6 +36,30 @@ use std::time::Instant;
 pub enum MethodUsed {
     Born,
     TimeMarching,
+    Gmres,
+    BiCgStab,
+}
+
+impl MethodUsed {
+    pub const ALL: [MethodUsed; 4] = [
+        MethodUsed::Born,
+        MethodUsed::TimeMarching,
+        MethodUsed::Gmres,
+        MethodUsed::BiCgStab,
+    ];
+}
+
+impl std::str::FromStr for MethodUsed {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        MethodUsed::ALL
+            .into_iter()
+            .find(|m| m.to_string() == s)
+            .ok_or_else(|| {
+                let names: Vec<String> = MethodUsed::ALL.iter().map(|m| m.to_string()).collect();
+                format!("`{s}` is not one of {}", names.join(", "))
+            })
+    }
 }
 
 impl fmt::Display for MethodUsed {
@@ -40,6 +67,8 @@ impl fmt::Display for MethodUsed {
         f.write_str(match self {
             MethodUsed::Born => "born",
             MethodUsed::TimeMarching => "time-marching",
+            MethodUsed::Gmres => "gmres",
+            MethodUsed::BiCgStab => "bicgstab",
         })
     }
 }
@@ -231,6 +260,16 @@ impl<'a> System<'a> {
         self.norm(out)
     }
 
+    /// `out ← A x = x − G_b V x` (the operator of the equation, without u_bg).
+    pub fn apply_a(&mut self, x: &Array3<C64>, out: &mut Array3<C64>) {
+        Zip::from(&mut *out)
+            .and(x)
+            .and(&self.v)
+            .par_for_each(|o, x, v| *o = v * x);
+        self.op.apply(&self.binder, out, &mut self.ws);
+        Zip::from(&mut *out).and(x).par_for_each(|o, x| *o = x - *o);
+    }
+
     /// ‖x‖ / ‖u_bg‖.
     pub fn norm(&self, x: &Array3<C64>) -> f64 {
         sum_slices(x, |c, _| c.norm_sqr(), x).sqrt() / self.ubg_norm
@@ -272,6 +311,19 @@ fn sum_slices(a: &Array3<C64>, f: impl Fn(&C64, &C64) -> f64 + Sync, b: &Array3<
     parts.iter().sum()
 }
 
+/// ⟨a, b⟩ = Σ conj(a) b, summed per z-slice in parallel and then in a fixed
+/// order (thread-count independent).
+pub fn dot(a: &Array3<C64>, b: &Array3<C64>) -> C64 {
+    use rayon::prelude::*;
+    let parts: Vec<C64> = a
+        .outer_iter()
+        .into_par_iter()
+        .zip(b.outer_iter().into_par_iter())
+        .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| x.conj() * y).sum())
+        .collect();
+    parts.iter().sum()
+}
+
 /// A solved problem: the field and what the far field needs.
 pub struct Solution {
     pub lattice: Lattice,
@@ -293,39 +345,57 @@ pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, So
     let mut u = Array3::zeros(p.eps.dim());
     sys.set_background(&mut u);
     let born = born::Born;
+    let gm = gmres::Gmres::default();
+    let bi = bicgstab::BiCgStab::default();
     let tm = marching::TimeMarching::default();
     let (used, out) = match method {
         Method::Born => (MethodUsed::Born, born.run(&mut sys, &mut u, ctl)?),
         Method::TimeMarching => (MethodUsed::TimeMarching, tm.run(&mut sys, &mut u, ctl)?),
-        Method::Auto => match born.validity(&mut sys) {
-            Validity::Unlikely(why) => {
-                sys.set_background(&mut u);
-                let mut o = tm.run(&mut sys, &mut u, ctl)?;
-                o.note = format!("auto: {why}; {}", o.note);
-                o.applications += born::ESTIMATE_STEPS;
-                (MethodUsed::TimeMarching, o)
+        Method::Gmres => (MethodUsed::Gmres, gm.run(&mut sys, &mut u, ctl)?),
+        Method::BiCgStab => (MethodUsed::BiCgStab, bi.run(&mut sys, &mut u, ctl)?),
+        Method::Auto => {
+            // Born only where its contraction estimate is good; then BiCGStab;
+            // time-marching (always convergent) as the last resort. Each
+            // failure is recorded.
+            let mut chain: Vec<&dyn IterativeMethod> = vec![&bi, &tm];
+            let mut notes = vec![];
+            let mut spent = 0;
+            match born.validity(&mut sys) {
+                Validity::Unlikely(why) => notes.push(format!("skipped Born: {why}")),
+                Validity::Likely(why) => {
+                    notes.push(format!("chose Born: {why}"));
+                    chain.insert(0, &born);
+                }
+                Validity::Always => {
+                    chain.insert(0, &born);
+                }
             }
-            v => {
-                let why = match v {
-                    Validity::Likely(s) => s,
-                    _ => String::new(),
-                };
+            spent += born::ESTIMATE_STEPS;
+            let mut result = None;
+            let mut last_err = None;
+            for m in chain {
                 sys.set_background(&mut u);
-                match born.run(&mut sys, &mut u, ctl) {
-                    Ok(mut o) => {
-                        o.note = format!("auto: {why}");
-                        o.applications += born::ESTIMATE_STEPS;
-                        (MethodUsed::Born, o)
+                match m.run(&mut sys, &mut u, ctl) {
+                    Ok(o) => {
+                        result = Some((m.kind(), o));
+                        break;
                     }
                     Err(e) => {
-                        sys.set_background(&mut u);
-                        let mut o = tm.run(&mut sys, &mut u, ctl)?;
-                        o.note = format!("auto: {why}, but {e}; fell back. {}", o.note);
-                        (MethodUsed::TimeMarching, o)
+                        notes.push(format!("{e}; falling back"));
+                        last_err = Some(e);
                     }
                 }
             }
-        },
+            match result {
+                Some((kind, mut o)) => {
+                    o.applications += spent;
+                    notes.push(o.note);
+                    o.note = format!("auto: {}", notes.join("; "));
+                    (kind, o)
+                }
+                None => return Err(last_err.expect("at least one method ran")),
+            }
+        }
     };
     let (r, t, absorption) = sys.outputs(&u);
     let record = SolveRecord {

@@ -264,3 +264,72 @@ fn same_result_for_one_and_two_threads() {
     let b = run(2);
     assert!(a.0 == b.0 && a.1 == b.1 && a.2.to_bits() == b.2.to_bits() && a.3 == b.3);
 }
+
+/// Orders exactly at grazing: the period makes the (1,0) order graze in the
+/// binder (γ = 0; the contour-average path) or in vacuum (β = 0). No inf or
+/// NaN, residual at tolerance, energy balance, for every method that claims
+/// validity.
+#[test]
+fn exactly_grazing_orders_stay_finite() {
+    let lambda = 500.0;
+    for period in [lambda / 1.558, lambda] {
+        let size = [period, period, 400.0];
+        let particles = vec![Particle {
+            species: 0,
+            spheres: vec![Sphere {
+                center: [period / 2.0, period / 2.0, 200.0],
+                radius: 0.4 * period.min(400.0) / 2.0,
+            }],
+        }];
+        let stats = GeometryStats {
+            count: vec![1],
+            target_fraction: vec![0.1],
+            achieved_fraction: vec![0.1],
+            min_gap_nm: f64::INFINITY,
+            attempts: 1,
+        };
+        let geom = Geometry {
+            size_nm: size,
+            particles,
+            stats,
+        };
+        let grid = Grid {
+            nx: 16,
+            ny: 16,
+            nz: 40,
+            size_nm: size,
+        };
+        let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.5));
+        let lat = Problem::lattice([16, 16, 40], size, lambda, 0.0, 0.0);
+        let [kx, _] = lat.kappa(1, 0);
+        let grazing_in = if period == lambda { 1.0 } else { 1.558 };
+        assert!((kx / lat.k0 - grazing_in).abs() < 1e-12);
+        for method in [
+            Method::TimeMarching,
+            Method::BiCgStab,
+            Method::Gmres,
+            Method::Auto,
+        ] {
+            let sol = solver::solve(
+                &Problem {
+                    lattice: lat,
+                    eps: &eps,
+                    eps_binder: EPS_B,
+                },
+                method,
+                &CTL,
+            )
+            .expect("converges");
+            assert!(sol
+                .field
+                .iter()
+                .all(|c| c.re.is_finite() && c.im.is_finite()));
+            let ff = efficiencies(&sol);
+            assert!(
+                ff.energy_balance.abs() < 1e-4,
+                "{method:?} period {period}: {}",
+                ff.energy_balance
+            );
+        }
+    }
+}

@@ -325,4 +325,89 @@ mod tests {
             assert!((top[j] - s).norm() < 1e-6 * s.norm());
         }
     }
+
+    /// u_bg against an independent transfer-matrix solution
+    /// `(u, u')(H) = M (u, u')(0)`, `M = [[cos γH, sin γH/γ], [−γ sin γH, cos γH]]`,
+    /// for real and absorbing slabs at normal and oblique incidence: r, t to
+    /// 1e-10 and the cell averages against quadrature of the exact field.
+    #[test]
+    fn background_response_matches_transfer_matrix() {
+        let i = C64::i();
+        for eps in [
+            C64::new(2.427, 0.0),
+            C64::new(1.32, 2.24),
+            C64::new(2.0, 0.3),
+        ] {
+            for polar in [0.0f64, 40.0, 75.0] {
+                let slab = Slab {
+                    k0: 2.0 * std::f64::consts::PI / 550.0,
+                    thickness: 900.0,
+                    nz: 9,
+                };
+                let k0 = slab.k0;
+                let kap = k0 * polar.to_radians().sin();
+                let g2 = k0 * k0 * eps - kap * kap;
+                let beta = C64::new((k0 * k0 - kap * kap).sqrt(), 0.0);
+                let mut cells = vec![C64::new(0.0, 0.0); 9];
+                let (r, t) = background_response(&slab, g2, beta, &mut cells);
+                // Transfer matrix, written with γ² only (no branch choice).
+                let g = g2.sqrt();
+                let h = slab.thickness;
+                let (c, sg) = ((g * h).cos(), (g * h).sin() / g);
+                let gs = -g * (g * h).sin();
+                // t = c(1+r) + sg iβ(1−r);  iβ t = gs(1+r) + c iβ(1−r)
+                let (a1, b1) = (c - i * beta * sg, c + i * beta * sg);
+                let (a2, b2) = (gs - i * beta * c, gs + i * beta * c);
+                // t = a1 r + b1,  iβ t = a2 r + b2
+                let r_tm = (b2 - i * beta * b1) / (i * beta * a1 - a2);
+                let t_tm = a1 * r_tm + b1;
+                assert!(
+                    (r - r_tm).norm() < 1e-10 && (t - t_tm).norm() < 1e-10,
+                    "{eps} {polar}: {r} vs {r_tm}"
+                );
+                let u0 = 1.0 + r_tm;
+                let du0 = i * beta * (1.0 - r_tm);
+                let q = 400;
+                let dz = slab.dz();
+                for (j, cell) in cells.iter().enumerate() {
+                    let mut acc = C64::new(0.0, 0.0);
+                    for a in 0..q {
+                        let z = (j as f64 + (a as f64 + 0.5) / q as f64) * dz;
+                        acc += (g * z).cos() * u0 + (g * z).sin() / g * du0;
+                    }
+                    let avg = acc / q as f64;
+                    assert!(
+                        (cell - avg).norm() < 1e-5 * avg.norm().max(1e-3),
+                        "cell {j}: {cell} vs {avg}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The Galerkin entries for an absorbing background, against quadrature.
+    #[test]
+    fn galerkin_entries_match_quadrature_absorbing_background() {
+        let slab = Slab {
+            k0: 2.0 * std::f64::consts::PI / 450.0,
+            thickness: 700.0,
+            nz: 5,
+        };
+        let k0 = slab.k0;
+        for kap in [0.0, 0.7 * k0, 2.0 * k0] {
+            let g2 = k0 * k0 * C64::new(1.32, 2.24) - kap * kap;
+            let beta = sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
+            let c = coef_from(&slab, g2, beta);
+            for j in 0..5 {
+                for k in 0..5 {
+                    let a = c.entry(5, j, k);
+                    let b = brute(&slab, g2, beta, j, k, 400);
+                    assert!(
+                        (a - b).norm() <= 1e-4 * b.norm().max(1e-3),
+                        "{kap} {j} {k}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -13,7 +13,13 @@ use std::process::ExitCode;
 /// incidence, and writes the diffraction-order efficiencies (BRDF/BTDF),
 /// absorption and energy balance to an HDF5 file plus a PNG picture.
 #[derive(Parser)]
-#[command(name = "inksim", version, about, long_about)]
+#[command(
+    name = "inksim",
+    version,
+    about,
+    long_about,
+    after_help = "Examples:\n  inksim run configs/demo.toml          run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml        validate and show the work a run would do\n  inksim --threads 1 run scene.toml     same numbers for any thread count"
+)]
 struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, global = true)]

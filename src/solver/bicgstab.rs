@@ -1,33 +1,24 @@
-//! BiCGStab on the CBS-preconditioned equation `P A u = P u_bg` (the same
-//! operator as [`gmres`](super::gmres)). Fixed memory (seven fields), two
-//! preconditioned operator applications per iteration, no restarts: on
+//! BiCGStab on the CBS-preconditioned shifted equation
+//! `γ (I − G_s V') u = γ u_s` (the same operator as [`gmres`](super::gmres)).
+//! Fixed memory (seven fields), two applications of `G_s` per iteration, no
+//! restarts: on
 //! low-loss layers, whose slab resonances make restarted GMRES forget what it
 //! learned, it needs far fewer applications. Breakdowns (⟨r̂, v⟩ ≈ 0) restart
 //! from the current iterate; convergence is confirmed on the true residual.
 
-use super::marching::Cbs;
 use super::{dot, Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
 /// BiCGStab settings.
-#[derive(Debug, Clone, Copy)]
-pub struct BiCgStab {
-    /// CBS shift margin, as for time-marching.
-    pub margin: f64,
-}
-
-impl Default for BiCgStab {
-    fn default() -> Self {
-        BiCgStab { margin: 1.05 }
-    }
-}
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BiCgStab {}
 
 impl BiCgStab {
     /// `out ← P A x`.
-    fn op(sys: &mut System, cbs: &Cbs, x: &Array3<C64>, out: &mut Array3<C64>) {
-        sys.apply_a(x, out);
-        cbs.apply(sys, out);
+    fn op(sys: &mut System, x: &Array3<C64>, out: &mut Array3<C64>) {
+        sys.apply_a_shifted(x, out);
+        sys.precondition(out);
     }
 }
 
@@ -48,7 +39,6 @@ impl IterativeMethod for BiCgStab {
         u: &mut Array3<C64>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
-        let cbs = Cbs::new(sys, self.margin);
         let dim = u.dim();
         let z = || Array3::<C64>::zeros(dim);
         let (mut r, mut rh, mut p, mut v, mut s, mut t) = (z(), z(), z(), z(), z(), z());
@@ -58,7 +48,7 @@ impl IterativeMethod for BiCgStab {
         let one = C64::new(1.0, 0.0);
         loop {
             // (Re)start: true residual, then its preconditioned form.
-            let res = sys.residual(u, &mut r);
+            let res = sys.residual_shifted(u, &mut r);
             applications += 1;
             if !res.is_finite() || res > 1e3 * best.max(ctl.tolerance) {
                 return Err(SolveError::Diverged {
@@ -69,7 +59,10 @@ impl IterativeMethod for BiCgStab {
             }
             best = best.min(res);
             if res <= ctl.tolerance {
-                let note = format!("BiCGStab, ε_r = {:.4}, ε_s = {:.4}", cbs.er, cbs.es);
+                let note = format!(
+                    "BiCGStab, ε_r = {:.4}, ε_s = {:.4}",
+                    sys.shift.er, sys.shift.es
+                );
                 return Ok(Outcome {
                     iterations,
                     applications,
@@ -85,8 +78,7 @@ impl IterativeMethod for BiCgStab {
                     tolerance: ctl.tolerance,
                 });
             }
-            cbs.apply(sys, &mut r);
-            applications += 1;
+            sys.precondition(&mut r);
             let r0 = dot(&r, &r).re.sqrt();
             // The preconditioned residual must fall by what the true one needs.
             let target = 0.5 * r0 * ctl.tolerance / res;
@@ -106,7 +98,7 @@ impl IterativeMethod for BiCgStab {
                     .and(&r)
                     .and(&v)
                     .par_for_each(|p, r, v| *p = r + beta * (*p - omega * v));
-                Self::op(sys, &cbs, &p, &mut v);
+                Self::op(sys, &p, &mut v);
                 let rv = dot(&rh, &v);
                 if rv.norm() < 1e-30 * r0 * r0 {
                     break;
@@ -116,8 +108,8 @@ impl IterativeMethod for BiCgStab {
                     .and(&r)
                     .and(&v)
                     .par_for_each(|s, r, v| *s = r - alpha * v);
-                Self::op(sys, &cbs, &s, &mut t);
-                applications += 4;
+                Self::op(sys, &s, &mut t);
+                applications += 2;
                 let tt = dot(&t, &t).re;
                 omega = if tt > 0.0 {
                     dot(&t, &s) / tt

@@ -28,6 +28,7 @@ use crate::config::Method;
 use ndarray::{Array2, Array3, Zip};
 use num_complex::Complex64 as C64;
 use operator::{GreenTable, Lattice, Operator, Workspace};
+use shift::{BandScratch, ShiftTable};
 use std::fmt;
 use std::time::Instant;
 
@@ -191,10 +192,33 @@ pub struct System<'a> {
     pub r_bg: C64,
     pub t_bg: C64,
     ubg_norm: f64,
+    /// CBS shift: real centre ε_r, ε_s, c = k0²(ε_r + iε_s − ε_b), and the
+    /// exact per-harmonic shifted operators.
+    pub shift: Shift,
+    /// V' = k0² (ε − ε_r − iε_s) = V − c.
+    pub v_shift: Array3<C64>,
+    /// u_s = (I − c G_b)⁻¹ u_bg per z cell (harmonic 00 only).
+    pub us: Vec<C64>,
+    us_norm: f64,
+    /// Top/bottom functionals of G_b for harmonic 00 (never resonant: it propagates).
+    top00: Vec<C64>,
+    bottom00: Vec<C64>,
     pub ws: Workspace,
     /// Scratch field.
     pub tmp: Array3<C64>,
 }
+
+/// The CBS shift of a problem (Osnabrugge et al. 2016): background
+/// `ε_r + iε_s` with `ε_s = margin · max|ε − ε_r|`.
+pub struct Shift {
+    pub er: f64,
+    pub es: f64,
+    pub c: C64,
+    pub table: ShiftTable,
+}
+
+/// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
+pub const SHIFT_MARGIN: f64 = 1.05;
 
 impl<'a> System<'a> {
     pub fn new(p: &Problem<'a>) -> Result<Self, SolveError> {
@@ -222,9 +246,30 @@ impl<'a> System<'a> {
         let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
         let ubg_norm =
             (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let (er, rad) = marching::shift_of(p.eps, p.eps_binder);
+        let es = (SHIFT_MARGIN * rad).max(1e-9);
+        let c = k2 * (C64::new(er, es) - p.eps_binder);
+        let table = ShiftTable::new(&lat, p.eps_binder, c);
+        let v_shift = v.mapv(|v| v - c);
+        let mut scr = BandScratch::new(lat.nz);
+        scr.column().copy_from_slice(&ubg);
+        table.solve_column(0, &mut scr);
+        let us = scr.column().to_vec();
+        let us_norm =
+            (us.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let c00 = green::coef_from(&lat.slab(), g2, lat.beta(0, 0));
+        let top00 = (0..lat.nz).map(|k| c00.top_weight(lat.nz, k)).collect();
+        let bottom00 = (0..lat.nz).map(|k| c00.bottom_weight(lat.nz, k)).collect();
+        let shift = Shift { er, es, c, table };
         let ws = op.workspace();
         let tmp = Array3::zeros(p.eps.dim());
         Ok(System {
+            shift,
+            v_shift,
+            us,
+            us_norm,
+            top00,
+            bottom00,
             op,
             binder,
             eps: p.eps,
@@ -260,14 +305,42 @@ impl<'a> System<'a> {
         self.norm(out)
     }
 
-    /// `out ← A x = x − G_b V x` (the operator of the equation, without u_bg).
-    pub fn apply_a(&mut self, x: &Array3<C64>, out: &mut Array3<C64>) {
+    /// `out ← u_s + G_s V' u − u`, the residual of the same equation in its
+    /// shifted form (`= (I − c G_b)⁻¹ × the plain residual`); returns
+    /// ‖out‖ / ‖u_s‖. Never applies `G_b`, so guided-mode poles of the binder
+    /// slab cannot enter.
+    pub fn residual_shifted(&mut self, u: &Array3<C64>, out: &mut Array3<C64>) -> f64 {
+        Zip::from(&mut *out)
+            .and(u)
+            .and(&self.v_shift)
+            .par_for_each(|o, u, v| *o = v * u);
+        self.op
+            .apply_shifted_green(&self.shift.table, out, &mut self.ws);
+        let us = &self.us;
+        for (j, (mut o, uu)) in out.outer_iter_mut().zip(u.outer_iter()).enumerate() {
+            Zip::from(&mut o).and(&uu).for_each(|o, u| *o += us[j] - u);
+        }
+        self.norm(out) * self.ubg_norm / self.us_norm
+    }
+
+    /// `out ← x − G_s V' x` (the shifted operator, without u_s).
+    pub fn apply_a_shifted(&mut self, x: &Array3<C64>, out: &mut Array3<C64>) {
         Zip::from(&mut *out)
             .and(x)
-            .and(&self.v)
+            .and(&self.v_shift)
             .par_for_each(|o, x, v| *o = v * x);
-        self.op.apply(&self.binder, out, &mut self.ws);
+        self.op
+            .apply_shifted_green(&self.shift.table, out, &mut self.ws);
         Zip::from(&mut *out).and(x).par_for_each(|o, x| *o = x - *o);
+    }
+
+    /// `x ← γ x`, γ = 1 + i(ε − ε_r)/ε_s: the CBS preconditioner of the
+    /// shifted form.
+    pub fn precondition(&self, x: &mut Array3<C64>) {
+        let (er, es) = (self.shift.er, self.shift.es);
+        Zip::from(x)
+            .and(self.eps)
+            .par_for_each(|x, e| *x *= 1.0 + C64::i() * (e - er) / es);
     }
 
     /// ‖x‖ / ‖u_bg‖.
@@ -279,17 +352,23 @@ impl<'a> System<'a> {
     fn outputs(&mut self, u: &Array3<C64>) -> (Array2<C64>, Array2<C64>, f64) {
         let lat = self.op.lat;
         let mut src = std::mem::replace(&mut self.tmp, Array3::zeros((0, 0, 0)));
-        Zip::from(&mut src)
-            .and(u)
-            .and(&self.v)
-            .par_for_each(|o, u, v| *o = v * u);
         let mut r = Array2::zeros((lat.nx, lat.ny));
         let mut t = Array2::zeros((lat.nx, lat.ny));
+        // G_b V u = G_b(V' u + c u) = w + c G_b(u − G_s V' u), and at the
+        // solution u − G_s V' u = u_s (harmonic 00 only): boundary values of
+        // w from the shifted sweep, of G_b u_s from the 00 functionals.
+        Zip::from(&mut src)
+            .and(u)
+            .and(&self.v_shift)
+            .par_for_each(|o, u, v| *o = v * u);
         self.op
-            .boundary_amplitudes(&self.binder, &mut src, &mut self.ws, &mut r, &mut t);
+            .shifted_boundary(&self.shift.table, &mut src, &mut self.ws, &mut r, &mut t);
         self.tmp = src;
-        r[[0, 0]] += self.r_bg;
-        t[[0, 0]] += self.t_bg;
+        let c = self.shift.c;
+        let us_top: C64 = self.top00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
+        let us_bottom: C64 = self.bottom00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
+        r[[0, 0]] += self.r_bg + c * us_top;
+        t[[0, 0]] += self.t_bg + c * us_bottom;
         let dz = lat.size_nm[2] / lat.nz as f64;
         let s = sum_slices(u, |u, e| e.im * u.norm_sqr(), self.eps);
         let beta00 = lat.beta(0, 0).re;

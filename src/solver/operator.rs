@@ -78,8 +78,6 @@ struct Special {
     /// Spectral index ix·ny + iy.
     index: usize,
     matrix: Vec<C64>,
-    top: Vec<C64>,
-    bottom: Vec<C64>,
 }
 
 /// Per-harmonic data of the Green's operator for one background permittivity.
@@ -103,12 +101,10 @@ impl GreenTable {
                 let g2 = lat.k0 * lat.k0 * eps_bg - (kx * kx + ky * ky);
                 let beta = lat.beta(ix, iy);
                 if green::is_small_gamma(&slab, g2) {
-                    let (matrix, top, bottom) = green::dense_small_gamma(&slab, g2, beta);
+                    let (matrix, _, _) = green::dense_small_gamma(&slab, g2, beta);
                     special.push(Special {
                         index: ix * ny + iy,
                         matrix,
-                        top,
-                        bottom,
                     });
                     coef.push(zero_coef(beta));
                 } else {
@@ -200,8 +196,9 @@ impl Operator {
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 
-    /// `field ← (I − c G_b)⁻¹ field`: the exact discrete CBS preconditioner.
-    pub fn apply_shift_inverse(
+    /// `field ← G_s field`, `G_s = (G_b⁻¹ − c)⁻¹` the shifted Green's operator
+    /// (exact, per harmonic, free of the guided-mode poles of `G_b`).
+    pub fn apply_shifted_green(
         &self,
         table: &ShiftTable,
         field: &mut Array3<C64>,
@@ -221,7 +218,7 @@ impl Operator {
                     for j in 0..nz {
                         col[j] = s[[j, iy]];
                     }
-                    table.solve_column(ix * ny + iy, scr);
+                    table.shifted_green_column(ix * ny + iy, scr);
                     let col = scr.column();
                     for j in 0..nz {
                         s[[j, iy]] = col[j] * norm;
@@ -229,6 +226,32 @@ impl Operator {
                 }
             });
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
+    }
+
+    /// Boundary values `w(0)`, `w(H)` of `w = G_b(x + c G_s x)` per harmonic
+    /// for a real-space source `x` (consumed as scratch), spectral layout.
+    pub fn shifted_boundary(
+        &self,
+        table: &ShiftTable,
+        source: &mut Array3<C64>,
+        ws: &mut Workspace,
+        r: &mut ndarray::Array2<C64>,
+        t: &mut ndarray::Array2<C64>,
+    ) {
+        let (nx, ny) = (self.lat.nx, self.lat.ny);
+        let norm = 1.0 / (nx * ny) as f64;
+        self.fft.forward(source, &mut ws.spec, &mut ws.fft);
+        let scr = &mut ws.bands[0];
+        for ix in 0..nx {
+            for iy in 0..ny {
+                for (j, c) in scr.column().iter_mut().enumerate() {
+                    *c = ws.spec[[j, ix, iy]];
+                }
+                let (w0, wh) = table.shifted_green_column(ix * ny + iy, scr);
+                r[[ix, iy]] = w0 * norm;
+                t[[ix, iy]] = wh * norm;
+            }
+        }
     }
 
     fn apply_spectral(&self, table: &GreenTable, ws: &mut Workspace) {
@@ -305,47 +328,6 @@ impl Operator {
                 let v: C64 = row.iter().zip(col).map(|(m, x)| m * x).sum();
                 ws.spec[[j, ix, iy]] = v * norm;
             }
-        }
-    }
-
-    /// Scattered amplitudes at the boundaries for a source `s = k0² Δε u`
-    /// (real space, consumed as scratch): `r_h = u_h(0) − u_bg,h(0)`,
-    /// `t_h = u_h(H) − u_bg,h(H)`, in spectral layout (nx, ny) each.
-    pub fn boundary_amplitudes(
-        &self,
-        table: &GreenTable,
-        source: &mut Array3<C64>,
-        ws: &mut Workspace,
-        r: &mut ndarray::Array2<C64>,
-        t: &mut ndarray::Array2<C64>,
-    ) {
-        let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
-        let norm = 1.0 / (nx * ny) as f64;
-        self.fft.forward(source, &mut ws.spec, &mut ws.fft);
-        for ix in 0..nx {
-            for iy in 0..ny {
-                let k = &table.coef[ix * ny + iy];
-                let (mut se, mut sh) = (ZERO, ZERO);
-                for j in 0..nz {
-                    let s = ws.spec[[j, ix, iy]];
-                    se += table.pow[[j, ix, iy]] * s;
-                    sh += table.pow[[nz - 1 - j, ix, iy]] * s;
-                }
-                let f = k.kdz * norm * (1.0 + k.rho) * k.phi1;
-                r[[ix, iy]] = f * (se + k.rho * k.qn * sh);
-                t[[ix, iy]] = f * (sh + k.rho * k.qn * se);
-            }
-        }
-        for sp in &table.special {
-            let (ix, iy) = (sp.index / ny, sp.index % ny);
-            let (mut rr, mut tt) = (ZERO, ZERO);
-            for j in 0..nz {
-                let s = ws.spec[[j, ix, iy]];
-                rr += sp.top[j] * s;
-                tt += sp.bottom[j] * s;
-            }
-            r[[ix, iy]] = rr * norm;
-            t[[ix, iy]] = tt * norm;
         }
     }
 }

@@ -36,6 +36,17 @@ struct HarmonicShift {
     beta: C64,
     q: C64,
     kappa: C64,
+    phi: C64,
+}
+
+/// A near-grazing harmonic: dense `(I − c M)⁻¹`, `G_s = (I − c M)⁻¹ M` and
+/// the top/bottom functionals of the contour-averaged `M`.
+struct Dense {
+    index: usize,
+    inv: Vec<C64>,
+    gs: Vec<C64>,
+    top: Vec<C64>,
+    bottom: Vec<C64>,
 }
 
 /// Per cell of the down sweep, independent of the right-hand side:
@@ -60,8 +71,7 @@ pub struct ShiftTable {
     /// Per harmonic: the top relation's `u_0 = top_u · b_0` factor and the
     /// bottom closure's final t.
     ends: Vec<[C64; 2]>,
-    /// (index, dense N×N inverse, row-major).
-    dense: Vec<(usize, Vec<C64>)>,
+    dense: Vec<Dense>,
 }
 
 impl ShiftTable {
@@ -78,8 +88,22 @@ impl ShiftTable {
                 let g2 = C64::new(lat.k0 * lat.k0 * eps_b - kx * kx - ky * ky, 0.0);
                 let beta = lat.beta(ix, iy);
                 if green::is_small_gamma(&slab, g2) {
-                    let (m, _, _) = green::dense_small_gamma(&slab, g2, beta);
-                    dense.push((ix * lat.ny + iy, dense_inverse_shift(&m, n, c)));
+                    let (m, top, bottom) = green::dense_small_gamma(&slab, g2, beta);
+                    let inv = dense_inverse_shift(&m, n, c);
+                    let gs = (0..n * n)
+                        .map(|i| {
+                            (0..n)
+                                .map(|k| inv[(i / n) * n + k] * m[k * n + i % n])
+                                .sum()
+                        })
+                        .collect();
+                    dense.push(Dense {
+                        index: ix * lat.ny + iy,
+                        inv,
+                        gs,
+                        top,
+                        bottom,
+                    });
                     h.push(None);
                 } else {
                     let gamma = green::sqrt_branch(g2);
@@ -92,6 +116,7 @@ impl ShiftTable {
                         beta,
                         q: x.exp(),
                         kappa: c * green::phi1(x) * inv_gs2,
+                        phi: green::phi1(x),
                     }));
                 }
             }
@@ -122,12 +147,11 @@ impl ShiftTable {
         }
     }
 
-    /// Dense inverse of harmonic `index` if it is a near-grazing one.
-    pub(crate) fn dense_of(&self, index: usize) -> Option<&[C64]> {
+    fn dense_of(&self, index: usize) -> &Dense {
         self.dense
             .iter()
-            .find(|(i, _)| *i == index)
-            .map(|(_, m)| m.as_slice())
+            .find(|d| d.index == index)
+            .expect("dense harmonic")
     }
 }
 
@@ -204,14 +228,38 @@ impl ShiftTable {
     /// (|t_j| ≲ 1: a reflection coefficient, so the sweep is stable), the
     /// bottom boundary closes it, and an up sweep recovers every `d_j`, `a_j`.
     pub fn solve_column(&self, index: usize, scr: &mut BandScratch) {
+        self.column(index, scr, Output::ShiftInverse);
+    }
+
+    /// `col ← G_s col` with `G_s = (G_h⁻¹ − c)⁻¹` the shifted Green's
+    /// operator, never forming `G_h` (whose guided-mode poles it avoids);
+    /// returns the continuous field `w = G_h(x + c G_s x)` at z = 0 and z = H.
+    pub fn shifted_green_column(&self, index: usize, scr: &mut BandScratch) -> (C64, C64) {
+        self.column(index, scr, Output::ShiftedGreen)
+    }
+
+    fn column(&self, index: usize, scr: &mut BandScratch, out: Output) -> (C64, C64) {
         let n = scr.col.len();
         let Some(hs) = self.h[index] else {
-            let m = self.dense_of(index).expect("dense harmonic");
-            let b = scr.col.clone();
+            let d = self.dense_of(index);
+            let x = scr.col.clone();
+            let m = match out {
+                Output::ShiftInverse => &d.inv,
+                Output::ShiftedGreen => &d.gs,
+            };
             for j in 0..n {
-                scr.col[j] = (0..n).map(|k| m[j * n + k] * b[k]).sum();
+                scr.col[j] = (0..n).map(|k| m[j * n + k] * x[k]).sum();
             }
-            return;
+            // w = G_h (x + c y): its boundary values from the functionals.
+            let (mut w0, mut wh) = (ZERO, ZERO);
+            if out == Output::ShiftedGreen {
+                for (k, (x, y)) in x.iter().zip(&scr.col).enumerate() {
+                    let src = x + self.c * y;
+                    w0 += d.top[k] * src;
+                    wh += d.bottom[k] * src;
+                }
+            }
+            return (w0, wh);
         };
         let HarmonicShift {
             gamma,
@@ -220,6 +268,7 @@ impl ShiftTable {
             beta,
             q,
             kappa,
+            phi,
         } = hs;
         let steps = &self.steps[index * n..(index + 1) * n];
         let [top_u, t_last] = self.ends[index];
@@ -235,16 +284,36 @@ impl ShiftTable {
         let ca = gamma * q - beta * q + beta * kappa;
         let cd = -gamma - beta + beta * kappa;
         let mut d = (-beta * b[n - 1] * inv_gs2 - u * ca) / (t_last * ca + cd);
-        let mut sig = t_last * d + u + d;
+        let mut a = t_last * d + u;
+        let mut sig = a + d;
         let last = n - 1;
-        scr.col[last] = gamma2 * (scr.col[last] * inv_gs2 + kappa * sig);
+        // w(H) = p + a q + d with p = −x/γ_s² − κ σ.
+        let wh = -scr.col[last] * inv_gs2 - kappa * sig + a * q + d;
+        let g_phi = gamma2 * phi * inv_gs2;
+        let emit = |x: C64, sig: C64| match out {
+            Output::ShiftInverse => gamma2 * (x * inv_gs2 + kappa * sig),
+            Output::ShiftedGreen => -x * inv_gs2 + g_phi * sig,
+        };
+        let x0 = scr.col[0];
+        scr.col[last] = emit(scr.col[last], sig);
         for j in (0..n - 1).rev() {
-            let [t, u, v, w] = scr.tuvw[j];
+            let [t, uu, v, w] = scr.tuvw[j];
             d = v * d + w;
-            sig = t * d + u + d;
-            scr.col[j] = gamma2 * (scr.col[j] * inv_gs2 + kappa * sig);
+            a = t * d + uu;
+            sig = a + d;
+            scr.col[j] = emit(scr.col[j], sig);
         }
+        // w(0) = p_0 + a_0 + d_0 q.
+        let w0 = -x0 * inv_gs2 - kappa * sig + a + d * q;
+        (w0, wh)
     }
+}
+
+/// What a column sweep returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Output {
+    ShiftInverse,
+    ShiftedGreen,
 }
 
 /// Dense `(I − c M)⁻¹` by Gauss–Jordan with partial pivoting.
@@ -332,6 +401,38 @@ mod tests {
                     let want: Vec<C64> = (0..n)
                         .map(|j| (0..n).map(|k| inv[j * n + k] * b[k]).sum())
                         .collect();
+                    // G_s = (I − c M)⁻¹ M and w = G_h(b + c G_s b) at the boundaries.
+                    let gs_b: Vec<C64> = (0..n)
+                        .map(|j| {
+                            (0..n)
+                                .map(|k| {
+                                    (0..n).map(|l| inv[j * n + l] * m[l * n + k]).sum::<C64>()
+                                        * b[k]
+                                })
+                                .sum()
+                        })
+                        .collect();
+                    let src: Vec<C64> = (0..n).map(|k| b[k] + c * gs_b[k]).collect();
+                    let w0: C64 = (0..n).map(|k| coef.top_weight(n, k) * src[k]).sum();
+                    let wh: C64 = (0..n).map(|k| coef.bottom_weight(n, k) * src[k]).sum();
+                    let mut scr = BandScratch::new(n);
+                    scr.column().copy_from_slice(&b);
+                    let (g0, gh) = table.shifted_green_column(ix * 6 + iy, &mut scr);
+                    let sc = gs_b.iter().map(|w| w.norm()).fold(0.0, f64::max);
+                    for (got, want) in scr.col.iter().zip(&gs_b) {
+                        assert!(
+                            (got - want).norm() < 1e-9 * sc,
+                            "G_s {ix} {iy}: {got} vs {want}"
+                        );
+                    }
+                    assert!(
+                        (g0 - w0).norm() < 1e-9 * w0.norm().max(sc),
+                        "w(0) {ix} {iy}: {g0} vs {w0}"
+                    );
+                    assert!(
+                        (gh - wh).norm() < 1e-9 * wh.norm().max(sc),
+                        "w(H) {ix} {iy}: {gh} vs {wh}"
+                    );
                     let mut scr = BandScratch::new(n);
                     scr.column().copy_from_slice(&b);
                     table.solve_column(ix * 6 + iy, &mut scr);

@@ -3,12 +3,13 @@
 //! Data flows one way through the stages, and each module imports only from
 //! the stages before it:
 //!
-//! `config` → `geometry` → `raster` → `solver` → `farfield` → `render` → `io`,
+//! `config` → `geometry` → `raster` → `solver` → `farfield` → `colour` → `render` → `io`,
 //! wired together by [`pipeline`]. [`progress`] is a leaf utility.
 //!
 //! The physics and numerics follow `METHOD.md` (shipped beside the project);
 //! each stage's module docs state what it owns and which choices it made.
 
+pub mod colour;
 pub mod config;
 pub mod farfield;
 pub mod geometry;

@@ -14,7 +14,7 @@
 
 use super::fft::{Fft2, FftScratch};
 use super::green::{self, Coef, Slab};
-use super::shift::{BandScratch, ShiftTable};
+use super::shift::{BandScratch, RowScratch, ShiftTable};
 use ndarray::{Array3, Axis};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
@@ -161,6 +161,8 @@ pub struct Workspace {
     special_in: Vec<C64>,
     /// One banded-solve scratch per spectral row (ix).
     bands: Vec<BandScratch>,
+    /// Row-sweep scratch, one per parallel chunk of spectral rows.
+    row_scratch: Vec<RowScratch>,
 }
 
 /// FFT plans plus the lattice: what every application shares.
@@ -186,6 +188,9 @@ impl Operator {
             fft: self.fft.scratch(nz),
             special_in: Vec::new(),
             bands: (0..nx).map(|_| BandScratch::new(nz)).collect(),
+            row_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
+                .map(|_| RowScratch::new(nz, ny))
+                .collect(),
         }
     }
 
@@ -207,24 +212,37 @@ impl Operator {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let norm = 1.0 / (nx * ny) as f64;
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
+        // Near-grazing harmonics: dense path on their saved columns.
+        let mut dense = std::mem::take(&mut ws.special_in);
+        dense.clear();
+        for h in table.dense_indices() {
+            let (ix, iy) = (h / ny, h % ny);
+            let scr = &mut ws.bands[0];
+            for (j, c) in scr.column().iter_mut().enumerate() {
+                *c = ws.spec[[j, ix, iy]];
+            }
+            table.shifted_green_column(h, scr);
+            dense.extend_from_slice(scr.column());
+        }
+        let rows_per = nx.div_ceil(ws.row_scratch.len());
         ws.spec
-            .axis_iter_mut(Axis(1))
+            .axis_chunks_iter_mut(Axis(1), rows_per)
             .into_par_iter()
-            .zip(ws.bands.par_iter_mut())
+            .zip(ws.row_scratch.par_iter_mut())
             .enumerate()
-            .for_each(|(ix, (mut s, scr))| {
-                for iy in 0..ny {
-                    let col = scr.column();
-                    for j in 0..nz {
-                        col[j] = s[[j, iy]];
-                    }
-                    table.shifted_green_column(ix * ny + iy, scr);
-                    let col = scr.column();
-                    for j in 0..nz {
-                        s[[j, iy]] = col[j] * norm;
-                    }
+            .for_each(|(chunk, (mut block, scr))| {
+                for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
+                    table.shifted_green_row(chunk * rows_per + k, &mut row, scr);
+                    row.mapv_inplace(|v| v * norm);
                 }
             });
+        for (k, h) in table.dense_indices().enumerate() {
+            let (ix, iy) = (h / ny, h % ny);
+            for j in 0..nz {
+                ws.spec[[j, ix, iy]] = dense[k * nz + j] * norm;
+            }
+        }
+        ws.special_in = dense;
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 

@@ -66,8 +66,11 @@ pub struct ShiftTable {
     pub c: C64,
     /// Spectral layout ix·ny + iy; `None` for dense (near-grazing) harmonics.
     h: Vec<Option<HarmonicShift>>,
-    /// Down-sweep coefficients, N per harmonic (harmonic-major).
+    /// Down-sweep coefficients, layout (ix, j, iy): a spectral row's
+    /// harmonics are contiguous for each cell j.
     steps: Vec<Step>,
+    n: usize,
+    ny: usize,
     /// Per harmonic: the top relation's `u_0 = top_u · b_0` factor and the
     /// bottom closure's final t.
     ends: Vec<[C64; 2]>,
@@ -133,9 +136,14 @@ impl ShiftTable {
             h.len() * n
         ];
         let mut ends = vec![[ZERO; 2]; h.len()];
+        let ny = lat.ny;
+        let mut col = steps[..n].to_vec();
         for (i, hs) in h.iter().enumerate() {
             if let Some(hs) = hs {
-                ends[i] = sweep_coefficients(hs, &mut steps[i * n..(i + 1) * n]);
+                ends[i] = sweep_coefficients(hs, &mut col);
+                for (j, st) in col.iter().enumerate() {
+                    steps[((i / ny) * n + j) * ny + i % ny] = *st;
+                }
             }
         }
         ShiftTable {
@@ -144,6 +152,8 @@ impl ShiftTable {
             dense,
             steps,
             ends,
+            n,
+            ny,
         }
     }
 
@@ -270,12 +280,13 @@ impl ShiftTable {
             kappa,
             phi,
         } = hs;
-        let steps = &self.steps[index * n..(index + 1) * n];
+        let (ix, iy) = (index / self.ny, index % self.ny);
+        let step = |j: usize| &self.steps[(ix * self.n + j) * self.ny + iy];
         let [top_u, t_last] = self.ends[index];
         let b = &scr.col;
         let mut u = top_u * b[0] * inv_gs2;
         for j in 0..n - 1 {
-            let st = &steps[j];
+            let st = step(j);
             let delta = (b[j] - b[j + 1]) * inv_gs2;
             scr.tuvw[j] = [st.t, u, st.v, st.wa * delta + st.wb * u];
             u = st.ua * delta + st.ub * u;
@@ -306,6 +317,100 @@ impl ShiftTable {
         // w(0) = p_0 + a_0 + d_0 q.
         let w0 = -x0 * inv_gs2 - kappa * sig + a + d * q;
         (w0, wh)
+    }
+}
+
+impl ShiftTable {
+    /// `row ← G_s row` for every harmonic of spectral row `ix` at once
+    /// (`row` is (N, ny), the cell index outermost), the same arithmetic as
+    /// [`Self::shifted_green_column`] with the harmonics innermost so the
+    /// loops run over contiguous memory. Near-grazing harmonics take the
+    /// dense path.
+    pub fn shifted_green_row(
+        &self,
+        ix: usize,
+        row: &mut ndarray::ArrayViewMut2<C64>,
+        scr: &mut RowScratch,
+    ) {
+        let (n, ny) = (self.n, self.ny);
+        let hs = &self.h[ix * ny..(ix + 1) * ny];
+        let ends = &self.ends[ix * ny..(ix + 1) * ny];
+        let steps = &self.steps[ix * n * ny..(ix + 1) * n * ny];
+        let (uu, ww) = (&mut scr.u, &mut scr.w);
+        let (u, d) = (&mut scr.run_u, &mut scr.run_d);
+        // Down sweep.
+        {
+            let b0 = row.row(0);
+            for iy in 0..ny {
+                u[iy] = match hs[iy] {
+                    Some(h) => ends[iy][0] * b0[iy] * h.inv_gs2,
+                    None => ZERO,
+                };
+            }
+        }
+        for j in 0..n - 1 {
+            let (bj, bn) = (row.row(j), row.row(j + 1));
+            let st = &steps[j * ny..(j + 1) * ny];
+            let (uj, wj) = (&mut uu[j * ny..(j + 1) * ny], &mut ww[j * ny..(j + 1) * ny]);
+            for iy in 0..ny {
+                let Some(h) = hs[iy] else { continue };
+                let s = &st[iy];
+                let delta = (bj[iy] - bn[iy]) * h.inv_gs2;
+                uj[iy] = u[iy];
+                wj[iy] = s.wa * delta + s.wb * u[iy];
+                u[iy] = s.ua * delta + s.ub * u[iy];
+            }
+        }
+        // Bottom closure, then the up sweep writing G_s x in place.
+        let last = n - 1;
+        {
+            let mut bl = row.row_mut(last);
+            for iy in 0..ny {
+                let Some(h) = hs[iy] else { continue };
+                let ca = h.gamma * h.q - h.beta * h.q + h.beta * h.kappa;
+                let cd = -h.gamma - h.beta + h.beta * h.kappa;
+                let t_last = ends[iy][1];
+                d[iy] = (-h.beta * bl[iy] * h.inv_gs2 - u[iy] * ca) / (t_last * ca + cd);
+                let sig = t_last * d[iy] + u[iy] + d[iy];
+                bl[iy] = -bl[iy] * h.inv_gs2 + h.gamma2 * h.phi * h.inv_gs2 * sig;
+            }
+        }
+        for j in (0..n - 1).rev() {
+            let st = &steps[j * ny..(j + 1) * ny];
+            let (uj, wj) = (&uu[j * ny..(j + 1) * ny], &ww[j * ny..(j + 1) * ny]);
+            let mut bj = row.row_mut(j);
+            for iy in 0..ny {
+                let Some(h) = hs[iy] else { continue };
+                let s = &st[iy];
+                d[iy] = s.v * d[iy] + wj[iy];
+                let sig = s.t * d[iy] + uj[iy] + d[iy];
+                bj[iy] = -bj[iy] * h.inv_gs2 + h.gamma2 * h.phi * h.inv_gs2 * sig;
+            }
+        }
+    }
+
+    /// Spectral indices of the near-grazing (dense) harmonics.
+    pub fn dense_indices(&self) -> impl Iterator<Item = usize> + '_ {
+        self.dense.iter().map(|d| d.index)
+    }
+}
+
+/// Per-row scratch of [`ShiftTable::shifted_green_row`].
+pub struct RowScratch {
+    u: Vec<C64>,
+    w: Vec<C64>,
+    run_u: Vec<C64>,
+    run_d: Vec<C64>,
+}
+
+impl RowScratch {
+    pub fn new(n: usize, ny: usize) -> Self {
+        RowScratch {
+            u: vec![ZERO; n * ny],
+            w: vec![ZERO; n * ny],
+            run_u: vec![ZERO; ny],
+            run_d: vec![ZERO; ny],
+        }
     }
 }
 
@@ -443,6 +548,35 @@ mod tests {
                             "{ix} {iy} {j}: {got} vs {want}"
                         );
                     }
+                }
+            }
+        }
+    }
+
+    /// The row-vectorised sweep equals the column sweep bit for bit.
+    #[test]
+    fn row_sweep_equals_column_sweep() {
+        let n = 10;
+        let lat =
+            crate::solver::Problem::lattice([5, 7, n], [900.0, 700.0, 600.0], 480.0, 25.0, 10.0);
+        let eps_b = 1.558f64.powi(2);
+        let c = lat.k0 * lat.k0 * C64::new(1.7 - eps_b, 0.9);
+        let table = ShiftTable::new(&lat, eps_b, c);
+        for ix in 0..5 {
+            let mut row = ndarray::Array2::from_shape_fn((n, 7), |(j, iy)| {
+                C64::new((j * 7 + iy) as f64 * 0.1, (j as f64).cos())
+            });
+            let orig = row.clone();
+            let mut scr = RowScratch::new(n, 7);
+            table.shifted_green_row(ix, &mut row.view_mut(), &mut scr);
+            for iy in 0..7 {
+                let mut col = BandScratch::new(n);
+                for j in 0..n {
+                    col.column()[j] = orig[[j, iy]];
+                }
+                table.shifted_green_column(ix * 7 + iy, &mut col);
+                for j in 0..n {
+                    assert_eq!(row[[j, iy]], col.column()[j], "{ix} {iy} {j}");
                 }
             }
         }

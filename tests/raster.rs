@@ -21,6 +21,9 @@ fn geometry(size_nm: [f64; 3], particles: Vec<Particle>, n_species: usize) -> Ge
             achieved_fraction: vec![0.0; n_species],
             min_gap_nm: f64::INFINITY,
             attempts: 0,
+            worst_overlap_nm: 0.0,
+            order_parameter: None,
+            relax_steps: 0,
         },
     }
 }

@@ -115,6 +115,9 @@ fn dense_lattice() -> (Geometry, [f64; 3]) {
         achieved_fraction: vec![frac],
         min_gap_nm: a - d,
         attempts: n as u64,
+        worst_overlap_nm: 0.0,
+        order_parameter: None,
+        relax_steps: 0,
     };
     (
         Geometry {
@@ -287,6 +290,9 @@ fn exactly_grazing_orders_stay_finite() {
             achieved_fraction: vec![0.1],
             min_gap_nm: f64::INFINITY,
             attempts: 1,
+            worst_overlap_nm: 0.0,
+            order_parameter: None,
+            relax_steps: 0,
         };
         let geom = Geometry {
             size_nm: size,

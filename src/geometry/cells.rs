@@ -20,7 +20,7 @@ pub(crate) fn min_image(d: f64, l: f64) -> f64 {
 /// [`min_image`] with a branch for the usual case of coordinates within one
 /// period of each other (no rounding call).
 #[inline]
-fn near_image(d: f64, l: f64) -> f64 {
+pub(crate) fn near_image(d: f64, l: f64) -> f64 {
     let h = 0.5 * l;
     if d > h {
         if d <= 3.0 * h {

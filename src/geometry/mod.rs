@@ -2,9 +2,11 @@
 //!
 //! Owns the particle list of one random fragment `[0,Lx) × [0,Ly) × [0,H]`,
 //! periodic in x and y with walls at `z = 0` and `z = H`, and the packers that
-//! build it. Every particle is a rigid cluster of spheres ([`Particle`]); the
-//! packer here ([`pack_rsa`], random sequential addition, for PVC ≲ 30 %)
-//! makes one-sphere particles. Lengths are in nm.
+//! build it. Every particle is a rigid cluster of spheres ([`Particle`]).
+//! Two packers: [`pack_rsa`] (random sequential addition of one-sphere
+//! particles, PVC ≲ 30 %) and [`pack_dynamics`] (first-order dynamics of
+//! sphere-cluster shapes — sphere, cylinder, rice grain, see [`Shape`] — with
+//! orientation modes, to 50 % PVC and beyond). Lengths are in nm.
 //!
 //! Choices:
 //! - sphere centres are stored wrapped into `[0,Lx) × [0,Ly)`; distances use
@@ -18,7 +20,14 @@
 //!   it reached instead of looping.
 
 mod cells;
+mod dynamics;
 mod rsa;
+mod shapes;
+
+pub use dynamics::{pack_dynamics, particle_axis, DynParams, DynSpecies};
+pub use shapes::{
+    axis_from_uniforms, order_parameter, union_volume, Orientation, Shape, ShapeTemplate,
+};
 
 use cells::{dist2, CellList};
 
@@ -84,8 +93,8 @@ impl PackParams {
     }
 }
 
-/// What the packer achieved.
-#[derive(Debug, Clone)]
+/// What the packer achieved (`Default`: empty, for hand-built geometries).
+#[derive(Debug, Clone, Default)]
 pub struct GeometryStats {
     /// Particles per species.
     pub count: Vec<usize>,
@@ -96,8 +105,16 @@ pub struct GeometryStats {
     /// Smallest surface-to-surface distance between two particles, periodic
     /// images included; `+inf` with fewer than two particles.
     pub min_gap_nm: f64,
-    /// Centres drawn in total (accepted and rejected).
+    /// Centres drawn in total (accepted and rejected); for
+    /// [`pack_dynamics`], particles inserted.
     pub attempts: u64,
+    /// Deepest overlap between two particles, `max(0, −min_gap_nm)`.
+    pub worst_overlap_nm: f64,
+    /// `S = <P2(cos θ)>`, θ between a particle axis and z, over particles of
+    /// more than one sphere; `None` when there are none.
+    pub order_parameter: Option<f64>,
+    /// Relaxation steps taken ([`pack_dynamics`]; 0 for RSA).
+    pub relax_steps: u64,
 }
 
 /// One packed fragment.
@@ -141,6 +158,21 @@ pub enum GeometryError {
         reached: f64,
         /// Centres drawn in total.
         attempts: u64,
+    },
+    #[error(
+        "first-order dynamics did not converge: worst overlap {worst_overlap_nm:.4} nm after \
+         {steps} steps; reached overlap-free volume fraction {reached:.4} of target \
+         {target:.4} (lower the PVC or raise max_steps_per_batch)"
+    )]
+    DynamicsNotReached {
+        /// Total requested volume fraction.
+        target: f64,
+        /// Volume fraction of the last overlap-free ensemble.
+        reached: f64,
+        /// Worst overlap left when the step limit was hit, nm.
+        worst_overlap_nm: f64,
+        /// Relaxation steps taken in total.
+        steps: u64,
     },
     #[error("invalid geometry parameters: {0}")]
     Invalid(String),
@@ -241,6 +273,9 @@ pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryErro
             achieved_fraction,
             min_gap_nm,
             attempts,
+            worst_overlap_nm: (-min_gap_nm).max(0.0),
+            order_parameter: None,
+            relax_steps: 0,
         },
     })
 }

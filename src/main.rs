@@ -105,6 +105,8 @@ fn real_main() -> Result<()> {
                 scene.solver.method,
                 scene.solver.tolerance
             );
+            let (packer, why) = inksim::pipeline::packer_of(&scene);
+            println!("packer: {packer} ({why})");
             let (h5, png) = inksim::pipeline::result_paths(&scene);
             println!("would write {} and {}", h5.display(), png.display());
         }

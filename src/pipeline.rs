@@ -7,9 +7,11 @@
 //! results are written atomically (temp file + rename), so an interrupted run
 //! leaves either the previous file or the complete new one.
 
-use crate::config::Scene;
+use crate::config::{GrainOrientation, GrainShape, Scene};
 use crate::farfield::{self, SolveEntry};
-use crate::geometry::{self, Geometry, PackParams, SpeciesParams};
+use crate::geometry::{
+    self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SpeciesParams,
+};
 use crate::io::{self, GeometrySummary, ResultSet};
 use crate::progress::Progress;
 use crate::raster::{self, Grid, Raster};
@@ -76,22 +78,69 @@ pub fn check_output_dir(dir: &Path) -> Result<(), PipelineError> {
     Ok(())
 }
 
-/// Build the particle set of a scene.
+/// Total PVC up to which random sequential addition of spheres is used: RSA
+/// jams near 0.30–0.38 in thin slabs (METHOD §2), so above this the
+/// dynamics packer runs.
+pub const RSA_MAX_PVC: f64 = 0.30;
+
+/// Which packer a scene needs, and why.
+pub fn packer_of(scene: &Scene) -> (&'static str, String) {
+    let spheres = scene.species.iter().all(|s| s.shape == GrainShape::Sphere);
+    let pvc = scene.total_pvc();
+    if spheres && pvc <= RSA_MAX_PVC {
+        ("rsa", format!("spheres at PVC {pvc:.3} ≤ {RSA_MAX_PVC}: random sequential addition reaches it, no dynamics needed"))
+    } else if !spheres {
+        (
+            "dynamics",
+            "non-spherical grains: first-order dynamics packing".to_string(),
+        )
+    } else {
+        ("dynamics", format!("PVC {pvc:.3} > {RSA_MAX_PVC}: beyond random sequential addition, first-order dynamics packing"))
+    }
+}
+
+/// Build the particle set of a scene with the packer it needs.
 pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
     let l = &scene.layer;
-    let params = PackParams {
-        size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
-        species: scene
-            .species
-            .iter()
-            .map(|s| SpeciesParams {
-                diameter_nm: s.diameter_nm,
-                volume_fraction: s.volume_fraction,
-            })
-            .collect(),
-        ..PackParams::default()
-    };
-    Ok(geometry::pack_rsa(&params, scene.seed)?)
+    let size_nm = [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm];
+    if packer_of(scene).0 == "rsa" {
+        let params = PackParams {
+            size_nm,
+            species: scene
+                .species
+                .iter()
+                .map(|s| SpeciesParams {
+                    diameter_nm: s.diameter_nm,
+                    volume_fraction: s.volume_fraction,
+                })
+                .collect(),
+            ..PackParams::default()
+        };
+        return Ok(geometry::pack_rsa(&params, scene.seed)?);
+    }
+    let species = scene
+        .species
+        .iter()
+        .map(|s| DynSpecies {
+            shape: match s.shape {
+                GrainShape::Sphere => Shape::Sphere,
+                GrainShape::Cylinder { aspect, spheres } => Shape::Cylinder { aspect, spheres },
+                GrainShape::Rice { aspect, spheres } => Shape::Rice { aspect, spheres },
+            },
+            effective_diameter_nm: s.diameter_nm,
+            volume_fraction: s.volume_fraction,
+            orientation: match s.orientation {
+                GrainOrientation::Random => Orientation::Random,
+                GrainOrientation::InPlane => Orientation::InPlane,
+                GrainOrientation::Perpendicular => Orientation::Perpendicular,
+            },
+            field: s.alignment_field,
+        })
+        .collect();
+    Ok(geometry::pack_dynamics(
+        &DynParams::new(size_nm, species),
+        scene.seed,
+    )?)
 }
 
 /// The raster grid of a scene.
@@ -185,12 +234,19 @@ pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
     check_output_dir(&scene.output.dir)?;
     let total = (scene.wavelengths_nm.len() * scene.incidence.len()) as u64;
     let progress = Progress::new(total, &scene.output.name);
+    let (packer, why) = packer_of(scene);
+    progress.log(&format!("geometry: {packer} ({why})"));
     let geometry = build_geometry(scene)?;
+    let s = &geometry.stats;
     progress.log(&format!(
-        "geometry: {} particles, PVC {:.4} (target {:.4})",
+        "geometry: {} particles, PVC {:.4} (target {:.4}), worst overlap {:.3} nm{}",
         geometry.particles.len(),
-        geometry.stats.achieved_fraction.iter().sum::<f64>(),
-        scene.total_pvc()
+        s.achieved_fraction.iter().sum::<f64>(),
+        scene.total_pvc(),
+        s.worst_overlap_nm,
+        s.order_parameter
+            .map(|o| format!(", order parameter S = {o:.3}"))
+            .unwrap_or_default()
     ));
     let grid = grid_of(scene);
     let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);

@@ -83,7 +83,7 @@ fn negative_thickness_is_named() {
 
 #[test]
 fn pvc_beyond_packer_is_named() {
-    expect_error(&TINY.replace("pvc = 0.15", "pvc = 0.5"), "0.35");
+    expect_error(&TINY.replace("pvc = 0.15", "pvc = 0.6"), "0.55");
 }
 
 #[test]
@@ -158,4 +158,46 @@ fn run_writes_results_identical_for_one_and_two_threads() {
     };
     assert_eq!(key(&summaries[0]), key(&summaries[1]));
     assert_eq!(summaries[0].input_hash, summaries[1].input_hash);
+}
+
+#[test]
+fn dense_rice_layer_uses_dynamics_and_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = TINY
+        .replace("pvc = 0.15", "pvc = 0.45")
+        .replace(
+            "diameter_nm = 150.0",
+            "diameter_nm = 80.0\nshape = { kind = \"rice\" }\norientation = \"in-plane\"\nalignment_field = 1.0",
+        )
+        .replace("wavelengths_nm = [500.0, 600.0]", "wavelengths_nm = [550.0]")
+        .replace("polar_deg = [0.0, 40.0]", "polar_deg = [20.0]");
+    let cfg = write_config(dir.path(), &text);
+    let out = dir.path().join("out");
+    let (ok, _, err) = inksim(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("geometry: dynamics"), "{err}");
+    let s_value: f64 = err
+        .split("order parameter S = ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .expect("order parameter logged");
+    assert!(s_value < -0.45, "in-plane grains: S = {s_value}");
+    let s = inksim::io::read_summary(&out.join("tiny.h5")).unwrap();
+    assert_eq!(s.entries.len(), 1);
+    assert!(s.entries[0].energy_balance.abs() < 1e-4);
+}
+
+#[test]
+fn sparse_spheres_use_random_addition() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let (ok, out, err) = inksim(&["check", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.contains("packer: rsa"), "{out}");
 }

@@ -244,23 +244,96 @@ fn other_ranges_are_checked() {
 }
 
 #[test]
-fn pvc_above_rsa_limit_is_rejected() {
-    let (key, shown) = invalid(&format!("{BASE}{SECOND_PIGMENT}"));
+fn pvc_above_packer_limit_is_rejected() {
+    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.4", 2);
+    let (key, shown) = invalid(&text);
     assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
-    assert!(shown.contains("0.35"), "{shown}");
-    assert!(shown.contains("random-sequential-addition"), "{shown}");
-    assert!(shown.contains("not yet supported"), "{shown}");
-    assert_eq!(MAX_PVC_RSA, 0.35);
+    assert!(shown.contains("0.55"), "{shown}");
+    assert_eq!(MAX_PVC, 0.55);
 
     // A single species above the limit, too.
-    let (key, _) = invalid(&edit("pvc = 0.2", "pvc = 0.36"));
+    let (key, _) = invalid(&edit("pvc = 0.2", "pvc = 0.56"));
     assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
 
-    // Exactly at the limit (0.15 + 0.2 is 0.35000000000000003 in f64) passes.
-    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.15", 1);
+    // Exactly at the limit (0.35 + 0.2 = 0.5499999999999999 or so in f64) passes.
+    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.35", 1);
     let s = parse(&text).unwrap();
     assert_eq!(s.species.len(), 2);
-    assert!((s.total_pvc() - 0.35).abs() < 1e-15);
+    assert!((s.total_pvc() - 0.55).abs() < 1e-15);
+}
+
+#[test]
+fn grain_shapes_and_orientation_are_read_and_checked() {
+    let rice = edit(
+        "diameter_nm = 200.0",
+        "diameter_nm = 200.0\nshape = { kind = \"rice\", aspect = 4.0, spheres = 9 }\norientation = \"in-plane\"\nalignment_field = 0.5",
+    );
+    let s = parse(&rice).unwrap();
+    assert_eq!(
+        s.species[0].shape,
+        GrainShape::Rice {
+            aspect: 4.0,
+            spheres: 9
+        }
+    );
+    assert_eq!(s.species[0].orientation, GrainOrientation::InPlane);
+    assert_eq!(s.species[0].alignment_field, 0.5);
+    // Defaults: a cylinder of length 6 radii (aspect 3) with 5 spheres.
+    let cyl = edit(
+        "diameter_nm = 200.0",
+        "diameter_nm = 200.0\nshape = { kind = \"cylinder\" }",
+    );
+    assert_eq!(
+        parse(&cyl).unwrap().species[0].shape,
+        GrainShape::Cylinder {
+            aspect: 3.0,
+            spheres: 5
+        }
+    );
+    // Spheres by default, random orientation, no field.
+    let s = parse(BASE).unwrap();
+    assert_eq!(
+        (s.species[0].shape, s.species[0].orientation),
+        (GrainShape::Sphere, GrainOrientation::Random)
+    );
+    // Errors name the key.
+    let bad = [
+        ("shape = { kind = \"banana\" }", "pigment[0].shape"),
+        (
+            "shape = { kind = \"rice\", spheres = 1 }",
+            "pigment[0].shape.spheres",
+        ),
+        (
+            "shape = { kind = \"cylinder\", aspect = 8.0, spheres = 4 }",
+            "pigment[0].shape.spheres",
+        ),
+        (
+            "shape = { kind = \"rice\", aspect = 0.5 }",
+            "pigment[0].shape.aspect",
+        ),
+        (
+            "shape = { kind = \"rice\" }\nalignment_field = 1.0",
+            "pigment[0].alignment_field",
+        ),
+        (
+            "alignment_field = 1.0\norientation = \"in-plane\"",
+            "pigment[0].alignment_field",
+        ),
+    ];
+    for (extra, want) in bad {
+        let text = edit(
+            "diameter_nm = 200.0",
+            &format!("diameter_nm = 200.0\n{extra}"),
+        );
+        match parse(&text) {
+            Err(ConfigError::Invalid { key, .. }) => assert_eq!(key, want, "{extra}"),
+            Err(ConfigError::Parse { message, .. }) => assert!(
+                want == "pigment[0].shape" && message.contains("banana"),
+                "{message}"
+            ),
+            other => panic!("{extra}: expected an error, got {other:?}"),
+        }
+    }
 }
 
 #[test]

@@ -20,23 +20,48 @@ fn reflected_orders_are_reciprocal() {
     let size = [900.0, 700.0, 500.0];
     let params = PackParams {
         size_nm: size,
-        species: vec![SpeciesParams { diameter_nm: 150.0, volume_fraction: 0.2 }],
+        species: vec![SpeciesParams {
+            diameter_nm: 150.0,
+            volume_fraction: 0.2,
+        }],
         ..PackParams::default()
     };
     let geom = pack_rsa(&params, 8).unwrap();
-    let grid = Grid { nx: 45, ny: 27, nz: 50, size_nm: size };
+    let grid = Grid {
+        nx: 45,
+        ny: 27,
+        nz: 50,
+        size_nm: size,
+    };
     let raster = rasterize(&geom, &grid, 4);
     let eps_b = 1.558f64.powi(2);
     let n = C64::new(1.4, 0.4);
     let mut eps = Array3::zeros((50, 27, 45));
     raster.epsilon_into(C64::new(eps_b, 0.0), &[n * n], &mut eps);
-    let ctl = Controls { tolerance: 1e-10, max_iterations: 20000 };
+    let ctl = Controls {
+        tolerance: 1e-10,
+        max_iterations: 20000,
+    };
     let lambda = 520.0;
     let lat = Problem::lattice([45, 27, 50], size, lambda, 25.0, 30.0);
-    let sol = solver::solve(&Problem { lattice: lat, eps: &eps, eps_binder: eps_b }, Method::Auto, &ctl).unwrap();
+    let sol = solver::solve(
+        &Problem {
+            lattice: lat,
+            eps: &eps,
+            eps_binder: eps_b,
+        },
+        Method::Auto,
+        &ctl,
+    )
+    .unwrap();
     let ff = efficiencies(&sol);
     let mut checked = 0;
-    for o in ff.orders.iter().filter(|o| (o.m, o.n) != (0, 0) && o.theta_deg < 70.0).take(4) {
+    for o in ff
+        .orders
+        .iter()
+        .filter(|o| (o.m, o.n) != (0, 0) && o.theta_deg < 70.0)
+        .take(4)
+    {
         // Incidence along the reversed direction of order (m, n).
         let ix = o.m.rem_euclid(45) as usize;
         let iy = o.n.rem_euclid(27) as usize;
@@ -44,12 +69,35 @@ fn reflected_orders_are_reciprocal() {
         let polar = (kx.hypot(ky) / lat.k0).asin().to_degrees();
         let azimuth = (-ky).atan2(-kx).to_degrees();
         let lat2 = Problem::lattice([45, 27, 50], size, lambda, polar, azimuth);
-        let sol2 = solver::solve(&Problem { lattice: lat2, eps: &eps, eps_binder: eps_b }, Method::Auto, &ctl).unwrap();
+        let sol2 = solver::solve(
+            &Problem {
+                lattice: lat2,
+                eps: &eps,
+                eps_binder: eps_b,
+            },
+            Method::Auto,
+            &ctl,
+        )
+        .unwrap();
         let ff2 = efficiencies(&sol2);
-        let back = ff2.orders.iter().find(|p| (p.m, p.n) == (o.m, o.n)).expect("order propagates");
+        let back = ff2
+            .orders
+            .iter()
+            .find(|p| (p.m, p.n) == (o.m, o.n))
+            .expect("order propagates");
         let rel = (back.reflectance - o.reflectance).abs() / o.reflectance;
-        eprintln!("order ({}, {}): R {:.6e} vs reciprocal {:.6e} (rel {rel:.1e})", o.m, o.n, o.reflectance, back.reflectance);
-        assert!(rel < 1e-4, "order ({}, {}): {} vs {}", o.m, o.n, o.reflectance, back.reflectance);
+        eprintln!(
+            "order ({}, {}): R {:.6e} vs reciprocal {:.6e} (rel {rel:.1e})",
+            o.m, o.n, o.reflectance, back.reflectance
+        );
+        assert!(
+            rel < 1e-4,
+            "order ({}, {}): {} vs {}",
+            o.m,
+            o.n,
+            o.reflectance,
+            back.reflectance
+        );
         checked += 1;
     }
     assert!(checked >= 3);

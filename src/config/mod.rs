@@ -15,10 +15,9 @@ use std::path::{Path, PathBuf};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use validate::{load_scene, parse_scene};
 
-/// Largest total pigment volume concentration the random-sequential-addition
-/// packer supports (METHOD §2: RSA is for PVC ≲ 30 %); denser packing is not
-/// yet implemented, so validation rejects more.
-pub const MAX_PVC_RSA: f64 = 0.35;
+/// Largest total pigment volume concentration a scene may ask for: what the
+/// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).
+pub const MAX_PVC: f64 = 0.55;
 
 /// Everything that can go wrong while reading or checking a configuration.
 #[derive(Debug, thiserror::Error)]
@@ -74,8 +73,36 @@ pub struct Species {
     pub material: Material,
     /// Target volume fraction of the layer (PVC share of this species), 0..1.
     pub volume_fraction: f64,
-    /// Sphere diameter in nm.
+    /// Effective diameter in nm: the diameter of the sphere of equal volume.
     pub diameter_nm: f64,
+    pub shape: GrainShape,
+    pub orientation: GrainOrientation,
+    /// Strength of the "magnetic" aligning torque (0: none).
+    pub alignment_field: f64,
+}
+
+/// Grain shape: a rigid cluster of spheres (METHOD §2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GrainShape {
+    Sphere,
+    /// Equal spheres on the axis; `aspect` = length / diameter.
+    Cylinder {
+        aspect: f64,
+        spheres: usize,
+    },
+    /// Spheres on the axis whose radii shrink towards both ends.
+    Rice {
+        aspect: f64,
+        spheres: usize,
+    },
+}
+
+/// How grain axes are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GrainOrientation {
+    Random,
+    InPlane,
+    Perpendicular,
 }
 
 /// Grid of the refractive-index raster and of the solver.

@@ -36,6 +36,33 @@ pub struct RawPigment {
     pub material: RawMaterial,
     pub pvc: f64,
     pub diameter_nm: f64,
+    pub shape: Option<RawShape>,
+    pub orientation: Option<RawOrientation>,
+    pub alignment_field: Option<f64>,
+}
+
+/// `{ kind = "sphere" }`, `{ kind = "cylinder", aspect = 3, spheres = 5 }`,
+/// `{ kind = "rice", aspect = 3, spheres = 7 }`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawShape {
+    Sphere,
+    Cylinder {
+        aspect: Option<f64>,
+        spheres: Option<i64>,
+    },
+    Rice {
+        aspect: Option<f64>,
+        spheres: Option<i64>,
+    },
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawOrientation {
+    Random,
+    InPlane,
+    Perpendicular,
 }
 
 /// `{ builtin = "red" }` or `{ csv = "path.csv" }`.

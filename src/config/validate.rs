@@ -17,15 +17,15 @@
 //!   within a relative 1e-9 of a step; the last value is then exactly `stop`.
 //! - A pigment's diameter must fit the layer (≤ thickness) and the periodic
 //!   fragment (≤ min(fragment x, y)); the total PVC is limited to
-//!   [`MAX_PVC_RSA`], what the random-sequential-addition packer supports.
+//!   [`MAX_PVC`], what the dynamics packer reaches.
 //! - `Provenance::input_hash` is SHA-256 over the config text followed by each
 //!   pigment's table text, in pigment order.
 
 use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
-use super::raw::{RawOutput, RawPigment, RawSolver};
+use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSolver};
 use super::{
-    ConfigError, GridSpec, Incidence, Layer, Material, Method, OutputSpec, Provenance, Scene,
-    SolverSpec, Species, MAX_PVC_RSA,
+    ConfigError, GrainOrientation, GrainShape, GridSpec, Incidence, Layer, Material, Method,
+    OutputSpec, Provenance, Scene, SolverSpec, Species, MAX_PVC,
 };
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
@@ -240,25 +240,83 @@ impl Checker<'_> {
                 d > 0.0 && d <= max_d,
                 &format!("(0, {max_d}] nm (at most the layer thickness and the fragment size)"),
             )?;
+            let shape = self.shape(p.shape.as_ref(), &key("shape"))?;
+            let orientation = match p.orientation {
+                None | Some(RawOrientation::Random) => GrainOrientation::Random,
+                Some(RawOrientation::InPlane) => GrainOrientation::InPlane,
+                Some(RawOrientation::Perpendicular) => GrainOrientation::Perpendicular,
+            };
+            let f = p.alignment_field.unwrap_or(0.0);
+            let alignment_field = self.range(
+                &key("alignment_field"),
+                f,
+                (0.0..=100.0).contains(&f),
+                "[0, 100]",
+            )?;
+            if alignment_field > 0.0 && orientation == GrainOrientation::Random {
+                return Err(self.invalid(
+                    key("alignment_field"),
+                    "needs orientation \"in-plane\" or \"perpendicular\" (the direction it aligns towards)",
+                ));
+            }
+            if alignment_field > 0.0 && shape == GrainShape::Sphere {
+                return Err(self.invalid(key("alignment_field"), "spheres have no axis to align"));
+            }
             species.push(Species {
                 name: name.to_string(),
                 material,
                 volume_fraction,
                 diameter_nm,
+                shape,
+                orientation,
+                alignment_field,
             });
         }
         let total: f64 = species.iter().map(|s| s.volume_fraction).sum();
-        if total > MAX_PVC_RSA * (1.0 + REL_EPS) {
+        if total > MAX_PVC * (1.0 + REL_EPS) {
             return Err(self.invalid(
                 "pigment[*].pvc",
-                format!(
-                    "total pvc {total} exceeds {MAX_PVC_RSA}, the most the \
-                     random-sequential-addition packer supports; denser packing is not yet \
-                     supported"
-                ),
+                format!("total pvc {total} exceeds {MAX_PVC}, the most the packer reaches"),
             ));
         }
         Ok(species)
+    }
+
+    fn shape(&self, raw: Option<&RawShape>, key: &str) -> Result<GrainShape, ConfigError> {
+        let parts = |aspect: Option<f64>, spheres: Option<i64>, def_a: f64, def_n: i64| {
+            let a = aspect.unwrap_or(def_a);
+            let a = self.range(
+                &format!("{key}.aspect"),
+                a,
+                (1.0..=20.0).contains(&a),
+                "[1, 20]",
+            )?;
+            let n = spheres.unwrap_or(def_n);
+            if !(2..=64).contains(&n) {
+                return Err(self.invalid(
+                    format!("{key}.spheres"),
+                    format!("must be in [2, 64], got {n}"),
+                ));
+            }
+            Ok((a, n as usize))
+        };
+        Ok(match raw {
+            None | Some(RawShape::Sphere) => GrainShape::Sphere,
+            Some(RawShape::Cylinder { aspect, spheres }) => {
+                let (aspect, spheres) = parts(*aspect, *spheres, 3.0, 5)?;
+                if (spheres as f64) <= aspect - 1.0 {
+                    return Err(self.invalid(
+                        format!("{key}.spheres"),
+                        format!("a cylinder of aspect {aspect} needs more than {} spheres so neighbours overlap", aspect - 1.0),
+                    ));
+                }
+                GrainShape::Cylinder { aspect, spheres }
+            }
+            Some(RawShape::Rice { aspect, spheres }) => {
+                let (aspect, spheres) = parts(*aspect, *spheres, 3.0, 7)?;
+                GrainShape::Rice { aspect, spheres }
+            }
+        })
     }
 
     fn material(&self, raw: &RawMaterial, key: &str) -> Result<Material, ConfigError> {

@@ -1,5 +1,6 @@
-//! One application of the background Green's operator against the batched
-//! 2-D FFTs it contains (forward + inverse over every z-slice). The ratio
+//! One application of the background Green's operator `G_b` and of the
+//! shifted operator `G_s` (what the CBS-based methods apply) against the
+//! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
 //! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
 //!
 //! `cargo bench --bench operator`
@@ -7,6 +8,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use inksim::solver::fft::Fft2;
 use inksim::solver::operator::{GreenTable, Operator};
+use inksim::solver::shift::ShiftTable;
 use inksim::solver::Problem;
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
@@ -36,6 +38,13 @@ fn bench(c: &mut Criterion) {
             BenchmarkId::new("apply", format!("{n}x{n}x{nz}")),
             &(),
             |b, _| b.iter(|| op.apply(&table, &mut u, &mut ws)),
+        );
+        let c = lat.k0 * lat.k0 * C64::new(2.0 - 1.558f64.powi(2), 0.8);
+        let shifted = ShiftTable::new(&lat, 1.558f64.powi(2), c);
+        g.bench_with_input(
+            BenchmarkId::new("apply_shifted", format!("{n}x{n}x{nz}")),
+            &(),
+            |b, _| b.iter(|| op.apply_shifted_green(&shifted, &mut u, &mut ws)),
         );
         let fft = Fft2::new(n, n);
         let mut scr = fft.scratch(nz);

@@ -2,8 +2,8 @@
 //! layer, λ = 450 nm, 40° incidence. Operator applications each method needs
 //! for relative residual 1e-6 (docs/PERFORMANCE.md).
 //!
-//! Geometry: 300 nm spheres on a jittered simple-cubic lattice at exactly
-//! 50 % PVC (until the dynamics packer is wired into scenes).
+//! Geometry: 300 nm spheres on a jittered simple-cubic lattice, 50 % within
+//! the lattice (three layers fill 914 nm of the 1 µm layer: 45.7 % overall).
 //!
 //! `cargo run --release --example hard_case [cells_per_side]`
 

@@ -6,7 +6,9 @@
 //! learned, it needs far fewer applications. Breakdowns (⟨r̂, v⟩ ≈ 0) restart
 //! from the current iterate; convergence is confirmed on the true residual.
 
-use super::{dot, Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
+use super::{
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -44,21 +46,13 @@ impl IterativeMethod for BiCgStab {
         let (mut r, mut rh, mut p, mut v, mut s, mut t) = (z(), z(), z(), z(), z(), z());
         let mut iterations = 0;
         let mut applications = 0;
-        let mut best = f64::INFINITY;
+        let mut monitor = Monitor::new(MethodUsed::BiCgStab);
         let one = C64::new(1.0, 0.0);
         loop {
             // (Re)start: true residual, then its preconditioned form.
             let res = sys.residual_shifted(u, &mut r);
             applications += 1;
-            if !res.is_finite() || res > 1e3 * best.max(ctl.tolerance) {
-                return Err(SolveError::Diverged {
-                    method: MethodUsed::BiCgStab,
-                    iterations,
-                    residual: res,
-                });
-            }
-            best = best.min(res);
-            if res <= ctl.tolerance {
+            if monitor.check(res, iterations, ctl)? {
                 let note = format!(
                     "BiCGStab, ε_r = {:.4}, ε_s = {:.4}",
                     sys.shift.er, sys.shift.es
@@ -68,14 +62,6 @@ impl IterativeMethod for BiCgStab {
                     applications,
                     residual: res,
                     note,
-                });
-            }
-            if iterations >= ctl.max_iterations {
-                return Err(SolveError::NotConverged {
-                    method: MethodUsed::BiCgStab,
-                    iterations,
-                    residual: res,
-                    tolerance: ctl.tolerance,
                 });
             }
             sys.precondition(&mut r);

@@ -10,7 +10,9 @@
 //! `‖u_s + G_s V' u − u‖ / ‖u_s‖`, evaluated at every restart. Inner products are
 //! summed in a fixed order, so results do not depend on the thread count.
 
-use super::{dot, Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
+use super::{
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -51,19 +53,11 @@ impl IterativeMethod for Gmres {
         let mut g = vec![C64::new(0.0, 0.0); m + 1];
         let mut inner = 0;
         let mut applications = 0;
-        let mut best = f64::INFINITY;
+        let mut monitor = Monitor::new(MethodUsed::Gmres);
         loop {
             let res = sys.residual_shifted(u, &mut r);
             applications += 1;
-            if !res.is_finite() || res > 1e3 * best.max(ctl.tolerance) {
-                return Err(SolveError::Diverged {
-                    method: MethodUsed::Gmres,
-                    iterations: inner,
-                    residual: res,
-                });
-            }
-            best = best.min(res);
-            if res <= ctl.tolerance {
+            if monitor.check(res, inner, ctl)? {
                 let note = format!(
                     "GMRES({m}), ε_r = {:.4}, ε_s = {:.4}",
                     sys.shift.er, sys.shift.es
@@ -73,14 +67,6 @@ impl IterativeMethod for Gmres {
                     applications,
                     residual: res,
                     note,
-                });
-            }
-            if inner >= ctl.max_iterations {
-                return Err(SolveError::NotConverged {
-                    method: MethodUsed::Gmres,
-                    iterations: inner,
-                    residual: res,
-                    tolerance: ctl.tolerance,
                 });
             }
             // Preconditioned residual starts the cycle.

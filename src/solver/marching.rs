@@ -19,7 +19,9 @@
 //! above its best. Cost per step: one application of `G_s` between a forward
 //! and an inverse 2-D FFT.
 
-use super::{Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
+use super::{
+    Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 /// Time-marching settings.
@@ -68,32 +70,16 @@ impl IterativeMethod for TimeMarching {
         let (er, es) = (sys.shift.er, sys.shift.es);
         let mut r = Array3::zeros(u.dim());
         let step = self.step;
-        let mut best = f64::INFINITY;
+        let mut monitor = Monitor::new(MethodUsed::TimeMarching);
         for it in 0..=ctl.max_iterations {
             let res = sys.residual_shifted(u, &mut r);
-            if !res.is_finite() || res > 1e3 * best.max(ctl.tolerance) {
-                return Err(SolveError::Diverged {
-                    method: MethodUsed::TimeMarching,
-                    iterations: it,
-                    residual: res,
-                });
-            }
-            best = best.min(res);
-            if res <= ctl.tolerance {
+            if monitor.check(res, it, ctl)? {
                 let note = format!("ε_r = {er:.4}, ε_s = {es:.4}, dτ = {step}");
                 return Ok(Outcome {
                     iterations: it,
                     applications: it + 1,
                     residual: res,
                     note,
-                });
-            }
-            if it == ctl.max_iterations {
-                return Err(SolveError::NotConverged {
-                    method: MethodUsed::TimeMarching,
-                    iterations: it,
-                    residual: res,
-                    tolerance: ctl.tolerance,
                 });
             }
             sys.precondition(&mut r);

@@ -165,6 +165,53 @@ pub struct Outcome {
     pub note: String,
 }
 
+/// Bookkeeping shared by the iterative methods: a residual that is not
+/// finite or grows a thousandfold above its best is divergence, one at
+/// tolerance is convergence, and a spent iteration budget is a loud failure.
+pub struct Monitor {
+    method: MethodUsed,
+    best: f64,
+}
+
+impl Monitor {
+    pub fn new(method: MethodUsed) -> Self {
+        Monitor {
+            method,
+            best: f64::INFINITY,
+        }
+    }
+
+    /// `Ok(true)`: converged; `Ok(false)`: go on; `Err`: stop with this error.
+    pub fn check(
+        &mut self,
+        res: f64,
+        iterations: usize,
+        ctl: &Controls,
+    ) -> Result<bool, SolveError> {
+        let method = self.method;
+        if !res.is_finite() || res > 1e3 * self.best.max(ctl.tolerance) {
+            return Err(SolveError::Diverged {
+                method,
+                iterations,
+                residual: res,
+            });
+        }
+        self.best = self.best.min(res);
+        if res <= ctl.tolerance {
+            return Ok(true);
+        }
+        if iterations >= ctl.max_iterations {
+            return Err(SolveError::NotConverged {
+                method,
+                iterations,
+                residual: res,
+                tolerance: ctl.tolerance,
+            });
+        }
+        Ok(false)
+    }
+}
+
 /// An iterative method for the shared discrete equation.
 pub trait IterativeMethod {
     fn kind(&self) -> MethodUsed;

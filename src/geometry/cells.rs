@@ -59,25 +59,32 @@ pub(crate) struct CellList {
     owner: Vec<u32>,
 }
 
+/// Cells per axis for a grid over `size` with cells no narrower than
+/// `min_cell`, widened until there are at most ~4 per expected item (so
+/// memory stays linear in `capacity`).
+pub(crate) fn cell_counts(size: [f64; 3], min_cell: f64, capacity: usize) -> [usize; 3] {
+    let limit = (4.0 * capacity as f64).max(1024.0);
+    let mut width = min_cell;
+    let mut counts = [1.0f64; 3];
+    for _ in 0..64 {
+        for a in 0..3 {
+            counts[a] = (size[a] / width).floor().max(1.0);
+        }
+        let total = counts[0] * counts[1] * counts[2];
+        if total <= limit {
+            break;
+        }
+        width *= (total / limit).cbrt().max(1.01);
+    }
+    counts.map(|c| c as usize)
+}
+
 impl CellList {
     /// An empty list over `size` with cells no narrower than `min_cell`,
     /// sized for about `capacity` spheres. Cells are widened when needed so
     /// that there are at most ~4 per expected sphere (memory stays linear).
     pub(crate) fn new(size: [f64; 3], min_cell: f64, capacity: usize) -> Self {
-        let limit = (4.0 * capacity as f64).max(1024.0);
-        let mut width = min_cell;
-        let mut counts = [1.0f64; 3];
-        for _ in 0..64 {
-            for a in 0..3 {
-                counts[a] = (size[a] / width).floor().max(1.0);
-            }
-            let total = counts[0] * counts[1] * counts[2];
-            if total <= limit {
-                break;
-            }
-            width *= (total / limit).cbrt().max(1.01);
-        }
-        let n = counts.map(|c| c as usize);
+        let n = cell_counts(size, min_cell, capacity);
         let cell = [
             size[0] / n[0] as f64,
             size[1] / n[1] as f64,

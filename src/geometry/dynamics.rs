@@ -242,20 +242,7 @@ struct Grid {
 
 impl Grid {
     fn new(size: [f64; 3], min_cell: f64, capacity: usize) -> Self {
-        let limit = (4.0 * capacity as f64).max(1024.0);
-        let mut width = min_cell;
-        let mut counts = [1.0f64; 3];
-        for _ in 0..64 {
-            for a in 0..3 {
-                counts[a] = (size[a] / width).floor().max(1.0);
-            }
-            let total = counts[0] * counts[1] * counts[2];
-            if total <= limit {
-                break;
-            }
-            width *= (total / limit).cbrt().max(1.01);
-        }
-        let n = counts.map(|c| c as usize);
+        let n = super::cells::cell_counts(size, min_cell, capacity);
         Grid {
             n,
             cell: [0, 1, 2].map(|a| size[a] / n[a] as f64),

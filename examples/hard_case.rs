@@ -2,68 +2,40 @@
 //! layer, λ = 450 nm, 40° incidence. Operator applications each method needs
 //! for relative residual 1e-6 (docs/PERFORMANCE.md).
 //!
-//! Geometry: 300 nm spheres on a jittered simple-cubic lattice, 50 % within
-//! the lattice (three layers fill 914 nm of the 1 µm layer: 45.7 % overall).
+//! Geometry: 300 nm spheres packed to 50 % PVC by the first-order dynamics
+//! packer in a `side × side × 1000 nm` fragment.
 //!
-//! `cargo run --release --example hard_case [cells_per_side]`
+//! `cargo run --release --example hard_case [side_nm] [seed]`
 
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
-use inksim::geometry::{Geometry, GeometryStats, Particle, Sphere};
+use inksim::geometry::{pack_dynamics, DynParams, DynSpecies, Orientation, Shape};
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
-use rand::{Rng, SeedableRng};
 
 fn main() {
-    let per_side: usize = std::env::args()
+    let side: f64 = std::env::args()
         .nth(1)
         .and_then(|s| s.parse().ok())
-        .unwrap_or(4);
-    let d = 300.0;
-    let a = d * (std::f64::consts::PI / (6.0 * 0.5)).cbrt();
-    let (layers, h) = (3usize, 1000.0);
-    let size = [a * per_side as f64, a * per_side as f64, h];
-    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(1);
-    let slack = (a - d) / 2.0;
-    let z0 = (h - layers as f64 * a) / 2.0;
-    let mut particles = vec![];
-    for i in 0..per_side {
-        for j in 0..per_side {
-            for k in 0..layers {
-                let jit = |r: &mut rand_xoshiro::Xoshiro256PlusPlus| r.gen_range(-slack..=slack);
-                let c = [
-                    (i as f64 + 0.5) * a + jit(&mut rng),
-                    (j as f64 + 0.5) * a + jit(&mut rng),
-                    z0 + (k as f64 + 0.5) * a + jit(&mut rng),
-                ];
-                particles.push(Particle {
-                    species: 0,
-                    spheres: vec![Sphere {
-                        center: c,
-                        radius: d / 2.0,
-                    }],
-                });
-            }
-        }
-    }
-    let n_p = particles.len();
-    let frac = n_p as f64 * std::f64::consts::PI * d.powi(3) / 6.0 / (size[0] * size[1] * size[2]);
-    let stats = GeometryStats {
-        count: vec![n_p],
-        target_fraction: vec![frac],
-        achieved_fraction: vec![frac],
-        min_gap_nm: 0.0,
-        attempts: n_p as u64,
-        ..Default::default()
-    };
-    let geom = Geometry {
-        size_nm: size,
-        particles,
-        stats,
-    };
-    let nxy = 16 * per_side;
+        .unwrap_or(1280.0);
+    let seed: u64 = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
+    let size = [side, side, 1000.0];
+    let species = vec![DynSpecies {
+        shape: Shape::Sphere,
+        effective_diameter_nm: 300.0,
+        volume_fraction: 0.5,
+        orientation: Orientation::Random,
+        field: 0.0,
+    }];
+    let geom = pack_dynamics(&DynParams::new(size, species), seed).expect("packing");
+    let n_p = geom.particles.len();
+    let frac = geom.stats.achieved_fraction[0];
+    let nxy = (side / 20.0).round() as usize;
     let grid = Grid {
         nx: nxy,
         ny: nxy,
@@ -120,5 +92,28 @@ fn main() {
             }
             Err(e) => println!("| {method:?} | — | — | — | {e} | | |"),
         }
+    }
+    // Unrestarted GMRES (restart longer than the iteration count).
+    let mut sys = solver::System::new(&p).expect("system");
+    let mut u = Array3::zeros(eps.dim());
+    sys.set_background(&mut u);
+    let t = std::time::Instant::now();
+    let g = solver::gmres::Gmres { restart: 80 };
+    match solver::IterativeMethod::run(
+        &g,
+        &mut sys,
+        &mut u,
+        &Controls {
+            tolerance: 1e-6,
+            max_iterations: 50_000,
+        },
+    ) {
+        Ok(o) => println!(
+            "| gmres(80) | {} | {} | {:.1} | | | |",
+            o.iterations,
+            o.applications,
+            t.elapsed().as_secs_f64()
+        ),
+        Err(e) => println!("| gmres(80) | — | — | — | {e} | | |"),
     }
 }

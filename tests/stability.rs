@@ -1,0 +1,150 @@
+//! Stability suite (issue 6), at CI size: the hard cases users run must
+//! finish with no inf/NaN, the residual at tolerance and the energy balance
+//! within 1e-4, with `auto` (which may fall back and says so). The grazing
+//! order, the guided resonance and the 3 µm layer live in tests/traps.rs and
+//! tests/solver_layers.rs.
+use inksim::config::Method;
+use inksim::farfield::efficiencies;
+use inksim::geometry::{
+    pack_dynamics, DynParams, DynSpecies, Geometry, GeometryStats, Orientation, Particle, Shape,
+    Sphere,
+};
+use inksim::raster::{rasterize, Grid};
+use inksim::solver::{self, Controls, Problem};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+
+const EPS_B: f64 = 1.558 * 1.558;
+const CTL: Controls = Controls {
+    tolerance: 1e-6,
+    max_iterations: 20_000,
+};
+
+fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, polar: f64) {
+    let grid = Grid {
+        nx: cells[0],
+        ny: cells[1],
+        nz: cells[2],
+        size_nm: geom.size_nm,
+    };
+    let raster = rasterize(geom, &grid, 4);
+    let mut eps = Array3::zeros((cells[2], cells[1], cells[0]));
+    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n * n], &mut eps);
+    let lat = Problem::lattice(cells, geom.size_nm, lambda, polar, 0.0);
+    let sol = solver::solve(
+        &Problem {
+            lattice: lat,
+            eps: &eps,
+            eps_binder: EPS_B,
+        },
+        Method::Auto,
+        &CTL,
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert!(
+        sol.field
+            .iter()
+            .all(|c| c.re.is_finite() && c.im.is_finite()),
+        "{name}: non-finite field"
+    );
+    assert!(
+        sol.record.residual <= CTL.tolerance,
+        "{name}: residual {}",
+        sol.record.residual
+    );
+    let ff = efficiencies(&sol);
+    eprintln!(
+        "{name}: {} {} it, R {:.4} T {:.4} A {:.4}, balance {:.1e}",
+        sol.record.method,
+        sol.record.iterations,
+        ff.total_reflectance,
+        ff.total_transmittance,
+        ff.absorption,
+        ff.energy_balance
+    );
+    assert!(
+        ff.energy_balance.abs() < 1e-4,
+        "{name}: balance {}",
+        ff.energy_balance
+    );
+}
+
+fn packed(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {
+    let species = vec![DynSpecies {
+        shape: Shape::Sphere,
+        effective_diameter_nm: d,
+        volume_fraction: pvc,
+        orientation: Orientation::Random,
+        field: 0.0,
+    }];
+    pack_dynamics(&DynParams::new(size, species), seed).expect("packing")
+}
+
+#[test]
+fn fifty_percent_pvc_strongly_absorbing() {
+    let g = packed([600.0, 600.0, 500.0], 150.0, 0.5, 1);
+    assert!((g.stats.achieved_fraction[0] - 0.5).abs() < 0.005);
+    check(
+        "50 % PVC, n = 1.4+0.8i",
+        &g,
+        [32, 32, 50],
+        C64::new(1.4, 0.8),
+        450.0,
+        20.0,
+    );
+}
+
+#[test]
+fn large_grains_of_450_nm() {
+    let g = packed([1350.0, 1350.0, 1000.0], 450.0, 0.3, 2);
+    check(
+        "450 nm grains, 30 % PVC",
+        &g,
+        [54, 54, 50],
+        C64::new(1.4, 0.5),
+        500.0,
+        30.0,
+    );
+}
+
+#[test]
+fn incidence_at_80_degrees() {
+    let g = packed([600.0, 600.0, 500.0], 150.0, 0.3, 3);
+    check(
+        "80° incidence",
+        &g,
+        [32, 32, 50],
+        C64::new(1.4, 0.6),
+        550.0,
+        80.0,
+    );
+}
+
+#[test]
+fn a_single_huge_grain() {
+    let size = [1000.0, 1000.0, 1000.0];
+    let particles = vec![Particle {
+        species: 0,
+        spheres: vec![Sphere {
+            center: [500.0, 500.0, 500.0],
+            radius: 480.0,
+        }],
+    }];
+    let stats = GeometryStats {
+        count: vec![1],
+        ..Default::default()
+    };
+    let g = Geometry {
+        size_nm: size,
+        particles,
+        stats,
+    };
+    check(
+        "one 960 nm grain",
+        &g,
+        [40, 40, 50],
+        C64::new(1.4, 0.8),
+        600.0,
+        10.0,
+    );
+}

@@ -17,6 +17,9 @@
 //! `/config` — scalar variable-length UTF-8 string: the exact TOML text
 //! (byte-exact round trip; a text containing NUL is refused).
 //!
+//! `/plan` — scalar UTF-8 string: the run's plan, one line per decision
+//! (which packer and why, which solves, which solver each used and why).
+//!
 //! `/geometry` (group):
 //! - datasets `centers_nm` (N × 3 f64), `radii_nm` (N f64),
 //!   `particle_of_sphere` (N u32), `species_of_particle` (P u32),
@@ -64,6 +67,8 @@ pub struct ResultSet<'a> {
     /// The exact TOML text of the scene.
     pub config_text: &'a str,
     pub input_hash: &'a str,
+    /// The run's plan, one line per decision: what ran, what was skipped, why.
+    pub plan: &'a str,
     pub seed: u64,
     pub created_unix_s: u64,
     pub geometry: GeometrySummary<'a>,
@@ -96,6 +101,7 @@ pub struct GeometrySummary<'a> {
 pub struct ResultSummary {
     pub version: String,
     pub input_hash: String,
+    pub plan: String,
     pub seed: u64,
     pub created_unix_s: u64,
     /// One per `/solves/NNNN` group, in index order.
@@ -195,6 +201,11 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
     let root: &Location = &file;
     let version = read_str_attr(root, "inksim_version").map_err(hdf)?;
     let input_hash = read_str_attr(root, "input_hash").map_err(hdf)?;
+    let plan = file
+        .dataset("plan")
+        .and_then(|d| d.read_scalar::<VarLenUnicode>())
+        .map(|s| s.as_str().to_string())
+        .map_err(hdf)?;
     let seed: u64 = root
         .attr("seed")
         .and_then(|a| a.read_scalar())
@@ -250,6 +261,7 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
     Ok(ResultSummary {
         version,
         input_hash,
+        plan,
         seed,
         created_unix_s,
         entries,
@@ -283,6 +295,7 @@ fn check_result_set(path: &Path, set: &ResultSet) -> Result<(), IoError> {
         ("config_path", set.config_path),
         ("config text", set.config_text),
         ("input_hash", set.input_hash),
+        ("plan", set.plan),
     ];
     for (what, s) in strings {
         if s.contains('\0') {
@@ -351,6 +364,10 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
         .shape(())
         .create("config")?
         .write_scalar(&vlu(set.config_text)?)?;
+    file.new_dataset::<VarLenUnicode>()
+        .shape(())
+        .create("plan")?
+        .write_scalar(&vlu(set.plan)?)?;
 
     let g = &set.geometry;
     let geo = file.create_group("geometry")?;

@@ -295,11 +295,13 @@ fn write_result(
         .map(|d| d.as_secs())
         .unwrap_or(0);
     let config_path = scene.provenance.path.display().to_string();
+    let plan = plan_text(scene, entries);
     let set = ResultSet {
         version: crate::VERSION,
         config_path: &config_path,
         config_text: &scene.provenance.text,
         input_hash: &scene.provenance.input_hash,
+        plan: &plan,
         seed: scene.seed,
         created_unix_s: created,
         geometry: GeometrySummary {
@@ -320,4 +322,28 @@ fn write_result(
     };
     io::write_result(path, &set)?;
     Ok(())
+}
+
+/// The run's plan as stored with the results: one line per decision.
+pub fn plan_text(scene: &Scene, entries: &[SolveEntry]) -> String {
+    let (packer, why) = packer_of(scene);
+    let mut lines = vec![format!("geometry: {packer} ({why})")];
+    lines.push(format!(
+        "solves: {} wavelengths × {} incidence directions, method {:?}, tolerance {:.0e}",
+        scene.wavelengths_nm.len(),
+        scene.incidence.len(),
+        scene.solver.method,
+        scene.solver.tolerance
+    ));
+    for e in entries {
+        lines.push(format!(
+            "solve {} nm, {}°/{}°: {} ({})",
+            e.wavelength_nm,
+            e.incidence.polar_deg,
+            e.incidence.azimuth_deg,
+            e.record.method,
+            e.record.note
+        ));
+    }
+    lines.join("\n")
 }

@@ -158,6 +158,16 @@ fn run_writes_results_identical_for_one_and_two_threads() {
     };
     assert_eq!(key(&summaries[0]), key(&summaries[1]));
     assert_eq!(summaries[0].input_hash, summaries[1].input_hash);
+    let plan = &summaries[0].plan;
+    assert!(
+        plan.starts_with("geometry: rsa (spheres at PVC 0.150"),
+        "{plan}"
+    );
+    assert_eq!(
+        plan.lines().filter(|l| l.starts_with("solve ")).count(),
+        4,
+        "{plan}"
+    );
 }
 
 #[test]

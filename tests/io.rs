@@ -139,6 +139,7 @@ fn set<'a>(g: &'a Geo, e: &'a [SolveEntry], hash: &'a str, png: Option<&'a [u8]>
         version: "0.1.0",
         config_path: "configs/grün study.toml",
         config_text: CONFIG,
+        plan: "geometry: rsa (spheres at PVC 0.2)\nsolves: 2 × auto",
         input_hash: hash,
         seed: u64::MAX - 7,
         created_unix_s: 1_700_000_000,
@@ -194,6 +195,10 @@ fn summary_round_trip_is_exact() {
     let s = read_summary(&path).unwrap();
     assert_eq!(s.version, "0.1.0");
     assert_eq!(s.input_hash, "abc123");
+    assert_eq!(
+        s.plan,
+        "geometry: rsa (spheres at PVC 0.2)\nsolves: 2 × auto"
+    );
     assert_eq!(s.seed, u64::MAX - 7);
     assert_eq!(s.created_unix_s, 1_700_000_000);
     assert_eq!(s.entries.len(), e.len());

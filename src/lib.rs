@@ -3,7 +3,8 @@
 //! Data flows one way through the stages, and each module imports only from
 //! the stages before it:
 //!
-//! `config` → `geometry` → `raster` → `solver` → `farfield` → `colour` → `render` → `io`,
+//! `config` → `geometry` → `raster` → `solver` → `farfield` → `substrate` → `colour`
+//! → `render` → `io`,
 //! wired together by [`pipeline`]. [`progress`] is a leaf utility.
 //!
 //! The physics and numerics follow `METHOD.md` (shipped beside the project);
@@ -19,6 +20,7 @@ pub mod progress;
 pub mod raster;
 pub mod render;
 pub mod solver;
+pub mod substrate;
 
 /// Version string embedded in every result file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

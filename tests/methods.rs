@@ -5,15 +5,14 @@
 //! answer.
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
-use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{
     self, born::Born, green, Controls, IterativeMethod, Problem, SolveError, System, Validity,
 };
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
-const EPS_B: f64 = 1.558 * 1.558;
+mod common;
+use common::{layer_eps, packed_rsa, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-9,
     max_iterations: 20000,
@@ -112,25 +111,8 @@ fn check_airy(method: Method) {
 /// between methods (all solve the same discrete equation).
 fn check_layer(method: Method) {
     let size = [800.0, 800.0, 500.0];
-    let params = PackParams {
-        size_nm: size,
-        species: vec![SpeciesParams {
-            diameter_nm: 160.0,
-            volume_fraction: 0.25,
-        }],
-        ..PackParams::default()
-    };
-    let geom = pack_rsa(&params, 21).unwrap();
-    let grid = Grid {
-        nx: 32,
-        ny: 32,
-        nz: 50,
-        size_nm: size,
-    };
-    let raster = rasterize(&geom, &grid, 4);
-    let n = C64::new(1.4, 0.6);
-    let mut eps = Array3::from_elem((50, 32, 32), C64::new(0.0, 0.0));
-    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n * n], &mut eps);
+    let geom = packed_rsa(size, 160.0, 0.25, 21);
+    let (eps, _) = layer_eps(&geom, [32, 32, 50], C64::new(1.4, 0.6));
     let lat = Problem::lattice([32, 32, 50], size, 480.0, 25.0, 30.0);
     let p = Problem {
         lattice: lat,

@@ -9,35 +9,18 @@
 //! up at 1e-3 or worse.
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
-use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
-use ndarray::Array3;
 use num_complex::Complex64 as C64;
+
+mod common;
+use common::{layer_eps, packed_rsa, EPS_B};
 
 #[test]
 fn reflected_orders_are_reciprocal() {
     let size = [900.0, 700.0, 500.0];
-    let params = PackParams {
-        size_nm: size,
-        species: vec![SpeciesParams {
-            diameter_nm: 150.0,
-            volume_fraction: 0.2,
-        }],
-        ..PackParams::default()
-    };
-    let geom = pack_rsa(&params, 8).unwrap();
-    let grid = Grid {
-        nx: 45,
-        ny: 27,
-        nz: 50,
-        size_nm: size,
-    };
-    let raster = rasterize(&geom, &grid, 4);
-    let eps_b = 1.558f64.powi(2);
-    let n = C64::new(1.4, 0.4);
-    let mut eps = Array3::zeros((50, 27, 45));
-    raster.epsilon_into(C64::new(eps_b, 0.0), &[n * n], &mut eps);
+    let geom = packed_rsa(size, 150.0, 0.2, 8);
+    let (eps, _) = layer_eps(&geom, [45, 27, 50], C64::new(1.4, 0.4));
+    let eps_b = EPS_B;
     let ctl = Controls {
         tolerance: 1e-10,
         max_iterations: 20000,

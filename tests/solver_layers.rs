@@ -2,37 +2,21 @@
 //! time-marching rescue, the molecular-mixture limit, thread independence.
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
-use inksim::geometry::{
-    pack_rsa, Geometry, GeometryStats, PackParams, Particle, SpeciesParams, Sphere,
-};
-use inksim::raster::{rasterize, Grid};
+use inksim::geometry::{Geometry, GeometryStats, Particle, Sphere};
+use inksim::raster::Grid;
 use inksim::solver::{self, green, Controls, Problem, SolveError};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
-const EPS_B: f64 = 1.558 * 1.558;
+mod common;
+use common::{packed_rsa as packed, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
 };
 
 fn eps_grid(geom: &Geometry, grid: &Grid, n_pigment: C64) -> (Array3<C64>, f64) {
-    let raster = rasterize(geom, grid, 4);
-    let mut eps = Array3::from_elem((grid.nz, grid.ny, grid.nx), C64::new(0.0, 0.0));
-    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n_pigment * n_pigment], &mut eps);
-    (eps, raster.mean_fractions()[0])
-}
-
-fn packed(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {
-    let params = PackParams {
-        size_nm: size,
-        species: vec![SpeciesParams {
-            diameter_nm: d,
-            volume_fraction: pvc,
-        }],
-        ..PackParams::default()
-    };
-    pack_rsa(&params, seed).expect("packing")
+    common::layer_eps(geom, [grid.nx, grid.ny, grid.nz], n_pigment)
 }
 
 #[test]

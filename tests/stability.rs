@@ -9,27 +9,18 @@ use inksim::geometry::{
     pack_dynamics, DynParams, DynSpecies, Geometry, GeometryStats, Orientation, Particle, Shape,
     Sphere,
 };
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
-use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
-const EPS_B: f64 = 1.558 * 1.558;
+mod common;
+use common::{layer_eps, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20_000,
 };
 
 fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, polar: f64) {
-    let grid = Grid {
-        nx: cells[0],
-        ny: cells[1],
-        nz: cells[2],
-        size_nm: geom.size_nm,
-    };
-    let raster = rasterize(geom, &grid, 4);
-    let mut eps = Array3::zeros((cells[2], cells[1], cells[0]));
-    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n * n], &mut eps);
+    let (eps, _) = layer_eps(geom, cells, n);
     let lat = Problem::lattice(cells, geom.size_nm, lambda, polar, 0.0);
     let sol = solver::solve(
         &Problem {

@@ -3,11 +3,12 @@
 //! from below (the layer flipped).
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
-use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
 use inksim::substrate::{Hemisphere, Paper};
 use ndarray::{s, Array3};
+
+mod common;
+use common::{layer_eps, packed_rsa, EPS_B};
 use num_complex::Complex64 as C64;
 
 #[test]
@@ -38,25 +39,9 @@ fn lossless_layer_on_white_paper_returns_all_light() {
     // leaves 1.1e-3 (measured; unchanged from 6 to 12 quadrature nodes, so
     // not quadrature error), hence the 5e-3 bounds.
     let size = [600.0, 600.0, 400.0];
-    let params = PackParams {
-        size_nm: size,
-        species: vec![SpeciesParams {
-            diameter_nm: 150.0,
-            volume_fraction: 0.2,
-        }],
-        ..PackParams::default()
-    };
-    let geom = pack_rsa(&params, 4).unwrap();
-    let grid = Grid {
-        nx: 24,
-        ny: 24,
-        nz: 40,
-        size_nm: size,
-    };
-    let raster = rasterize(&geom, &grid, 4);
-    let eps_b = 1.558f64.powi(2);
-    let mut eps = Array3::zeros((40, 24, 24));
-    raster.epsilon_into(C64::new(eps_b, 0.0), &[C64::new(1.96, 0.0)], &mut eps);
+    let geom = packed_rsa(size, 150.0, 0.2, 4);
+    let (eps, _) = layer_eps(&geom, [24, 24, 40], C64::new(1.4, 0.0));
+    let eps_b = EPS_B;
     let flipped = eps.slice(s![..;-1, .., ..]).to_owned();
     let hemi = Hemisphere::new(6);
     let ctl = Controls {

@@ -38,6 +38,15 @@ enum Command {
         #[arg(long)]
         output_dir: Option<PathBuf>,
     },
+    /// Build the layer only: particle set and statistics to
+    /// <dir>/<name>-geometry.h5, a top view and cross-section to <name>-geometry.png.
+    Geometry {
+        /// Scene file (TOML).
+        config: PathBuf,
+        /// Write results here instead of the scene's [output] dir.
+        #[arg(long)]
+        output_dir: Option<PathBuf>,
+    },
     /// Validate a scene and print what a run would compute, without running it.
     Check {
         /// Scene file (TOML).
@@ -82,6 +91,18 @@ fn real_main() -> Result<()> {
                 "{} solves, worst energy balance |ΣR+ΣT+A−1| = {worst:.1e}",
                 report.entries.len()
             );
+        }
+        Command::Geometry { config, output_dir } => {
+            let mut scene = inksim::config::load_scene(&config)?;
+            if let Some(d) = output_dir {
+                scene.output.dir = d;
+            }
+            let report = inksim::pipeline::run_geometry(&scene)?;
+            for l in &report.lines {
+                println!("{l}");
+            }
+            println!("geometry: {}", report.result_path.display());
+            println!("picture: {}", report.picture_path.display());
         }
         Command::Check { config } => {
             let scene = inksim::config::load_scene(&config)?;

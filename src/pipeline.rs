@@ -324,10 +324,64 @@ fn write_result(
     Ok(())
 }
 
+/// What `inksim geometry` produced.
+pub struct GeometryReport {
+    pub result_path: PathBuf,
+    pub picture_path: PathBuf,
+    pub geometry: Geometry,
+    /// Human-readable statistics (also drawn under the picture).
+    pub lines: Vec<String>,
+}
+
+/// Build and rasterise a scene's layer only: the particle set and its
+/// statistics to `<name>-geometry.h5`, a top view and a cross-section to
+/// `<name>-geometry.png`. No solves.
+pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
+    let d = &scene.output.dir;
+    let name = &scene.output.name;
+    let result_path = d.join(format!("{name}-geometry.h5"));
+    let picture_path = d.join(format!("{name}-geometry.png"));
+    check_output_dir(d)?;
+    let geometry = build_geometry(scene)?;
+    let grid = grid_of(scene);
+    let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+    let s = &geometry.stats;
+    let (packer, _) = packer_of(scene);
+    let mut lines = vec![
+        format!(
+            "{} particles by {packer}; PVC {:.4} (target {:.4}; raster {:.4})",
+            geometry.particles.len(),
+            s.achieved_fraction.iter().sum::<f64>(),
+            scene.total_pvc(),
+            raster.mean_fractions().iter().sum::<f64>()
+        ),
+        format!(
+            "worst overlap {:.3} nm; min gap {:.3} nm",
+            s.worst_overlap_nm, s.min_gap_nm
+        ),
+    ];
+    if let Some(o) = s.order_parameter {
+        lines.push(format!("order parameter S = {o:.3}"));
+    }
+    let png = render::geometry_png(&raster, name, &lines)?;
+    io::write_atomic(&picture_path, &png)?;
+    write_result(scene, &geometry, &raster, &[], &png, &result_path)?;
+    Ok(GeometryReport {
+        result_path,
+        picture_path,
+        geometry,
+        lines,
+    })
+}
+
 /// The run's plan as stored with the results: one line per decision.
 pub fn plan_text(scene: &Scene, entries: &[SolveEntry]) -> String {
     let (packer, why) = packer_of(scene);
     let mut lines = vec![format!("geometry: {packer} ({why})")];
+    if entries.is_empty() {
+        lines.push("solves: none (geometry only)".to_string());
+        return lines.join("\n");
+    }
     lines.push(format!(
         "solves: {} wavelengths × {} incidence directions, method {:?}, tolerance {:.0e}",
         scene.wavelengths_nm.len(),

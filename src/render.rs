@@ -301,6 +301,93 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
     encode(&img, title)
 }
 
+/// A picture of a layer so a person can see it: the top view (pigment
+/// fraction averaged over the thickness) and the x–z cross-section through
+/// the middle of the fragment (pigment fraction; z down), both on the raster,
+/// with `lines` of statistics underneath. Bright = pigment, dark = binder.
+pub fn geometry_png(
+    raster: &crate::raster::Raster,
+    title: &str,
+    lines: &[String],
+) -> Result<Vec<u8>, RenderError> {
+    let g = raster.grid;
+    let (nx, ny, nz) = (g.nx, g.ny, g.nz);
+    let [dx, _, dz] = g.cell_nm();
+    let total = |iz: usize, iy: usize, ix: usize| -> f64 {
+        raster
+            .fractions
+            .iter()
+            .map(|f| f[[iz, iy, ix]])
+            .sum::<f64>()
+            .min(1.0)
+    };
+    let scale = (320 / nx.max(ny)).max(1);
+    let zscale = ((scale as f64 * dz / dx).round() as usize).max(1);
+    let margin = 20;
+    let label_h = 7 * FONT_SCALE + 8;
+    let top_w = nx * scale;
+    let cross_w = nx * scale;
+    let w = (margin * 3 + top_w + cross_w)
+        .max(margin * 2 + lines.iter().map(|l| text_width(l)).max().unwrap_or(0));
+    let h = margin * 2 + label_h * 2 + (ny * scale).max(nz * zscale) + label_h * lines.len();
+    if w * h > MAX_PIXELS {
+        return Err(RenderError::TooLarge {
+            width: w,
+            height: h,
+        });
+    }
+    let mut img = Canvas {
+        w,
+        h,
+        px: vec![0; w * h * 3],
+    };
+    img.fill([24, 24, 28]);
+    let grey = |f: f64| {
+        let v = (40.0 + 215.0 * f.clamp(0.0, 1.0)).round() as u8;
+        [v, v, (v as f64 * 0.9) as u8]
+    };
+    let (x0, y0) = (margin, margin + label_h);
+    img.text(x0, margin, &title.to_uppercase(), [230, 230, 230]);
+    img.text(x0, y0, "TOP VIEW", [200, 200, 200]);
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let f = (0..nz).map(|iz| total(iz, iy, ix)).sum::<f64>() / nz as f64;
+            for py in 0..scale {
+                for px in 0..scale {
+                    // y up in the picture.
+                    img.set(
+                        (x0 + ix * scale + px) as i64,
+                        (y0 + label_h + (ny - 1 - iy) * scale + py) as i64,
+                        grey(f),
+                    );
+                }
+            }
+        }
+    }
+    let x1 = x0 + top_w + margin;
+    img.text(x1, y0, "CROSS-SECTION X-Z", [200, 200, 200]);
+    let iy = ny / 2;
+    for iz in 0..nz {
+        for ix in 0..nx {
+            let c = grey(total(iz, iy, ix));
+            for py in 0..zscale {
+                for px in 0..scale {
+                    img.set(
+                        (x1 + ix * scale + px) as i64,
+                        (y0 + label_h + iz * zscale + py) as i64,
+                        c,
+                    );
+                }
+            }
+        }
+    }
+    let ytext = y0 + label_h + (ny * scale).max(nz * zscale) + 8;
+    for (k, l) in lines.iter().enumerate() {
+        img.text(x0, ytext + k * label_h, &l.to_uppercase(), [210, 210, 210]);
+    }
+    encode(&img, title)
+}
+
 fn encode(img: &Canvas, title: &str) -> Result<Vec<u8>, RenderError> {
     let mut out = Vec::new();
     {

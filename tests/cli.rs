@@ -211,3 +211,30 @@ fn sparse_spheres_use_random_addition() {
     assert!(ok, "{err}");
     assert!(out.contains("packer: rsa"), "{out}");
 }
+
+#[test]
+fn geometry_command_writes_particles_and_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let out = dir.path().join("geo");
+    let (ok, stdout, err) = inksim(&[
+        "geometry",
+        cfg.to_str().unwrap(),
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("8 particles by rsa; PVC 0.1414"), "{stdout}");
+    let png = std::fs::read(out.join("tiny-geometry.png")).unwrap();
+    let decoder = png::Decoder::new(std::io::Cursor::new(png));
+    let reader = decoder.read_info().unwrap();
+    assert!(reader.info().width > 100 && reader.info().height > 100);
+    let s = inksim::io::read_summary(&out.join("tiny-geometry.h5")).unwrap();
+    assert!(s.entries.is_empty());
+    assert!(
+        s.plan.contains("solves: none (geometry only)"),
+        "{}",
+        s.plan
+    );
+    assert!(!out.join("tiny.h5").exists(), "no solves were run");
+}

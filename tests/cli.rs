@@ -224,7 +224,10 @@ fn geometry_command_writes_particles_and_picture() {
         out.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    assert!(stdout.contains("8 particles by rsa; PVC 0.1414"), "{stdout}");
+    assert!(
+        stdout.contains("8 particles by rsa; PVC 0.1414"),
+        "{stdout}"
+    );
     let png = std::fs::read(out.join("tiny-geometry.png")).unwrap();
     let decoder = png::Decoder::new(std::io::Cursor::new(png));
     let reader = decoder.read_info().unwrap();

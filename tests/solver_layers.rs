@@ -293,6 +293,9 @@ fn exactly_grazing_orders_stay_finite() {
         let lat = Problem::lattice([16, 16, 40], size, lambda, 0.0, 0.0);
         let [kx, _] = lat.kappa(1, 0);
         let grazing_in = if period == lambda { 1.0 } else { 1.558 };
+        // In the binder the grazing order must take the contour-average path.
+        let table = inksim::solver::operator::GreenTable::new(&lat, C64::new(EPS_B, 0.0));
+        assert_eq!(table.special_count() > 0, period != lambda);
         assert!((kx / lat.k0 - grazing_in).abs() < 1e-12);
         for method in [
             Method::TimeMarching,

@@ -21,7 +21,7 @@
 //! a few complex operations per cell. Harmonics near `γ = 0` use a dense
 //! inverse of the contour-averaged matrix.
 
-use super::green::{self, Slab};
+use super::green;
 use super::operator::Lattice;
 use num_complex::Complex64 as C64;
 
@@ -468,11 +468,6 @@ fn dense_inverse_shift(m: &[C64], n: usize, c: C64) -> Vec<C64> {
         }
     }
     inv
-}
-
-/// Slab of a lattice (re-exported for tests).
-pub fn slab_of(lat: &Lattice) -> Slab {
-    lat.slab()
 }
 
 #[cfg(test)]

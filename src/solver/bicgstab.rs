@@ -7,7 +7,8 @@
 //! from the current iterate; convergence is confirmed on the true residual.
 
 use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, System,
+    Validity,
 };
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
@@ -49,25 +50,22 @@ impl IterativeMethod for BiCgStab {
         let mut monitor = Monitor::new(MethodUsed::BiCgStab);
         let one = C64::new(1.0, 0.0);
         loop {
-            // (Re)start: true residual, then its preconditioned form.
-            let res = sys.residual_shifted(u, &mut r);
             applications += 1;
-            if monitor.check(res, iterations, ctl)? {
-                let note = format!(
-                    "BiCGStab, ε_r = {:.4}, ε_s = {:.4}",
-                    sys.shift.er, sys.shift.es
-                );
-                return Ok(Outcome {
-                    iterations,
-                    applications,
-                    residual: res,
-                    note,
-                });
-            }
-            sys.precondition(&mut r);
-            let r0 = dot(&r, &r).re.sqrt();
-            // The preconditioned residual must fall by what the true one needs.
-            let target = 0.5 * r0 * ctl.tolerance / res;
+            let (r0, target) = match sys.restart(u, &mut r, &mut monitor, iterations, ctl)? {
+                Restart::Converged(residual) => {
+                    let note = format!(
+                        "BiCGStab, ε_r = {:.4}, ε_s = {:.4}",
+                        sys.shift.er, sys.shift.es
+                    );
+                    return Ok(Outcome {
+                        iterations,
+                        applications,
+                        residual,
+                        note,
+                    });
+                }
+                Restart::Go { norm, target } => (norm, target),
+            };
             rh.assign(&r);
             p.fill(C64::new(0.0, 0.0));
             v.fill(C64::new(0.0, 0.0));

@@ -11,7 +11,8 @@
 //! summed in a fixed order, so results do not depend on the thread count.
 
 use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, System,
+    Validity,
 };
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
@@ -55,26 +56,22 @@ impl IterativeMethod for Gmres {
         let mut applications = 0;
         let mut monitor = Monitor::new(MethodUsed::Gmres);
         loop {
-            let res = sys.residual_shifted(u, &mut r);
             applications += 1;
-            if monitor.check(res, inner, ctl)? {
-                let note = format!(
-                    "GMRES({m}), ε_r = {:.4}, ε_s = {:.4}",
-                    sys.shift.er, sys.shift.es
-                );
-                return Ok(Outcome {
-                    iterations: inner,
-                    applications,
-                    residual: res,
-                    note,
-                });
-            }
-            // Preconditioned residual starts the cycle.
-            sys.precondition(&mut r);
-            let beta = dot(&r, &r).re.sqrt();
-            // Stop the cycle when the preconditioned residual has fallen by the
-            // factor the true one still needs (with a safety margin).
-            let target = 0.5 * beta * ctl.tolerance / res;
+            let (beta, target) = match sys.restart(u, &mut r, &mut monitor, inner, ctl)? {
+                Restart::Converged(residual) => {
+                    let note = format!(
+                        "GMRES({m}), ε_r = {:.4}, ε_s = {:.4}",
+                        sys.shift.er, sys.shift.es
+                    );
+                    return Ok(Outcome {
+                        iterations: inner,
+                        applications,
+                        residual,
+                        note,
+                    });
+                }
+                Restart::Go { norm, target } => (norm, target),
+            };
             Zip::from(&mut basis[0])
                 .and(&r)
                 .par_for_each(|v, r| *v = r / beta);

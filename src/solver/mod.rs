@@ -212,6 +212,39 @@ impl Monitor {
     }
 }
 
+/// A Krylov (re)start: the true residual, checked, then preconditioned.
+pub enum Restart {
+    /// The true relative residual is at tolerance.
+    Converged(f64),
+    /// Go on from `r ← γ r'`: its norm, and the norm the preconditioned
+    /// residual must reach for the true one to be at tolerance (with a
+    /// safety factor 2).
+    Go { norm: f64, target: f64 },
+}
+
+impl System<'_> {
+    /// Shared start of a GMRES cycle or a BiCGStab run.
+    pub fn restart(
+        &mut self,
+        u: &Array3<C64>,
+        r: &mut Array3<C64>,
+        monitor: &mut Monitor,
+        iterations: usize,
+        ctl: &Controls,
+    ) -> Result<Restart, SolveError> {
+        let res = self.residual_shifted(u, r);
+        if monitor.check(res, iterations, ctl)? {
+            return Ok(Restart::Converged(res));
+        }
+        self.precondition(r);
+        let norm = dot(r, r).re.sqrt();
+        Ok(Restart::Go {
+            norm,
+            target: 0.5 * norm * ctl.tolerance / res,
+        })
+    }
+}
+
 /// An iterative method for the shared discrete equation.
 pub trait IterativeMethod {
     fn kind(&self) -> MethodUsed;

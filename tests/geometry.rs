@@ -5,7 +5,6 @@ use inksim::geometry::{
     min_gap_nm, pack_rsa, sphere_volume, Geometry, GeometryError, PackParams, Particle,
     SpeciesParams, Sphere,
 };
-use std::time::Instant;
 
 fn species(diameter_nm: f64, volume_fraction: f64) -> SpeciesParams {
     SpeciesParams {
@@ -122,9 +121,7 @@ fn dense_thin_slab_stops_with_not_reached() {
         species: vec![species(100.0, 0.45)],
         max_attempts_per_particle: 2000,
     };
-    let t = Instant::now();
     let err = pack_rsa(&params, 3).unwrap_err();
-    let secs = t.elapsed().as_secs_f64();
     match err {
         GeometryError::NotReached {
             species,
@@ -140,11 +137,15 @@ fn dense_thin_slab_stops_with_not_reached() {
             let expect = placed as f64 * sphere_volume(50.0) / (2000.0 * 2000.0 * 250.0);
             assert!((reached - expect).abs() < 1e-12, "{reached} vs {expect}");
             assert!(reached > 0.15 && reached < 0.45, "reached {reached}");
-            assert!(attempts >= 2000);
+            // Work is bounded by the attempt budget, not by luck: the
+            // failing particle used exactly its budget on top of the placed ones.
+            assert!(
+                attempts >= 2000 && attempts <= placed as u64 * 2000 + 2000,
+                "{attempts}"
+            );
         }
         other => panic!("expected NotReached, got {other}"),
     }
-    assert!(secs < 5.0, "took {secs} s");
 }
 
 /// Known limit of RSA: spheres jam well below the 0.45–0.6 the dynamics
@@ -325,13 +326,12 @@ fn min_gap_sees_periodic_images() {
 }
 
 #[test]
-fn packer_speed_large_fragment() {
-    // 10 × 10 × 1 µm at 30 % of 100 nm spheres (~57 000 particles).
+fn large_fragment_packs_fully() {
+    // 10 × 10 × 1 µm at 30 % of 100 nm spheres (~57 000 particles); about
+    // 0.6 s in release on the project machine (not asserted: timing belongs
+    // in benches, not tests).
     let params = PackParams::new([10_000.0, 10_000.0, 1_000.0], vec![species(100.0, 0.30)]);
-    let t = Instant::now();
     let g = pack_rsa(&params, 11).unwrap();
-    let secs = t.elapsed().as_secs_f64();
     assert_eq!(g.particles.len(), 57_296);
     assert!(g.stats.min_gap_nm >= 0.0);
-    assert!(secs < 20.0, "packing took {secs} s");
 }

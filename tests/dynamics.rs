@@ -1,6 +1,8 @@
 //! Stage 1, high PVC: sphere-cluster shapes and the first-order dynamics
 //! packer, checked by brute force (all pairs, 3×3 periodic images).
 
+mod common;
+use common::brute_min_gap;
 use inksim::geometry::{
     axis_from_uniforms, order_parameter, pack_dynamics, particle_axis, union_volume, DynParams,
     DynSpecies, Geometry, GeometryError, Orientation, Shape, ShapeTemplate,
@@ -24,33 +26,9 @@ const RICE: Shape = Shape::Rice {
 };
 
 /// Deepest overlap between spheres of different particles, all pairs and the
-/// 3×3 periodic images in x, y.
+/// 3×3 periodic images in x, y: minus the smallest brute-force gap.
 fn brute_worst_overlap(g: &Geometry) -> f64 {
-    let [lx, ly, _] = g.size_nm;
-    let all: Vec<_> = g
-        .particles
-        .iter()
-        .enumerate()
-        .flat_map(|(i, p)| p.spheres.iter().map(move |s| (i, *s)))
-        .collect();
-    let mut worst = f64::NEG_INFINITY;
-    for (a, (pa, sa)) in all.iter().enumerate() {
-        for (pb, sb) in &all[a + 1..] {
-            if pa == pb {
-                continue;
-            }
-            for ix in -1..=1 {
-                for iy in -1..=1 {
-                    let dx = sa.center[0] - sb.center[0] + ix as f64 * lx;
-                    let dy = sa.center[1] - sb.center[1] + iy as f64 * ly;
-                    let dz = sa.center[2] - sb.center[2];
-                    let l = sa.radius + sb.radius - (dx * dx + dy * dy + dz * dz).sqrt();
-                    worst = worst.max(l);
-                }
-            }
-        }
-    }
-    worst
+    -brute_min_gap(g)
 }
 
 /// Checks walls (within `tol`), lateral wrapping and rigid shapes.

@@ -1,6 +1,8 @@
 //! Stage 1: random sequential addition and the geometry statistics, checked
 //! against brute-force O(N²) references.
 
+mod common;
+use common::brute_min_gap;
 use inksim::geometry::{
     min_gap_nm, pack_rsa, sphere_volume, Geometry, GeometryError, PackParams, Particle,
     SpeciesParams, Sphere,
@@ -11,36 +13,6 @@ fn species(diameter_nm: f64, volume_fraction: f64) -> SpeciesParams {
         diameter_nm,
         volume_fraction,
     }
-}
-
-/// Smallest surface gap over all pairs of particles, brute force, checking
-/// the 3×3 periodic images explicitly (not just the nearest one).
-fn brute_min_gap(g: &Geometry) -> f64 {
-    let [lx, ly, _] = g.size_nm;
-    let all: Vec<(usize, Sphere)> = g
-        .particles
-        .iter()
-        .enumerate()
-        .flat_map(|(i, p)| p.spheres.iter().map(move |s| (i, *s)))
-        .collect();
-    let mut best = f64::INFINITY;
-    for (a, (pa, sa)) in all.iter().enumerate() {
-        for (pb, sb) in &all[a + 1..] {
-            if pa == pb {
-                continue;
-            }
-            for ix in -1..=1 {
-                for iy in -1..=1 {
-                    let dx = sa.center[0] - sb.center[0] + ix as f64 * lx;
-                    let dy = sa.center[1] - sb.center[1] + iy as f64 * ly;
-                    let dz = sa.center[2] - sb.center[2];
-                    let gap = (dx * dx + dy * dy + dz * dz).sqrt() - sa.radius - sb.radius;
-                    best = best.min(gap);
-                }
-            }
-        }
-    }
-    best
 }
 
 fn check_inside(g: &Geometry) {

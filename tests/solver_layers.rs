@@ -3,33 +3,22 @@
 use inksim::config::Method;
 use inksim::farfield::efficiencies;
 use inksim::geometry::{Geometry, GeometryStats, Particle, Sphere};
-use inksim::raster::Grid;
 use inksim::solver::{self, green, Controls, Problem, SolveError};
-use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::{packed_rsa as packed, EPS_B};
+use common::{layer_eps, packed_rsa as packed, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
 };
 
-fn eps_grid(geom: &Geometry, grid: &Grid, n_pigment: C64) -> (Array3<C64>, f64) {
-    common::layer_eps(geom, [grid.nx, grid.ny, grid.nz], n_pigment)
-}
-
 #[test]
 fn energy_balance_on_random_absorbing_layer() {
     let size = [1000.0, 1000.0, 600.0];
     let geom = packed(size, 200.0, 0.2, 3);
-    let grid = Grid {
-        nx: 40,
-        ny: 40,
-        nz: 60,
-        size_nm: size,
-    };
-    let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.5));
+    let cells = [40, 40, 60];
+    let (eps, _) = layer_eps(&geom, cells, C64::new(1.4, 0.5));
     for polar in [0.0, 45.0] {
         let lat = Problem::lattice([40, 40, 60], size, 520.0, polar, 0.0);
         let sol = solver::solve(
@@ -116,13 +105,8 @@ fn dense_lattice() -> (Geometry, [f64; 3]) {
 #[test]
 fn born_reports_divergence_and_time_marching_converges() {
     let (geom, size) = dense_lattice();
-    let grid = Grid {
-        nx: 32,
-        ny: 32,
-        nz: 64,
-        size_nm: size,
-    };
-    let (eps, f) = eps_grid(&geom, &grid, C64::new(1.4, 0.8));
+    let cells = [32, 32, 64];
+    let (eps, f) = layer_eps(&geom, cells, C64::new(1.4, 0.8));
     assert!((f - 0.4).abs() < 0.01, "fill {f}");
     let lat = Problem::lattice([32, 32, 64], size, 450.0, 20.0, 0.0);
     let p = Problem {
@@ -175,17 +159,12 @@ fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
 fn shrinking_grains_approach_the_volume_averaged_slab() {
     let size = [480.0, 480.0, 500.0];
     let n_p = C64::new(1.4, 0.3);
-    let grid = Grid {
-        nx: 48,
-        ny: 48,
-        nz: 50,
-        size_nm: size,
-    };
+    let cells = [48, 48, 50];
     let lambda = 600.0;
     let mut errs = vec![];
     for d in [160.0, 80.0, 40.0, 20.0] {
         let geom = packed(size, d, 0.2, 11);
-        let (eps, f) = eps_grid(&geom, &grid, n_p);
+        let (eps, f) = layer_eps(&geom, cells, n_p);
         let lat = Problem::lattice([48, 48, 50], size, lambda, 0.0, 0.0);
         let sol = solver::solve(
             &Problem {
@@ -220,13 +199,8 @@ fn shrinking_grains_approach_the_volume_averaged_slab() {
 fn same_result_for_one_and_two_threads() {
     let size = [600.0, 600.0, 400.0];
     let geom = packed(size, 150.0, 0.2, 5);
-    let grid = Grid {
-        nx: 24,
-        ny: 24,
-        nz: 30,
-        size_nm: size,
-    };
-    let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.6));
+    let cells = [24, 24, 30];
+    let (eps, _) = layer_eps(&geom, cells, C64::new(1.4, 0.6));
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -283,13 +257,8 @@ fn exactly_grazing_orders_stay_finite() {
             particles,
             stats,
         };
-        let grid = Grid {
-            nx: 16,
-            ny: 16,
-            nz: 40,
-            size_nm: size,
-        };
-        let (eps, _) = eps_grid(&geom, &grid, C64::new(1.4, 0.5));
+        let cells = [16, 16, 40];
+        let (eps, _) = layer_eps(&geom, cells, C64::new(1.4, 0.5));
         let lat = Problem::lattice([16, 16, 40], size, lambda, 0.0, 0.0);
         let [kx, _] = lat.kappa(1, 0);
         let grazing_in = if period == lambda { 1.0 } else { 1.558 };

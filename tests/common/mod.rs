@@ -1,7 +1,8 @@
-//! Set-up shared by the solver tests: a layer of one pigment in the binder.
+//! Set-up shared by the tests: a layer of one pigment in the binder, and a
+//! brute-force check of particle gaps.
 #![allow(dead_code)]
 
-use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams};
+use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
 use inksim::raster::{rasterize, Grid};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
@@ -35,4 +36,34 @@ pub fn layer_eps(geom: &Geometry, cells: [usize; 3], n: C64) -> (Array3<C64>, f6
     let mut eps = Array3::zeros((cells[2], cells[1], cells[0]));
     raster.epsilon_into(C64::new(EPS_B, 0.0), &[n * n], &mut eps);
     (eps, raster.mean_fractions()[0])
+}
+
+/// Smallest surface gap over all pairs of particles, brute force, checking
+/// the 3×3 periodic images explicitly (not just the nearest one).
+pub fn brute_min_gap(g: &Geometry) -> f64 {
+    let [lx, ly, _] = g.size_nm;
+    let all: Vec<(usize, Sphere)> = g
+        .particles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, p)| p.spheres.iter().map(move |s| (i, *s)))
+        .collect();
+    let mut best = f64::INFINITY;
+    for (a, (pa, sa)) in all.iter().enumerate() {
+        for (pb, sb) in &all[a + 1..] {
+            if pa == pb {
+                continue;
+            }
+            for ix in -1..=1 {
+                for iy in -1..=1 {
+                    let dx = sa.center[0] - sb.center[0] + ix as f64 * lx;
+                    let dy = sa.center[1] - sb.center[1] + iy as f64 * ly;
+                    let dz = sa.center[2] - sb.center[2];
+                    let gap = (dx * dx + dy * dy + dz * dz).sqrt() - sa.radius - sb.radius;
+                    best = best.min(gap);
+                }
+            }
+        }
+    }
+    best
 }

@@ -123,7 +123,7 @@ pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
         .iter()
         .map(|s| DynSpecies {
             shape: match s.shape {
-                GrainShape::Sphere => Shape::Sphere,
+                GrainShape::Sphere | GrainShape::Molecular => Shape::Sphere,
                 GrainShape::Cylinder { aspect, spheres } => Shape::Cylinder { aspect, spheres },
                 GrainShape::Rice { aspect, spheres } => Shape::Rice { aspect, spheres },
             },

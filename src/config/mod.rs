@@ -13,7 +13,7 @@ mod validate;
 use std::path::{Path, PathBuf};
 
 pub use materials::{Material, MaterialError, MaterialSource};
-pub use validate::{load_scene, parse_scene};
+pub use validate::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
 /// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).
@@ -73,7 +73,8 @@ pub struct Species {
     pub material: Material,
     /// Target volume fraction of the layer (PVC share of this species), 0..1.
     pub volume_fraction: f64,
-    /// Effective diameter in nm: the diameter of the sphere of equal volume.
+    /// Effective diameter in nm: the diameter of the sphere of equal volume
+    /// (0 for [`GrainShape::Molecular`]).
     pub diameter_nm: f64,
     pub shape: GrainShape,
     pub orientation: GrainOrientation,
@@ -85,6 +86,9 @@ pub struct Species {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum GrainShape {
     Sphere,
+    /// Dissolved to molecular size: the layer is the homogeneous slab with
+    /// the volume-averaged ε (METHOD §7's molecular-mixture limit).
+    Molecular,
     /// Equal spheres on the axis; `aspect` = length / diameter.
     Cylinder {
         aspect: f64,
@@ -153,12 +157,51 @@ pub struct OutputSpec {
     pub name: String,
 }
 
+/// What lies under the layer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Substrate {
+    /// Nothing: the layer alone in vacuum.
+    None,
+    /// Flat Lambertian paper of the given albedo (METHOD §5).
+    Paper { albedo: f64 },
+}
+
+/// Which appearance products a scene asks for; each one decides which solves
+/// and stages run (see `pipeline::plan`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Products {
+    /// Binned diffuse BRDF table and the specular split.
+    pub brdf: bool,
+    /// Binned BTDF table.
+    pub btdf: bool,
+    /// The colour tile of METHOD §6 (natural-light strip + BRDF square).
+    pub tile: bool,
+    /// The BRDF exported in MERL's binary format (RGB, isotropic).
+    pub merl: bool,
+}
+
+/// How the far field becomes appearance.
+#[derive(Debug, Clone)]
+pub struct Appearance {
+    /// Polar viewing angles (deg, increasing): the tile's rows.
+    pub viewing_deg: Vec<f64>,
+    pub products: Products,
+    /// Cell of the angular BRDF/BTDF table in projected direction
+    /// coordinates `sin θ (cos φ, sin φ)`; `None`: 2 λ_max / min(Lx, Ly).
+    pub brdf_cell: Option<f64>,
+    /// Gauss–Legendre nodes in cos θ for hemispherical integrals.
+    pub quadrature_points: usize,
+}
+
 /// A validated scene: every value is in range and every material covers every
 /// requested wavelength.
 #[derive(Debug, Clone)]
 pub struct Scene {
     pub provenance: Provenance,
     pub seed: u64,
+    /// Independent random fragments averaged (seed of realisation k derived
+    /// from `seed` and k).
+    pub realisations: usize,
     pub layer: Layer,
     pub species: Vec<Species>,
     pub grid: GridSpec,
@@ -166,12 +209,21 @@ pub struct Scene {
     pub incidence: Vec<Incidence>,
     pub solver: SolverSpec,
     pub output: OutputSpec,
+    pub appearance: Appearance,
+    pub substrate: Substrate,
 }
 
 impl Scene {
     /// Total pigment volume concentration requested.
     pub fn total_pvc(&self) -> f64 {
         self.species.iter().map(|s| s.volume_fraction).sum()
+    }
+
+    /// Whether the pigments are dissolved (homogeneous layer, no grains).
+    pub fn is_molecular(&self) -> bool {
+        self.species
+            .iter()
+            .all(|s| s.shape == GrainShape::Molecular)
     }
 
     /// File the scene was read from.

@@ -12,6 +12,7 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct RawConfig {
     pub seed: Option<i64>,
+    pub realisations: Option<i64>,
     pub layer: RawLayer,
     #[serde(default)]
     pub pigment: Vec<RawPigment>,
@@ -19,6 +20,8 @@ pub struct RawConfig {
     pub illumination: RawIllumination,
     pub solver: Option<RawSolver>,
     pub output: Option<RawOutput>,
+    pub appearance: Option<RawAppearance>,
+    pub substrate: Option<RawSubstrate>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -27,6 +30,8 @@ pub struct RawLayer {
     pub thickness_nm: f64,
     pub fragment_nm: Vec<f64>,
     pub binder_index: Option<f64>,
+    /// Total PVC, shared among the pigments by their `share`.
+    pub pvc: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -34,8 +39,9 @@ pub struct RawLayer {
 pub struct RawPigment {
     pub name: String,
     pub material: RawMaterial,
-    pub pvc: f64,
-    pub diameter_nm: f64,
+    pub pvc: Option<f64>,
+    pub share: Option<f64>,
+    pub diameter_nm: Option<f64>,
     pub shape: Option<RawShape>,
     pub orientation: Option<RawOrientation>,
     pub alignment_field: Option<f64>,
@@ -47,6 +53,7 @@ pub struct RawPigment {
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum RawShape {
     Sphere,
+    Molecular,
     Cylinder {
         aspect: Option<f64>,
         spheres: Option<i64>,
@@ -124,4 +131,30 @@ pub enum RawMethod {
 pub struct RawOutput {
     pub dir: Option<String>,
     pub name: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAppearance {
+    pub viewing_deg: Option<Vec<f64>>,
+    pub outputs: Option<Vec<RawProduct>>,
+    pub brdf_cell: Option<f64>,
+    pub quadrature_points: Option<i64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawProduct {
+    Brdf,
+    Btdf,
+    Tile,
+    Merl,
+}
+
+/// `{ kind = "paper", albedo = 0.9 }` or `{ kind = "none" }`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawSubstrate {
+    Paper { albedo: Option<f64> },
+    None,
 }

@@ -21,11 +21,12 @@
 //! - `Provenance::input_hash` is SHA-256 over the config text followed by each
 //!   pigment's table text, in pigment order.
 
+use super::raw::{RawAppearance, RawProduct, RawSubstrate};
 use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
 use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSolver};
 use super::{
-    ConfigError, GrainOrientation, GrainShape, GridSpec, Incidence, Layer, Material, Method,
-    OutputSpec, Provenance, Scene, SolverSpec, Species, MAX_PVC,
+    Appearance, ConfigError, GrainOrientation, GrainShape, GridSpec, Incidence, Layer, Material,
+    Method, OutputSpec, Products, Provenance, Scene, SolverSpec, Species, Substrate, MAX_PVC,
 };
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
@@ -43,6 +44,10 @@ const MAX_POLAR_DEG: f64 = 89.0;
 pub const DEFAULT_Z_CELL_NM: f64 = 10.0;
 const DEFAULT_BINDER_INDEX: f64 = 1.558;
 const DEFAULT_SEED: u64 = 1;
+const MAX_REALISATIONS: i64 = 10_000;
+/// Paper albedo of the reference study (METHOD §8).
+pub const DEFAULT_PAPER_ALBEDO: f64 = 0.9;
+const DEFAULT_QUADRATURE_POINTS: i64 = 6;
 const DEFAULT_TOLERANCE: f64 = 1e-6;
 const DEFAULT_MAX_ITERATIONS: usize = 5000;
 const MAX_ITERATIONS: i64 = 10_000_000;
@@ -120,13 +125,25 @@ impl Checker<'_> {
             Some(s) if s >= 0 => s as u64,
             Some(s) => return Err(self.invalid("seed", format!("must be >= 0, got {s}"))),
         };
+        let realisations = match raw.realisations {
+            None => 1,
+            Some(r) if (1..=MAX_REALISATIONS).contains(&r) => r as usize,
+            Some(r) => {
+                return Err(self.invalid(
+                    "realisations",
+                    format!("must be in [1, {MAX_REALISATIONS}], got {r}"),
+                ))
+            }
+        };
         let layer = self.layer(&raw.layer)?;
-        let species = self.pigments(&raw.pigment, &layer)?;
+        let species = self.pigments(&raw.pigment, &layer, raw.layer.pvc)?;
         let grid = self.grid(&raw.grid, &layer)?;
         let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
         let incidence = self.incidence(&raw.illumination)?;
         let solver = self.solver(raw.solver.as_ref())?;
         let output = self.output(path, raw.output.as_ref())?;
+        let appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
+        let substrate = self.substrate(raw.substrate.as_ref())?;
 
         for &wl in &wavelengths_nm {
             for s in &species {
@@ -161,6 +178,7 @@ impl Checker<'_> {
                 input_hash,
             },
             seed,
+            realisations,
             layer,
             species,
             grid,
@@ -168,6 +186,99 @@ impl Checker<'_> {
             incidence,
             solver,
             output,
+            appearance,
+            substrate,
+        })
+    }
+
+    fn appearance(
+        &self,
+        raw: Option<&RawAppearance>,
+        incidence: &[Incidence],
+    ) -> Result<Appearance, ConfigError> {
+        let viewing_deg = match raw.and_then(|a| a.viewing_deg.as_ref()) {
+            None => incidence.iter().map(|i| i.polar_deg).collect(),
+            Some(list) => {
+                let key = "appearance.viewing_deg";
+                if list.is_empty() {
+                    return Err(self.invalid(key, "must not be empty"));
+                }
+                for (i, &v) in list.iter().enumerate() {
+                    let k = format!("{key}[{i}]");
+                    self.range(
+                        &k,
+                        v,
+                        (0.0..=MAX_POLAR_DEG).contains(&v),
+                        &format!("[0, {MAX_POLAR_DEG}] deg"),
+                    )?;
+                    if i > 0 && v <= list[i - 1] {
+                        return Err(self.invalid(
+                            k,
+                            format!(
+                                "values must be strictly increasing, got {v} after {}",
+                                list[i - 1]
+                            ),
+                        ));
+                    }
+                }
+                list.clone()
+            }
+        };
+        let mut products = Products::default();
+        let list = raw
+            .and_then(|a| a.outputs.clone())
+            .unwrap_or_else(|| vec![RawProduct::Brdf, RawProduct::Tile]);
+        for p in list {
+            match p {
+                RawProduct::Brdf => products.brdf = true,
+                RawProduct::Btdf => products.btdf = true,
+                RawProduct::Tile => products.tile = true,
+                RawProduct::Merl => products.merl = true,
+            }
+        }
+        let brdf_cell = match raw.and_then(|a| a.brdf_cell) {
+            None => None,
+            Some(c) => Some(self.range(
+                "appearance.brdf_cell",
+                c,
+                c > 0.0 && c <= 1.0,
+                "(0, 1] (in units of sin θ)",
+            )?),
+        };
+        let q = raw
+            .and_then(|a| a.quadrature_points)
+            .unwrap_or(DEFAULT_QUADRATURE_POINTS);
+        if !(2..=32).contains(&q) {
+            return Err(self.invalid(
+                "appearance.quadrature_points",
+                format!("must be in [2, 32], got {q}"),
+            ));
+        }
+        Ok(Appearance {
+            viewing_deg,
+            products,
+            brdf_cell,
+            quadrature_points: q as usize,
+        })
+    }
+
+    fn substrate(&self, raw: Option<&RawSubstrate>) -> Result<Substrate, ConfigError> {
+        Ok(match raw {
+            Some(RawSubstrate::None) => Substrate::None,
+            None => Substrate::Paper {
+                albedo: DEFAULT_PAPER_ALBEDO,
+            },
+            Some(RawSubstrate::Paper { albedo }) => {
+                let a = albedo.unwrap_or(DEFAULT_PAPER_ALBEDO);
+                Substrate::Paper {
+                    albedo: self.range(
+                        "substrate.albedo",
+                        a,
+                        (0.0..=1.0).contains(&a),
+                        "[0, 1]",
+                    )?,
+                }
+            }
         })
     }
 
@@ -208,9 +319,74 @@ impl Checker<'_> {
         })
     }
 
-    fn pigments(&self, raw: &[RawPigment], layer: &Layer) -> Result<Vec<Species>, ConfigError> {
+    fn pigments(
+        &self,
+        raw: &[RawPigment],
+        layer: &Layer,
+        total_pvc: Option<f64>,
+    ) -> Result<Vec<Species>, ConfigError> {
         if raw.is_empty() {
             return Err(self.invalid("pigment", "at least one [[pigment]] table is required"));
+        }
+        if let Some(t) = total_pvc {
+            self.range(
+                "layer.pvc",
+                t,
+                t > 0.0 && t <= MAX_PVC,
+                &format!("(0, {MAX_PVC}] (the most the packer reaches)"),
+            )?;
+        }
+        let mut shares = Vec::with_capacity(raw.len());
+        for (i, p) in raw.iter().enumerate() {
+            let key = |field: &str| format!("pigment[{i}].{field}");
+            match (total_pvc, p.pvc, p.share) {
+                (Some(_), Some(_), _) => {
+                    return Err(self.invalid(
+                        key("pvc"),
+                        "layer.pvc is given: set this pigment's `share` of it instead",
+                    ))
+                }
+                (None, _, Some(_)) => {
+                    return Err(self.invalid(
+                        key("share"),
+                        "a share needs the total layer.pvc; or give this pigment's pvc",
+                    ))
+                }
+                (None, None, None) => {
+                    return Err(self.invalid(
+                        key("pvc"),
+                        "missing; give each pigment's pvc, or layer.pvc with shares",
+                    ))
+                }
+                (None, Some(v), None) => shares.push(v),
+                (Some(_), None, sh) => {
+                    let sh = sh.unwrap_or(1.0);
+                    shares.push(self.range(
+                        &key("share"),
+                        sh,
+                        sh > 0.0 && sh.is_finite(),
+                        "(0, inf)",
+                    )?);
+                }
+            }
+        }
+        let fractions: Vec<f64> = match total_pvc {
+            None => shares,
+            Some(t) => {
+                let sum: f64 = shares.iter().sum();
+                shares.iter().map(|s| t * s / sum).collect()
+            }
+        };
+        let molecular: Vec<bool> = raw
+            .iter()
+            .map(|p| matches!(p.shape, Some(RawShape::Molecular)))
+            .collect();
+        if molecular.iter().any(|&m| m) && !molecular.iter().all(|&m| m) {
+            let i = molecular.iter().position(|&m| !m).unwrap_or(0);
+            return Err(self.invalid(
+                format!("pigment[{i}].shape"),
+                "another pigment is molecular; dissolved and particulate pigments cannot be mixed",
+            ));
         }
         let mut seen: HashMap<&str, usize> = HashMap::new();
         let mut species = Vec::with_capacity(raw.len());
@@ -231,16 +407,25 @@ impl Checker<'_> {
                 ));
             }
             let material = self.material(&p.material, &key("material"))?;
-            let volume_fraction =
-                self.range(&key("pvc"), p.pvc, p.pvc > 0.0 && p.pvc < 1.0, "(0, 1)")?;
-            let d = p.diameter_nm;
-            let diameter_nm = self.range(
-                &key("diameter_nm"),
-                d,
-                d > 0.0 && d <= max_d,
-                &format!("(0, {max_d}] nm (at most the layer thickness and the fragment size)"),
-            )?;
+            let vf = fractions[i];
+            let vf_key = if total_pvc.is_some() {
+                "layer.pvc".to_string()
+            } else {
+                key("pvc")
+            };
+            let volume_fraction = self.range(&vf_key, vf, vf > 0.0 && vf < 1.0, "(0, 1)")?;
             let shape = self.shape(p.shape.as_ref(), &key("shape"))?;
+            // A molecular pigment's diameter is not used (documented).
+            let diameter_nm = match (shape, p.diameter_nm) {
+                (GrainShape::Molecular, _) => 0.0,
+                (_, None) => return Err(self.invalid(key("diameter_nm"), "missing")),
+                (_, Some(d)) => self.range(
+                    &key("diameter_nm"),
+                    d,
+                    d > 0.0 && d <= max_d,
+                    &format!("(0, {max_d}] nm (at most the layer thickness and the fragment size)"),
+                )?,
+            };
             let orientation = match p.orientation {
                 None | Some(RawOrientation::Random) => GrainOrientation::Random,
                 Some(RawOrientation::InPlane) => GrainOrientation::InPlane,
@@ -259,8 +444,12 @@ impl Checker<'_> {
                     "needs orientation \"in-plane\" or \"perpendicular\" (the direction it aligns towards)",
                 ));
             }
-            if alignment_field > 0.0 && shape == GrainShape::Sphere {
-                return Err(self.invalid(key("alignment_field"), "spheres have no axis to align"));
+            if alignment_field > 0.0 && matches!(shape, GrainShape::Sphere | GrainShape::Molecular)
+            {
+                return Err(self.invalid(
+                    key("alignment_field"),
+                    "spheres and dissolved pigments have no axis to align",
+                ));
             }
             species.push(Species {
                 name: name.to_string(),
@@ -302,6 +491,7 @@ impl Checker<'_> {
         };
         Ok(match raw {
             None | Some(RawShape::Sphere) => GrainShape::Sphere,
+            Some(RawShape::Molecular) => GrainShape::Molecular,
             Some(RawShape::Cylinder { aspect, spheres }) => {
                 let (aspect, spheres) = parts(*aspect, *spheres, 3.0, 5)?;
                 if (spheres as f64) <= aspect - 1.0 {

@@ -41,6 +41,11 @@ use std::cmp::Ordering;
 use crate::config::Incidence;
 use crate::farfield::{Order, SolveEntry};
 
+pub mod canvas;
+#[cfg(test)]
+use canvas::glyph;
+pub use canvas::{text_width, Canvas, FONT_SCALE, GLYPH_ADVANCE, GLYPH_HEIGHT};
+
 /// Radius of a panel's disk of directions, in pixels.
 pub const DISK_RADIUS_PX: f64 = 60.0;
 /// Standard deviation of an order's dot, in pixels.
@@ -51,9 +56,6 @@ pub const LOG_DECADES: f64 = 4.0;
 /// Side of the square cell that holds one panel.
 const CELL_PX: usize = 140;
 /// Font scale (5×7 glyphs drawn as 10×14 pixels, advance 12).
-const FONT_SCALE: usize = 2;
-const GLYPH_ADVANCE: usize = 6 * FONT_SCALE;
-const GLYPH_HEIGHT: usize = 7 * FONT_SCALE;
 const MARGIN: usize = 12;
 /// Largest image produced (pixels), to refuse absurd grids instead of
 /// allocating gigabytes.
@@ -82,6 +84,10 @@ pub enum RenderError {
     TooLarge { width: usize, height: usize },
     #[error("render: PNG encoding failed: {0}")]
     Encode(#[from] png::EncodingError),
+    #[error("render: PNG decoding failed: {0}")]
+    Decode(#[from] png::DecodingError),
+    #[error("render: unsupported PNG ({0}); need 8-bit RGB or RGBA")]
+    Format(String),
 }
 
 /// Where the panels of a picture lie; computed from the entries alone.
@@ -281,7 +287,7 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
                 let b = 0.2 + 0.8 * t.clamp(0.0, 1.0);
                 let (sx, sy) = order_direction(o);
                 let (x, y) = layout.direction_px(row, col, sx, sy);
-                img.splat(x, y, tint, b);
+                splat(&mut img, x, y, tint, b);
             }
         }
     }
@@ -298,7 +304,7 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
         }
     }
 
-    encode(&img, title)
+    img.encode_png(title)
 }
 
 /// A picture of a layer so a person can see it: the top view (pigment
@@ -385,24 +391,7 @@ pub fn geometry_png(
     for (k, l) in lines.iter().enumerate() {
         img.text(x0, ytext + k * label_h, &l.to_uppercase(), [210, 210, 210]);
     }
-    encode(&img, title)
-}
-
-fn encode(img: &Canvas, title: &str) -> Result<Vec<u8>, RenderError> {
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, img.w as u32, img.h as u32);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let keyword_ok = title.chars().all(|c| c != '\0');
-        if keyword_ok && !title.is_empty() {
-            enc.add_itxt_chunk("Title".into(), title.into())?;
-        }
-        let mut writer = enc.write_header()?;
-        writer.write_image_data(&img.px)?;
-        writer.finish()?;
-    }
-    Ok(out)
+    img.encode_png(title)
 }
 
 fn check_entries(entries: &[SolveEntry]) -> Result<(), RenderError> {
@@ -552,162 +541,22 @@ fn legend_lines(scale: Option<(f64, f64)>) -> Vec<String> {
     ]
 }
 
-fn text_width(s: &str) -> usize {
-    s.chars().count() * GLYPH_ADVANCE
-}
-
-/// An RGB8 image; all drawing clips at the border.
-struct Canvas {
-    w: usize,
-    h: usize,
-    px: Vec<u8>,
-}
-
-impl Canvas {
-    fn fill(&mut self, c: [u8; 3]) {
-        for p in self.px.chunks_exact_mut(3) {
-            p.copy_from_slice(&c);
-        }
-    }
-
-    fn index(&self, x: i64, y: i64) -> Option<usize> {
-        (x >= 0 && y >= 0 && (x as usize) < self.w && (y as usize) < self.h)
-            .then(|| (y as usize * self.w + x as usize) * 3)
-    }
-
-    fn set(&mut self, x: i64, y: i64, c: [u8; 3]) {
-        if let Some(i) = self.index(x, y) {
-            self.px[i..i + 3].copy_from_slice(&c);
-        }
-    }
-
-    fn disk(&mut self, cx: f64, cy: f64, r: f64, c: [u8; 3]) {
-        let (x0, x1) = ((cx - r).floor() as i64, (cx + r).ceil() as i64);
-        let (y0, y1) = ((cy - r).floor() as i64, (cy + r).ceil() as i64);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let (dx, dy) = (x as f64 - cx, y as f64 - cy);
-                if dx * dx + dy * dy <= r * r {
-                    self.set(x, y, c);
-                }
+/// Gaussian dot of peak brightness `b`, combined by per-channel maximum.
+fn splat(img: &mut Canvas, x: f64, y: f64, tint: [f64; 3], b: f64) {
+    let reach = (3.0 * DOT_SIGMA_PX).ceil() as i64;
+    let (xc, yc) = (x.round() as i64, y.round() as i64);
+    for py in yc - reach..=yc + reach {
+        for px in xc - reach..=xc + reach {
+            let Some(i) = img.index(px, py) else {
+                continue;
+            };
+            let (dx, dy) = (px as f64 - x, py as f64 - y);
+            let g = (-(dx * dx + dy * dy) / (2.0 * DOT_SIGMA_PX * DOT_SIGMA_PX)).exp();
+            let c = to_rgb8(tint, b * g);
+            for (p, v) in img.px[i..i + 3].iter_mut().zip(c) {
+                *p = (*p).max(v);
             }
         }
-    }
-
-    fn ring(&mut self, cx: f64, cy: f64, r: f64, c: [u8; 3]) {
-        let steps = (2.0 * std::f64::consts::PI * r * 2.0).ceil().max(8.0) as usize;
-        for k in 0..steps {
-            let a = 2.0 * std::f64::consts::PI * k as f64 / steps as f64;
-            self.set(
-                (cx + r * a.cos()).round() as i64,
-                (cy + r * a.sin()).round() as i64,
-                c,
-            );
-        }
-    }
-
-    /// Gaussian dot of peak brightness `b`, combined by per-channel maximum.
-    fn splat(&mut self, x: f64, y: f64, tint: [f64; 3], b: f64) {
-        let reach = (3.0 * DOT_SIGMA_PX).ceil() as i64;
-        let (xc, yc) = (x.round() as i64, y.round() as i64);
-        for py in yc - reach..=yc + reach {
-            for px in xc - reach..=xc + reach {
-                let Some(i) = self.index(px, py) else {
-                    continue;
-                };
-                let (dx, dy) = (px as f64 - x, py as f64 - y);
-                let g = (-(dx * dx + dy * dy) / (2.0 * DOT_SIGMA_PX * DOT_SIGMA_PX)).exp();
-                let c = to_rgb8(tint, b * g);
-                for (p, v) in self.px[i..i + 3].iter_mut().zip(c) {
-                    *p = (*p).max(v);
-                }
-            }
-        }
-    }
-
-    fn text(&mut self, x: usize, y: usize, s: &str, c: [u8; 3]) {
-        for (k, ch) in s.chars().enumerate() {
-            let g = glyph(ch);
-            let x0 = x + k * GLYPH_ADVANCE;
-            for (row, bits) in g.iter().enumerate() {
-                for col in 0..5 {
-                    if bits & (0x10 >> col) == 0 {
-                        continue;
-                    }
-                    for dy in 0..FONT_SCALE {
-                        for dx in 0..FONT_SCALE {
-                            self.set(
-                                (x0 + col * FONT_SCALE + dx) as i64,
-                                (y + row * FONT_SCALE + dy) as i64,
-                                c,
-                            );
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// 5×7 glyph rows, bit 4 = leftmost column.
-fn glyph(c: char) -> [u8; 7] {
-    match c.to_ascii_uppercase() {
-        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
-        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
-        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
-        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
-        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
-        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
-        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
-        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
-        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
-        'A' => [0x0E, 0x11, 0x11, 0x11, 0x1F, 0x11, 0x11],
-        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
-        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
-        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
-        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
-        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
-        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
-        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
-        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
-        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
-        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
-        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
-        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
-        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
-        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
-        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
-        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
-        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
-        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
-        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
-        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
-        ' ' => [0; 7],
-        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
-        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
-        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
-        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
-        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
-        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
-        ';' => [0, 0x0C, 0x0C, 0, 0x0C, 0x04, 0x08],
-        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
-        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
-        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
-        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
-        '[' => [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E],
-        ']' => [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E],
-        '<' => [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02],
-        '>' => [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08],
-        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
-        '\'' => [0x0C, 0x04, 0x08, 0, 0, 0, 0],
-        '°' => [0x0C, 0x12, 0x12, 0x0C, 0, 0, 0],
-        _ => [0x0E, 0x11, 0x01, 0x02, 0x04, 0, 0x04], // '?'
     }
 }
 

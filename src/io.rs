@@ -106,6 +106,20 @@ pub struct ResultSummary {
     pub created_unix_s: u64,
     /// One per `/solves/NNNN` group, in index order.
     pub entries: Vec<EntrySummary>,
+    /// The colour of the layer (on its substrate) under natural light, when
+    /// the file has an `/appearance` group.
+    pub appearance: Option<AppearanceSummary>,
+}
+
+/// The headline colour figures of a result, from `/appearance`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AppearanceSummary {
+    /// Viewing polar angles, deg.
+    pub viewing_deg: Vec<f64>,
+    /// sRGB (8 bit) under a uniform white sky, one per viewing angle.
+    pub natural_srgb8: Vec<[u8; 3]>,
+    /// CIELAB (D65 white) of the same, one per viewing angle.
+    pub natural_lab: Vec<[f64; 3]>,
 }
 
 /// The per-solve numbers of a result file.
@@ -258,6 +272,36 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
             residual: f("residual")?,
         });
     }
+    let appearance = if file.link_exists("appearance") {
+        let g = file.group("appearance").map_err(hdf)?;
+        let viewing_deg: Vec<f64> = g
+            .dataset("viewing_deg")
+            .and_then(|d| d.read_raw())
+            .map_err(hdf)?;
+        let rgb: Vec<u8> = g
+            .dataset("natural_srgb8")
+            .and_then(|d| d.read_raw())
+            .map_err(hdf)?;
+        let lab: Vec<f64> = g
+            .dataset("natural_lab")
+            .and_then(|d| d.read_raw())
+            .map_err(hdf)?;
+        let n = viewing_deg.len();
+        if rgb.len() != 3 * n || lab.len() != 3 * n {
+            return Err(format(format!(
+                "/appearance: {n} viewing angles but {} sRGB and {} Lab values",
+                rgb.len(),
+                lab.len()
+            )));
+        }
+        Some(AppearanceSummary {
+            viewing_deg,
+            natural_srgb8: rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            natural_lab: lab.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
+    } else {
+        None
+    };
     Ok(ResultSummary {
         version,
         input_hash,
@@ -265,6 +309,7 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
         seed,
         created_unix_s,
         entries,
+        appearance,
     })
 }
 

@@ -20,6 +20,7 @@ pub mod progress;
 pub mod raster;
 pub mod render;
 pub mod solver;
+pub mod study;
 pub mod substrate;
 
 /// Version string embedded in every result file.

@@ -154,6 +154,12 @@ pub fn grid_of(scene: &Scene) -> Grid {
     }
 }
 
+/// Number of Helmholtz solves a run of `scene` performs (what `inksim plan`
+/// reports; a run's result holds exactly this many `/solves` entries).
+pub fn planned_solves(scene: &Scene) -> usize {
+    scene.wavelengths_nm.len() * scene.incidence.len()
+}
+
 /// Solve every (wavelength, incidence) of a scene on a given raster.
 pub fn solve_all(
     scene: &Scene,

@@ -25,13 +25,19 @@
 //!   `particle_of_sphere` (N u32), `species_of_particle` (P u32),
 //!   `species_names` (S variable-length UTF-8 strings),
 //!   `target_fraction`, `achieved_fraction`, `raster_fraction` (S f64 each);
-//! - attribute `min_gap_nm` (f64).
+//! - attribute `min_gap_nm` (f64; absent for a molecular mixture, which has
+//!   no grains).
+//!
+//! `/realisations` (group): `seed` (R u64), `achieved_pvc` (R f64), the
+//! geometry of each random fragment (`/geometry` holds realisation 0's).
 //!
 //! `/solves/NNNN` (one group per solve, `NNNN` = zero-padded index 0000, 0001, …
 //! in the order given), attributes:
 //! `wavelength_nm`, `polar_deg`, `azimuth_deg`, `total_reflectance`,
 //! `total_transmittance`, `absorption`, `energy_balance` (f64), `r00`, `t00`
-//! (2 × f64: re, im), `method` (string: `born` | `time-marching` | `gmres` | `bicgstab`),
+//! (2 × f64: re, im), `method` (string: `born` | `time-marching` | `gmres` | `bicgstab` | `airy`),
+//! `side` (string: `above` | `below`, the face lit; below = layer flipped),
+//! `realisation` (u64),
 //! `iterations`, `operator_applications` (u64), `residual`, `seconds` (f64),
 //! `note` (string); datasets over the K propagating orders: `orders_mn`
 //! (K × 2 i32: m, n), `orders_theta_deg`, `orders_phi_deg`,
@@ -43,6 +49,27 @@
 //! in Python: `h5py.File(p)["summary"]["reflectance"]`.
 //!
 //! `/picture_png` — the rendered PNG as a 1-D u8 dataset (present when given).
+//!
+//! `/appearance` (group, present when the scene asked for appearance
+//! products), ensemble means over the realisations with standard errors
+//! (`*_se`, same shape, present when R ≥ 2). Axes: L wavelengths, A polar
+//! angles solved from above, I illumination and V viewing angles, Q
+//! quadrature nodes from below, N×N table nodes.
+//! - `wavelengths_nm` (L), `above_deg` (A), `illumination_deg` (I),
+//!   `viewing_deg` (V), `below_deg` (Q, may be empty); attributes
+//!   `azimuth_deg`, `table_cell` (node spacing in sin θ), `realisations` (u64);
+//! - `reflectance`, `transmittance`, `absorption` (L × A);
+//!   `specular_coherent`, `specular_incoherent`, `direct_coherent`,
+//!   `direct_incoherent` (L × A: |⟨r00⟩|², ⟨|r00|²⟩ − |⟨r00⟩|², same for t00);
+//! - `brdf_table` (L × I × N × N: density f cos θ on nodes
+//!   s = (i − N/2, j − N/2)·cell, row j along sin θ sin φ), `brdf_diffuse`
+//!   (L × I × V, 1/sr, plane of incidence, specular side); `btdf_table`,
+//!   `btdf_diffuse` likewise when requested;
+//! - with paper: attribute `paper_albedo`, `r_dd_up`, `t_d` (L);
+//! - with the tile: `brdf_total` (L × I × V, layer + substrate, 1/sr),
+//!   `natural` (L × V, radiance factor under a uniform white sky),
+//!   `tile_srgb8` (V × (1 + I) × 3 u8), `natural_srgb8` (V × 3 u8),
+//!   `natural_lab` (V × 3 f64), `tile_png` (u8).
 
 use std::fs;
 use std::io::Write;
@@ -53,7 +80,8 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{H5Type, Location};
 use ndarray::Array2;
 
-use crate::farfield::SolveEntry;
+use crate::appearance::{Appearance, Estimate};
+use crate::farfield::{Side, SolveEntry};
 use crate::solver::MethodUsed;
 
 /// Version of the layout described in the module docs, stored as `format_version`.
@@ -78,6 +106,11 @@ pub struct ResultSet<'a> {
     pub size_nm: [f64; 3],
     pub entries: &'a [SolveEntry],
     pub picture_png: Option<&'a [u8]>,
+    /// Seed and achieved PVC of each realisation.
+    pub realisations: &'a [(u64, f64)],
+    pub appearance: Option<&'a Appearance>,
+    /// The tile PNG (stored in `/appearance`).
+    pub tile_png: Option<&'a [u8]>,
 }
 
 /// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
@@ -93,7 +126,8 @@ pub struct GeometrySummary<'a> {
     pub target_fraction: &'a [f64],
     pub achieved_fraction: &'a [f64],
     pub raster_fraction: &'a [f64],
-    pub min_gap_nm: f64,
+    /// Smallest surface gap between grains (None: no grains).
+    pub min_gap_nm: Option<f64>,
 }
 
 /// What [`read_summary`] returns.
@@ -111,7 +145,8 @@ pub struct ResultSummary {
     pub appearance: Option<AppearanceSummary>,
 }
 
-/// The headline colour figures of a result, from `/appearance`.
+/// The headline colour figures of a result, from `/appearance` (present
+/// when the scene asked for the tile).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AppearanceSummary {
     /// Viewing polar angles, deg.
@@ -125,6 +160,8 @@ pub struct AppearanceSummary {
 /// The per-solve numbers of a result file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EntrySummary {
+    pub side: Side,
+    pub realisation: usize,
     pub wavelength_nm: f64,
     pub polar_deg: f64,
     pub azimuth_deg: f64,
@@ -256,7 +293,16 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
         let method: MethodUsed = method_text
             .parse()
             .map_err(|e: String| format(format!("/solves/{name}: attribute `method`: {e}")))?;
+        let side_text = read_str_attr(&g, "side").map_err(hdf)?;
+        let side: Side = side_text
+            .parse()
+            .map_err(|e: String| format(format!("/solves/{name}: attribute `side`: {e}")))?;
         entries.push(EntrySummary {
+            side,
+            realisation: g
+                .attr("realisation")
+                .and_then(|a| a.read_scalar::<u64>())
+                .map_err(hdf)? as usize,
             wavelength_nm: f("wavelength_nm")?,
             polar_deg: f("polar_deg")?,
             azimuth_deg: f("azimuth_deg")?,
@@ -272,7 +318,12 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
             residual: f("residual")?,
         });
     }
-    let appearance = if file.link_exists("appearance") {
+    let has_colours = file.link_exists("appearance")
+        && file
+            .group("appearance")
+            .map_err(hdf)?
+            .link_exists("natural_srgb8");
+    let appearance = if has_colours {
         let g = file.group("appearance").map_err(hdf)?;
         let viewing_deg: Vec<f64> = g
             .dataset("viewing_deg")
@@ -446,7 +497,18 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     geo.new_dataset_builder()
         .with_data(g.raster_fraction)
         .create("raster_fraction")?;
-    write_scalar_attr(&geo, "min_gap_nm", g.min_gap_nm)?;
+    if let Some(gap) = g.min_gap_nm {
+        write_scalar_attr(&geo, "min_gap_nm", gap)?;
+    }
+    let real = file.create_group("realisations")?;
+    let seeds: Vec<u64> = set.realisations.iter().map(|r| r.0).collect();
+    let pvc: Vec<f64> = set.realisations.iter().map(|r| r.1).collect();
+    real.new_dataset_builder()
+        .with_data(&seeds[..])
+        .create("seed")?;
+    real.new_dataset_builder()
+        .with_data(&pvc[..])
+        .create("achieved_pvc")?;
 
     let solves = file.create_group("solves")?;
     let mut rows = Vec::with_capacity(set.entries.len());
@@ -475,7 +537,99 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
             .with_data(png)
             .create("picture_png")?;
     }
+    if let Some(app) = set.appearance {
+        write_appearance(file, app, set.tile_png)?;
+    }
     file.flush()
+}
+
+fn write_estimate<D: ndarray::Dimension>(
+    g: &hdf5::Group,
+    name: &str,
+    e: &Estimate<D>,
+) -> hdf5::Result<()> {
+    g.new_dataset_builder()
+        .with_data(e.mean.view())
+        .create(name)?;
+    if let Some(se) = &e.se {
+        g.new_dataset_builder()
+            .with_data(se.view())
+            .create(format!("{name}_se").as_str())?;
+    }
+    Ok(())
+}
+
+fn write_appearance(
+    file: &hdf5::File,
+    a: &Appearance,
+    tile_png: Option<&[u8]>,
+) -> hdf5::Result<()> {
+    let g = file.create_group("appearance")?;
+    let sp = &a.spec;
+    let below = sp.below.as_ref().map(|h| h.polar_deg()).unwrap_or_default();
+    for (name, v) in [
+        ("wavelengths_nm", &sp.wavelengths_nm),
+        ("above_deg", &sp.above_deg),
+        ("illumination_deg", &sp.illumination_deg),
+        ("viewing_deg", &sp.viewing_deg),
+        ("below_deg", &below),
+    ] {
+        g.new_dataset_builder().with_data(&v[..]).create(name)?;
+    }
+    write_scalar_attr(&g, "azimuth_deg", sp.azimuth_deg)?;
+    write_scalar_attr(&g, "table_cell", sp.table.cell)?;
+    write_scalar_attr(&g, "realisations", sp.realisations as u64)?;
+    write_estimate(&g, "reflectance", &a.reflectance)?;
+    write_estimate(&g, "transmittance", &a.transmittance)?;
+    write_estimate(&g, "absorption", &a.absorption)?;
+    for (name, v) in [
+        ("specular_coherent", &a.specular_coherent),
+        ("specular_incoherent", &a.specular_incoherent),
+        ("direct_coherent", &a.direct_coherent),
+        ("direct_incoherent", &a.direct_incoherent),
+    ] {
+        g.new_dataset_builder().with_data(v.view()).create(name)?;
+    }
+    write_estimate(&g, "brdf_table", &a.brdf_table)?;
+    write_estimate(&g, "brdf_diffuse", &a.brdf_diffuse)?;
+    if let Some(t) = &a.btdf_table {
+        write_estimate(&g, "btdf_table", t)?;
+    }
+    if let Some(t) = &a.btdf_diffuse {
+        write_estimate(&g, "btdf_diffuse", t)?;
+    }
+    if let Some(p) = &a.paper {
+        write_scalar_attr(&g, "paper_albedo", p.albedo)?;
+        write_estimate(&g, "r_dd_up", &p.r_dd_up)?;
+        write_estimate(&g, "t_d", &p.t_d)?;
+    }
+    if let Some(t) = &a.brdf_total {
+        g.new_dataset_builder()
+            .with_data(t.view())
+            .create("brdf_total")?;
+    }
+    if let Some(n) = &a.natural {
+        g.new_dataset_builder()
+            .with_data(n.view())
+            .create("natural")?;
+    }
+    if let Some(c) = &a.colours {
+        g.new_dataset_builder()
+            .with_data(c.tile_srgb8.view())
+            .create("tile_srgb8")?;
+        let rgb = Array2::from_shape_fn((c.natural_srgb8.len(), 3), |(i, j)| c.natural_srgb8[i][j]);
+        g.new_dataset_builder()
+            .with_data(&rgb)
+            .create("natural_srgb8")?;
+        let lab = Array2::from_shape_fn((c.natural_lab.len(), 3), |(i, j)| c.natural_lab[i][j]);
+        g.new_dataset_builder()
+            .with_data(&lab)
+            .create("natural_lab")?;
+    }
+    if let Some(png) = tile_png {
+        g.new_dataset_builder().with_data(png).create("tile_png")?;
+    }
+    Ok(())
 }
 
 fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
@@ -501,6 +655,8 @@ fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
         .with_data(&[eff.t00.re, eff.t00.im][..])
         .create("t00")?;
     write_str_attr(g, "method", &rec.method.to_string())?;
+    write_str_attr(g, "side", &e.side.to_string())?;
+    write_scalar_attr(g, "realisation", e.realisation as u64)?;
     write_scalar_attr(g, "iterations", rec.iterations as u64)?;
     write_scalar_attr(g, "operator_applications", rec.operator_applications as u64)?;
     write_str_attr(g, "note", &rec.note)?;

@@ -4,17 +4,19 @@
 //! the stages before it:
 //!
 //! `config` → `geometry` → `raster` → `solver` → `farfield` → `substrate` → `colour`
-//! → `render` → `io`,
+//! → `appearance` → `render` → `io`,
 //! wired together by [`pipeline`]. [`progress`] is a leaf utility.
 //!
 //! The physics and numerics follow `METHOD.md` (shipped beside the project);
 //! each stage's module docs state what it owns and which choices it made.
 
+pub mod appearance;
 pub mod colour;
 pub mod config;
 pub mod farfield;
 pub mod geometry;
 pub mod io;
+pub mod merl;
 pub mod pipeline;
 pub mod progress;
 pub mod raster;

@@ -7,17 +7,22 @@
 //! results are written atomically (temp file + rename), so an interrupted run
 //! leaves either the previous file or the complete new one.
 
-use crate::config::{GrainOrientation, GrainShape, Scene};
-use crate::farfield::{self, SolveEntry};
+use crate::appearance::{self, Appearance, AppearanceSpec};
+use crate::colour::Observer;
+use crate::config::{GrainOrientation, GrainShape, Incidence, Scene, Substrate};
+use crate::farfield::table::TableSpec;
+use crate::farfield::{self, Side, SolveEntry};
 use crate::geometry::{
     self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SpeciesParams,
 };
 use crate::io::{self, GeometrySummary, ResultSet};
+use crate::merl;
 use crate::progress::Progress;
 use crate::raster::{self, Grid, Raster};
 use crate::render;
-use crate::solver::{self, Controls, Problem};
-use ndarray::Array3;
+use crate::solver::{self, airy, Controls, MethodUsed, Problem, SolveRecord};
+use crate::substrate::Hemisphere;
+use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 use std::path::{Path, PathBuf};
 
@@ -46,14 +51,23 @@ pub enum PipelineError {
     Io(#[from] io::IoError),
     #[error("render: {0}")]
     Render(#[from] render::RenderError),
+    #[error(transparent)]
+    Appearance(#[from] appearance::AppearanceError),
+    #[error("MERL export: {0}")]
+    Merl(#[from] merl::MerlError),
 }
 
 /// What a finished run produced.
 pub struct RunReport {
     pub result_path: PathBuf,
+    /// The tile (or the orders picture when no tile was asked for).
     pub picture_path: PathBuf,
-    pub geometry: Geometry,
+    /// Every reflected order of every solve, drawn per wavelength and angle.
+    pub orders_picture_path: PathBuf,
+    /// Geometry of realisation 0 (None for a molecular mixture).
+    pub geometry: Option<Geometry>,
     pub entries: Vec<SolveEntry>,
+    pub appearance: Option<Appearance>,
 }
 
 /// Paths of the result files of a scene.
@@ -99,8 +113,13 @@ pub fn packer_of(scene: &Scene) -> (&'static str, String) {
     }
 }
 
-/// Build the particle set of a scene with the packer it needs.
+/// Build the particle set of a scene (realisation 0) with the packer it needs.
 pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
+    build_geometry_seeded(scene, scene.seed)
+}
+
+/// Build the particle set of a scene from a given seed.
+pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, PipelineError> {
     let l = &scene.layer;
     let size_nm = [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm];
     if packer_of(scene).0 == "rsa" {
@@ -116,7 +135,7 @@ pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
                 .collect(),
             ..PackParams::default()
         };
-        return Ok(geometry::pack_rsa(&params, scene.seed)?);
+        return Ok(geometry::pack_rsa(&params, seed)?);
     }
     let species = scene
         .species
@@ -139,7 +158,7 @@ pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
         .collect();
     Ok(geometry::pack_dynamics(
         &DynParams::new(size_nm, species),
-        scene.seed,
+        seed,
     )?)
 }
 
@@ -154,16 +173,257 @@ pub fn grid_of(scene: &Scene) -> Grid {
     }
 }
 
+/// Seed of realisation `r`: the scene's seed for r = 0 (so a
+/// one-realisation run equals the plain scene), else SplitMix64 of
+/// `seed + r · 0x9E3779B97F4A7C15` — fixed by (seed, r), never by scheduling.
+pub fn realisation_seed(seed: u64, r: usize) -> u64 {
+    if r == 0 {
+        return seed;
+    }
+    let mut z = seed.wrapping_add((r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// What a run computes and what it skips, derived from what the scene asks
+/// for (issue #6: only the effects a scene calls for).
+#[derive(Debug, Clone)]
+pub struct RunPlan {
+    /// Homogeneous layer in closed form: no geometry, grid or iteration.
+    pub analytic: bool,
+    /// Realisations actually run (1 for a deterministic homogeneous layer).
+    pub realisations: usize,
+    pub seeds: Vec<u64>,
+    /// Polar angles solved from above.
+    pub above_deg: Vec<f64>,
+    /// Quadrature for light from below (paper term), if needed.
+    pub below: Option<Hemisphere>,
+    pub table: TableSpec,
+    /// One line per decision: what runs, what is skipped, and why.
+    pub lines: Vec<String>,
+}
+
+impl RunPlan {
+    /// Derive the plan of a scene.
+    pub fn of(scene: &Scene) -> RunPlan {
+        let mut lines = Vec::new();
+        let products = scene.appearance.products;
+        let analytic = scene.is_molecular();
+        if analytic {
+            lines.push(
+                "geometry: none — molecular mixture: the homogeneous slab with the \
+                 volume-averaged ε, solved in closed form (Airy); no grid, no iteration"
+                    .to_string(),
+            );
+        } else {
+            let (packer, why) = packer_of(scene);
+            lines.push(format!("geometry: {packer} ({why})"));
+        }
+        let realisations = if analytic { 1 } else { scene.realisations };
+        if analytic && scene.realisations > 1 {
+            lines.push(format!(
+                "realisations: 1 of {} requested — a homogeneous layer is deterministic",
+                scene.realisations
+            ));
+        } else {
+            lines.push(format!(
+                "realisations: {realisations}{}",
+                if realisations == 1 {
+                    " (no standard errors; the specular split needs ≥ 2)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        let seeds = (0..realisations)
+            .map(|r| realisation_seed(scene.seed, r))
+            .collect();
+        let illum: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
+        let mut above = illum.clone();
+        if products.tile {
+            for &v in &scene.appearance.viewing_deg {
+                if !above.contains(&v) {
+                    above.push(v);
+                }
+            }
+            above.sort_by(f64::total_cmp);
+        }
+        let extra = above.len() - illum.len();
+        lines.push(format!(
+            "solves from above at {} polar angles {}{}",
+            above.len(),
+            fmt_list(&above),
+            if extra > 0 {
+                format!(" ({extra} viewing angles beyond the illumination angles: the tile needs R and T there)")
+            } else {
+                String::new()
+            }
+        ));
+        let paper = matches!(scene.substrate, Substrate::Paper { .. });
+        let below = if products.tile && paper {
+            let h = Hemisphere::new(scene.appearance.quadrature_points);
+            lines.push(format!(
+                "solves from below (layer flipped) at {} Gauss–Legendre nodes {}: the paper term needs R_dd↑ and T_d",
+                h.mu.len(),
+                fmt_list(&h.polar_deg())
+            ));
+            Some(h)
+        } else if !paper {
+            lines.push("solves from below: skipped — no substrate".to_string());
+            None
+        } else {
+            lines.push(
+                "solves from below: skipped — no tile requested, nothing uses the paper term"
+                    .to_string(),
+            );
+            None
+        };
+        let max_wl = scene.wavelengths_nm.iter().copied().fold(0.0, f64::max);
+        let l = &scene.layer;
+        let cell = scene
+            .appearance
+            .brdf_cell
+            .unwrap_or_else(|| TableSpec::default_cell(max_wl, [l.fragment_x_nm, l.fragment_y_nm]));
+        let table = TableSpec::new(cell);
+        lines.push(format!(
+            "BRDF table: cell {cell:.4} in sin θ ({}), {}×{} nodes",
+            if scene.appearance.brdf_cell.is_some() {
+                "set"
+            } else {
+                "default 2 λ_max / L"
+            },
+            table.n(),
+            table.n()
+        ));
+        lines.push(if products.btdf {
+            "BTDF table: computed (requested)".to_string()
+        } else {
+            "BTDF table: skipped — not requested".to_string()
+        });
+        lines.push(if products.tile {
+            "tile: computed (sky strip + BRDF square, CIE 1931 2°, D65, sRGB)".to_string()
+        } else {
+            "tile and colours: skipped — not requested".to_string()
+        });
+        if products.merl {
+            lines.push(
+                "MERL export: written beside the result (approximation: see docs)".to_string(),
+            );
+        }
+        RunPlan {
+            analytic,
+            realisations,
+            seeds,
+            above_deg: above,
+            below,
+            table,
+            lines,
+        }
+    }
+
+    /// Solves per realisation and wavelength.
+    pub fn solves_per_wavelength(&self) -> usize {
+        self.above_deg.len() + self.below.as_ref().map_or(0, |h| h.mu.len())
+    }
+
+    /// Total solves of a run.
+    pub fn solves(&self, scene: &Scene) -> usize {
+        self.realisations * scene.wavelengths_nm.len() * self.solves_per_wavelength()
+    }
+}
+
+fn fmt_list(v: &[f64]) -> String {
+    let items: Vec<String> = v
+        .iter()
+        .map(|x| format!("{}", (x * 100.0).round() / 100.0))
+        .collect();
+    format!("[{}]°", items.join(", "))
+}
+
 /// Number of Helmholtz solves a run of `scene` performs (what `inksim plan`
 /// reports; a run's result holds exactly this many `/solves` entries).
 pub fn planned_solves(scene: &Scene) -> usize {
-    scene.wavelengths_nm.len() * scene.incidence.len()
+    RunPlan::of(scene).solves(scene)
 }
 
-/// Solve every (wavelength, incidence) of a scene on a given raster.
-pub fn solve_all(
+/// Permittivity of every species at a wavelength.
+fn species_eps(scene: &Scene, lambda: f64) -> Result<Vec<C64>, PipelineError> {
+    scene
+        .species
+        .iter()
+        .map(|s| {
+            s.material
+                .index_at(lambda)
+                .map(|n| n * n)
+                .ok_or_else(|| PipelineError::Material {
+                    material: s.material.name.clone(),
+                    wavelength_nm: lambda,
+                })
+        })
+        .collect()
+}
+
+/// The polar angles and sides solved per wavelength, in solve order.
+fn incidences(scene: &Scene, plan: &RunPlan) -> Vec<(Side, Incidence)> {
+    let az = scene.incidence.first().map_or(0.0, |i| i.azimuth_deg);
+    let mut out: Vec<(Side, Incidence)> = plan
+        .above_deg
+        .iter()
+        .map(|&p| {
+            (
+                Side::Above,
+                Incidence {
+                    polar_deg: p,
+                    azimuth_deg: az,
+                },
+            )
+        })
+        .collect();
+    if let Some(h) = &plan.below {
+        for p in h.polar_deg() {
+            out.push((
+                Side::Below,
+                Incidence {
+                    polar_deg: p,
+                    azimuth_deg: az,
+                },
+            ));
+        }
+    }
+    out
+}
+
+fn log_solve(progress: &Progress, e: &SolveEntry) {
+    let eff = &e.efficiencies;
+    progress.inc(
+        1,
+        &format!(
+            "{} nm, {}° {}{}: R {:.4} T {:.4} A {:.4} ({} {} it, balance {:.1e})",
+            e.wavelength_nm,
+            (e.incidence.polar_deg * 100.0).round() / 100.0,
+            e.side,
+            if e.realisation > 0 {
+                format!(" #{}", e.realisation)
+            } else {
+                String::new()
+            },
+            eff.total_reflectance,
+            eff.total_transmittance,
+            eff.absorption,
+            e.record.method,
+            e.record.iterations,
+            eff.energy_balance
+        ),
+    );
+}
+
+/// Solve every (wavelength, incidence, side) of one realisation on a raster.
+pub fn solve_realisation(
     scene: &Scene,
+    plan: &RunPlan,
     raster: &Raster,
+    realisation: usize,
     progress: &Progress,
 ) -> Result<Vec<SolveEntry>, PipelineError> {
     let g = raster.grid;
@@ -172,24 +432,20 @@ pub fn solve_all(
         tolerance: scene.solver.tolerance,
         max_iterations: scene.solver.max_iterations,
     };
+    let incs = incidences(scene, plan);
     let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
+    let mut flipped = plan
+        .below
+        .as_ref()
+        .map(|_| Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0)));
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
-        let eps_species = scene
-            .species
-            .iter()
-            .map(|s| {
-                s.material
-                    .index_at(lambda)
-                    .map(|n| n * n)
-                    .ok_or_else(|| PipelineError::Material {
-                        material: s.material.name.clone(),
-                        wavelength_nm: lambda,
-                    })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let eps_species = species_eps(scene, lambda)?;
         raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
-        for inc in &scene.incidence {
+        if let Some(f) = flipped.as_mut() {
+            f.assign(&eps.slice(s![..;-1, .., ..]));
+        }
+        for (side, inc) in &incs {
             let lattice = Problem::lattice(
                 [g.nx, g.ny, g.nz],
                 g.size_nm,
@@ -197,9 +453,13 @@ pub fn solve_all(
                 inc.polar_deg,
                 inc.azimuth_deg,
             );
+            let grid_eps = match (side, flipped.as_ref()) {
+                (Side::Below, Some(f)) => f,
+                _ => &eps,
+            };
             let p = Problem {
                 lattice,
-                eps: &eps,
+                eps: grid_eps,
                 eps_binder: eps_b,
             };
             let sol = solver::solve(&p, scene.solver.method, &ctl).map_err(|source| {
@@ -209,105 +469,263 @@ pub fn solve_all(
                     source,
                 }
             })?;
-            let eff = farfield::efficiencies(&sol);
-            progress.inc(
-                1,
-                &format!(
-                    "{lambda} nm, {}°: R {:.4} T {:.4} A {:.4} ({} {} it, balance {:.1e})",
-                    inc.polar_deg,
-                    eff.total_reflectance,
-                    eff.total_transmittance,
-                    eff.absorption,
-                    sol.record.method,
-                    sol.record.iterations,
-                    eff.energy_balance
-                ),
-            );
-            entries.push(SolveEntry {
+            let entry = SolveEntry {
                 wavelength_nm: lambda,
                 incidence: *inc,
-                efficiencies: eff,
+                side: *side,
+                realisation,
+                efficiencies: farfield::efficiencies(&sol),
                 record: sol.record,
-            });
+            };
+            log_solve(progress, &entry);
+            entries.push(entry);
         }
     }
     Ok(entries)
 }
 
+/// The homogeneous slab of a molecular mixture, `⟨ε⟩ = Σ f ε_s + (1 − Σ f) ε_b`,
+/// in closed form for every (wavelength, incidence, side).
+pub fn solve_analytic(
+    scene: &Scene,
+    plan: &RunPlan,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    let eps_b = C64::new(scene.layer.binder_index.powi(2), 0.0);
+    let total: f64 = scene.total_pvc();
+    let incs = incidences(scene, plan);
+    let mut entries = Vec::new();
+    for &lambda in &scene.wavelengths_nm {
+        let eps_s = species_eps(scene, lambda)?;
+        let mean = scene
+            .species
+            .iter()
+            .zip(&eps_s)
+            .fold(eps_b * (1.0 - total), |acc, (s, e)| {
+                acc + e * s.volume_fraction
+            });
+        for (side, inc) in &incs {
+            let start = std::time::Instant::now();
+            // A homogeneous slab is symmetric: from below = from above.
+            let resp = airy::slab(mean, scene.layer.thickness_nm, lambda, inc.polar_deg);
+            let entry = SolveEntry {
+                wavelength_nm: lambda,
+                incidence: *inc,
+                side: *side,
+                realisation: 0,
+                efficiencies: farfield::slab_efficiencies(&resp, inc),
+                record: SolveRecord {
+                    method: MethodUsed::Airy,
+                    iterations: 0,
+                    operator_applications: 0,
+                    residual: 0.0,
+                    seconds: start.elapsed().as_secs_f64(),
+                    note: format!(
+                        "molecular mixture: homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form",
+                        mean.re, mean.im
+                    ),
+                },
+            };
+            log_solve(progress, &entry);
+            entries.push(entry);
+        }
+    }
+    Ok(entries)
+}
+
+/// The appearance assembly parameters of a scene under its plan.
+pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
+    AppearanceSpec {
+        wavelengths_nm: scene.wavelengths_nm.clone(),
+        azimuth_deg: scene.incidence.first().map_or(0.0, |i| i.azimuth_deg),
+        illumination_deg: scene.incidence.iter().map(|i| i.polar_deg).collect(),
+        viewing_deg: scene.appearance.viewing_deg.clone(),
+        above_deg: plan.above_deg.clone(),
+        below: plan.below.clone(),
+        paper_albedo: match scene.substrate {
+            Substrate::Paper { albedo } => Some(albedo),
+            Substrate::None => None,
+        },
+        table: plan.table,
+        realisations: plan.realisations,
+        btdf: scene.appearance.products.btdf,
+        tile: scene.appearance.products.tile,
+    }
+}
+
 /// Run a scene end to end and write its result files.
 pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
     let (result_path, picture_path) = result_paths(scene);
+    let orders_path = scene
+        .output
+        .dir
+        .join(format!("{}-orders.png", scene.output.name));
     check_output_dir(&scene.output.dir)?;
-    let total = (scene.wavelengths_nm.len() * scene.incidence.len()) as u64;
-    let progress = Progress::new(total, &scene.output.name);
-    let (packer, why) = packer_of(scene);
-    progress.log(&format!("geometry: {packer} ({why})"));
-    let geometry = build_geometry(scene)?;
-    let s = &geometry.stats;
-    progress.log(&format!(
-        "geometry: {} particles, PVC {:.4} (target {:.4}), worst overlap {:.3} nm{}",
-        geometry.particles.len(),
-        s.achieved_fraction.iter().sum::<f64>(),
-        scene.total_pvc(),
-        s.worst_overlap_nm,
-        s.order_parameter
-            .map(|o| format!(", order parameter S = {o:.3}"))
-            .unwrap_or_default()
-    ));
-    let grid = grid_of(scene);
-    let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
-    progress.log(&format!(
-        "raster: {} × {} × {} voxels",
-        grid.nx, grid.ny, grid.nz
-    ));
-    let entries = solve_all(scene, &raster, &progress)?;
+    let plan = RunPlan::of(scene);
+    let progress = Progress::new(plan.solves(scene) as u64, &scene.output.name);
+    for l in &plan.lines {
+        progress.log(l);
+    }
+    let mut entries = Vec::new();
+    let mut realisations = Vec::new();
+    let mut first: Option<(Geometry, Raster)> = None;
+    if plan.analytic {
+        entries = solve_analytic(scene, &plan, &progress)?;
+        realisations.push((scene.seed, scene.total_pvc()));
+    } else {
+        let grid = grid_of(scene);
+        for (r, &seed) in plan.seeds.iter().enumerate() {
+            let geometry = build_geometry_seeded(scene, seed)?;
+            let st = &geometry.stats;
+            let pvc: f64 = st.achieved_fraction.iter().sum();
+            progress.log(&format!(
+                "geometry{}: {} particles, PVC {:.4} (target {:.4}), worst overlap {:.3} nm{}",
+                if plan.realisations > 1 {
+                    format!(" #{r} (seed {seed})")
+                } else {
+                    String::new()
+                },
+                geometry.particles.len(),
+                pvc,
+                scene.total_pvc(),
+                st.worst_overlap_nm,
+                st.order_parameter
+                    .map(|o| format!(", order parameter S = {o:.3}"))
+                    .unwrap_or_default()
+            ));
+            let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+            if r == 0 {
+                progress.log(&format!(
+                    "raster: {} × {} × {} voxels",
+                    grid.nx, grid.ny, grid.nz
+                ));
+            }
+            entries.extend(solve_realisation(scene, &plan, &raster, r, &progress)?);
+            realisations.push((seed, pvc));
+            if first.is_none() {
+                first = Some((geometry, raster));
+            }
+        }
+    }
     progress.finish("all solves done");
 
-    let png = render::diffuse_brdf_png(&entries, &scene.output.name)?;
-    io::write_atomic(&picture_path, &png)?;
-    write_result(scene, &geometry, &raster, &entries, &png, &result_path)?;
+    let above: Vec<SolveEntry> = entries
+        .iter()
+        .filter(|e| e.side == Side::Above)
+        .cloned()
+        .collect();
+    let orders_png = render::diffuse_brdf_png(&above, &scene.output.name)?;
+    let products = scene.appearance.products;
+    let wants_appearance = products.brdf || products.btdf || products.tile || products.merl;
+    let appearance = if wants_appearance {
+        let obs = Observer::cie1931_d65();
+        Some(appearance::assemble(
+            &appearance_spec(scene, &plan),
+            &entries,
+            &obs,
+        )?)
+    } else {
+        None
+    };
+    let tile_png = match appearance.as_ref().and_then(|a| a.colours.as_ref()) {
+        Some(c) => Some(render::tile::tile_png(
+            &c.tile_srgb8,
+            &scene.appearance.viewing_deg,
+            &appearance_spec(scene, &plan).illumination_deg,
+            &scene.output.name,
+        )?),
+        None => None,
+    };
+    if let (Some(a), true) = (appearance.as_ref(), products.merl) {
+        let merl = merl::encode(a)?;
+        io::write_atomic(
+            &scene
+                .output
+                .dir
+                .join(format!("{}.binary", scene.output.name)),
+            &merl,
+        )?;
+    }
+    io::write_atomic(&orders_path, &orders_png)?;
+    io::write_atomic(&picture_path, tile_png.as_deref().unwrap_or(&orders_png))?;
+    let plan_text = plan_text(&plan, &entries);
+    write_result(
+        scene,
+        first.as_ref(),
+        &entries,
+        &realisations,
+        &plan_text,
+        Pictures {
+            orders: &orders_png,
+            tile: tile_png.as_deref(),
+        },
+        appearance.as_ref(),
+        &result_path,
+    )?;
     Ok(RunReport {
         result_path,
         picture_path,
-        geometry,
+        orders_picture_path: orders_path,
+        geometry: first.map(|f| f.0),
         entries,
+        appearance,
     })
 }
 
+struct Pictures<'a> {
+    orders: &'a [u8],
+    tile: Option<&'a [u8]>,
+}
+
+#[allow(clippy::too_many_arguments)]
 fn write_result(
     scene: &Scene,
-    geometry: &Geometry,
-    raster: &Raster,
+    layer: Option<&(Geometry, Raster)>,
     entries: &[SolveEntry],
-    png: &[u8],
+    realisations: &[(u64, f64)],
+    plan: &str,
+    pictures: Pictures,
+    appearance: Option<&Appearance>,
     path: &Path,
 ) -> Result<(), PipelineError> {
     let mut centers = Vec::new();
     let mut radii = Vec::new();
     let mut particle_of_sphere = Vec::new();
     let mut species_of_particle = Vec::new();
-    for (i, p) in geometry.particles.iter().enumerate() {
-        species_of_particle.push(p.species as u32);
-        for s in &p.spheres {
-            centers.push(s.center);
-            radii.push(s.radius);
-            particle_of_sphere.push(i as u32);
-        }
-    }
     let names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
-    let raster_fraction = raster.mean_fractions();
+    let targets: Vec<f64> = scene.species.iter().map(|s| s.volume_fraction).collect();
+    let (achieved, raster_fraction, min_gap, grid) = match layer {
+        Some((geometry, raster)) => {
+            for (i, p) in geometry.particles.iter().enumerate() {
+                species_of_particle.push(p.species as u32);
+                for s in &p.spheres {
+                    centers.push(s.center);
+                    radii.push(s.radius);
+                    particle_of_sphere.push(i as u32);
+                }
+            }
+            (
+                geometry.stats.achieved_fraction.clone(),
+                raster.mean_fractions(),
+                Some(geometry.stats.min_gap_nm),
+                [raster.grid.nx, raster.grid.ny, raster.grid.nz],
+            )
+        }
+        // A molecular mixture is exactly its target composition.
+        None => (targets.clone(), targets.clone(), None, [0, 0, 0]),
+    };
     let created = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs())
         .unwrap_or(0);
     let config_path = scene.provenance.path.display().to_string();
-    let plan = plan_text(scene, entries);
+    let l = &scene.layer;
     let set = ResultSet {
         version: crate::VERSION,
         config_path: &config_path,
         config_text: &scene.provenance.text,
         input_hash: &scene.provenance.input_hash,
-        plan: &plan,
+        plan,
         seed: scene.seed,
         created_unix_s: created,
         geometry: GeometrySummary {
@@ -316,15 +734,18 @@ fn write_result(
             radii_nm: &radii,
             particle_of_sphere: &particle_of_sphere,
             species_of_particle: &species_of_particle,
-            target_fraction: &geometry.stats.target_fraction,
-            achieved_fraction: &geometry.stats.achieved_fraction,
+            target_fraction: &targets,
+            achieved_fraction: &achieved,
             raster_fraction: &raster_fraction,
-            min_gap_nm: geometry.stats.min_gap_nm,
+            min_gap_nm: min_gap,
         },
-        grid: [raster.grid.nx, raster.grid.ny, raster.grid.nz],
-        size_nm: raster.grid.size_nm,
+        grid,
+        size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
         entries,
-        picture_png: Some(png),
+        picture_png: Some(pictures.orders),
+        realisations,
+        appearance,
+        tile_png: pictures.tile,
     };
     io::write_result(path, &set)?;
     Ok(())
@@ -371,7 +792,22 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     }
     let png = render::geometry_png(&raster, name, &lines)?;
     io::write_atomic(&picture_path, &png)?;
-    write_result(scene, &geometry, &raster, &[], &png, &result_path)?;
+    let pvc = geometry.stats.achieved_fraction.iter().sum();
+    let layer = (geometry, raster);
+    write_result(
+        scene,
+        Some(&layer),
+        &[],
+        &[(scene.seed, pvc)],
+        &plan_text(&RunPlan::of(scene), &[]),
+        Pictures {
+            orders: &png,
+            tile: None,
+        },
+        None,
+        &result_path,
+    )?;
+    let geometry = layer.0;
     Ok(GeometryReport {
         result_path,
         picture_path,
@@ -380,27 +816,22 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     })
 }
 
-/// The run's plan as stored with the results: one line per decision.
-pub fn plan_text(scene: &Scene, entries: &[SolveEntry]) -> String {
-    let (packer, why) = packer_of(scene);
-    let mut lines = vec![format!("geometry: {packer} ({why})")];
+/// The run's plan as stored with the results: one line per decision, then
+/// one line per solve (method and why).
+pub fn plan_text(plan: &RunPlan, entries: &[SolveEntry]) -> String {
+    let mut lines = plan.lines.clone();
     if entries.is_empty() {
         lines.push("solves: none (geometry only)".to_string());
         return lines.join("\n");
     }
-    lines.push(format!(
-        "solves: {} wavelengths × {} incidence directions, method {:?}, tolerance {:.0e}",
-        scene.wavelengths_nm.len(),
-        scene.incidence.len(),
-        scene.solver.method,
-        scene.solver.tolerance
-    ));
     for e in entries {
         lines.push(format!(
-            "solve {} nm, {}°/{}°: {} ({})",
+            "solve {} nm, {}°/{}° {} #{}: {} ({})",
             e.wavelength_nm,
             e.incidence.polar_deg,
             e.incidence.azimuth_deg,
+            e.side,
+            e.realisation,
             e.record.method,
             e.record.note
         ));

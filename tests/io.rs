@@ -6,7 +6,7 @@ use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
 use inksim::config::Incidence;
-use inksim::farfield::{Efficiencies, Order, SolveEntry};
+use inksim::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::io::{read_summary, write_atomic, write_result, GeometrySummary, IoError, ResultSet};
 use inksim::solver::{MethodUsed, SolveRecord};
 use num_complex::Complex64;
@@ -29,6 +29,8 @@ fn entries() -> Vec<SolveEntry> {
     vec![
         SolveEntry {
             wavelength_nm: 450.0,
+            side: Side::Above,
+            realisation: 0,
             incidence: Incidence {
                 polar_deg: 0.0,
                 azimuth_deg: 0.0,
@@ -57,6 +59,8 @@ fn entries() -> Vec<SolveEntry> {
         },
         SolveEntry {
             wavelength_nm: 632.8,
+            side: Side::Above,
+            realisation: 0,
             incidence: Incidence {
                 polar_deg: 30.0,
                 azimuth_deg: 45.0,
@@ -81,6 +85,8 @@ fn entries() -> Vec<SolveEntry> {
         },
         SolveEntry {
             wavelength_nm: 700.000_000_000_1,
+            side: Side::Above,
+            realisation: 0,
             incidence: Incidence {
                 polar_deg: 60.0,
                 azimuth_deg: -90.0,
@@ -152,12 +158,15 @@ fn set<'a>(g: &'a Geo, e: &'a [SolveEntry], hash: &'a str, png: Option<&'a [u8]>
             target_fraction: &g.target,
             achieved_fraction: &g.achieved,
             raster_fraction: &g.raster,
-            min_gap_nm: 2.5,
+            min_gap_nm: Some(2.5),
         },
         grid: [64, 48, 20],
         size_nm: [2000.0, 1500.5, 1000.0],
         entries: e,
         picture_png: png,
+        realisations: &[(7, 0.3)],
+        appearance: None,
+        tile_png: None,
     }
 }
 

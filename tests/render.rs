@@ -2,7 +2,7 @@
 //! the orders where their directions say.
 
 use inksim::config::Incidence;
-use inksim::farfield::{Efficiencies, Order, SolveEntry};
+use inksim::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::render::{diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX};
 use inksim::solver::{MethodUsed, SolveRecord};
 use num_complex::Complex64;
@@ -50,6 +50,8 @@ fn lattice_entry(
 fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
     SolveEntry {
         wavelength_nm: wl,
+        side: Side::Above,
+        realisation: 0,
         incidence: Incidence {
             polar_deg: polar,
             azimuth_deg: 0.0,

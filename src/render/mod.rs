@@ -42,6 +42,7 @@ use crate::config::Incidence;
 use crate::farfield::{Order, SolveEntry};
 
 pub mod canvas;
+pub mod tile;
 #[cfg(test)]
 use canvas::glyph;
 pub use canvas::{text_width, Canvas, FONT_SCALE, GLYPH_ADVANCE, GLYPH_HEIGHT};
@@ -503,7 +504,7 @@ fn incidence_cmp(a: &Incidence, b: &Incidence) -> Ordering {
 }
 
 /// A number with at most two decimals, trailing zeros dropped.
-fn fmt_num(x: f64) -> String {
+pub(crate) fn fmt_num(x: f64) -> String {
     let s = format!("{x:.2}");
     let s = if s.contains('.') {
         s.trim_end_matches('0').trim_end_matches('.').to_string()

@@ -15,6 +15,7 @@
 //! * [`marching::TimeMarching`]: pseudo-time marching `u ← u + dτ P r` with the
 //!   convergent-Born-series preconditioner of Osnabrugge et al. (2016).
 
+pub mod airy;
 pub mod bicgstab;
 pub mod born;
 pub mod fft;
@@ -39,14 +40,17 @@ pub enum MethodUsed {
     TimeMarching,
     Gmres,
     BiCgStab,
+    /// Closed-form homogeneous slab ([`airy`]): no grains, no iteration.
+    Airy,
 }
 
 impl MethodUsed {
-    pub const ALL: [MethodUsed; 4] = [
+    pub const ALL: [MethodUsed; 5] = [
         MethodUsed::Born,
         MethodUsed::TimeMarching,
         MethodUsed::Gmres,
         MethodUsed::BiCgStab,
+        MethodUsed::Airy,
     ];
 }
 
@@ -70,6 +74,7 @@ impl fmt::Display for MethodUsed {
             MethodUsed::TimeMarching => "time-marching",
             MethodUsed::Gmres => "gmres",
             MethodUsed::BiCgStab => "bicgstab",
+            MethodUsed::Airy => "airy",
         })
     }
 }

@@ -3,7 +3,10 @@
 //! The Kirchhoff far field of a periodic layer is a finite set of plane waves,
 //! one per propagating Bloch order, so no numerical far-field integral is
 //! needed (METHOD §5). Energy balance `ΣR + ΣT + A = 1` is checked on every
-//! solve.
+//! solve. [`table`] spreads the orders onto a fixed angular table (the
+//! smooth BRDF/BTDF of METHOD §5).
+
+pub mod table;
 
 use crate::config::Incidence;
 use crate::solver::SolveRecord;
@@ -38,11 +41,46 @@ pub struct Efficiencies {
     pub energy_balance: f64,
 }
 
-/// One solve of the scene: a wavelength and a direction of incidence.
+/// Which face of the layer the light comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Side {
+    /// From the viewer's side (z < 0), the normal case.
+    #[default]
+    Above,
+    /// From the paper's side: the layer is flipped (z → H − z) and lit from
+    /// above; "reflected" orders then go back down towards the paper.
+    Below,
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Side::Above => "above",
+            Side::Below => "below",
+        })
+    }
+}
+
+impl std::str::FromStr for Side {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "above" => Ok(Side::Above),
+            "below" => Ok(Side::Below),
+            _ => Err(format!("`{s}` is not one of above, below")),
+        }
+    }
+}
+
+/// One solve of the scene: a wavelength, a direction of incidence, a side
+/// and a realisation of the random layer.
 #[derive(Debug, Clone)]
 pub struct SolveEntry {
     pub wavelength_nm: f64,
     pub incidence: Incidence,
+    pub side: Side,
+    /// Index of the random fragment (0-based).
+    pub realisation: usize,
     pub efficiencies: Efficiencies,
     pub record: SolveRecord,
 }
@@ -87,5 +125,34 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
         total_transmittance: tt,
         absorption: sol.absorption,
         energy_balance: tr + tt + sol.absorption - 1.0,
+    }
+}
+
+/// Far field of a homogeneous slab: only the specular order propagates.
+pub fn slab_efficiencies(
+    resp: &crate::solver::airy::SlabResponse,
+    inc: &Incidence,
+) -> Efficiencies {
+    let (rr, t) = (resp.r.norm_sqr(), resp.t.norm_sqr());
+    Efficiencies {
+        orders: vec![Order {
+            m: 0,
+            n: 0,
+            theta_deg: inc.polar_deg,
+            phi_deg: if inc.polar_deg == 0.0 {
+                0.0
+            } else {
+                let a = inc.azimuth_deg.to_radians();
+                a.sin().atan2(a.cos()).to_degrees()
+            },
+            reflectance: rr,
+            transmittance: t,
+        }],
+        r00: resp.r,
+        t00: resp.t,
+        total_reflectance: rr,
+        total_transmittance: t,
+        absorption: resp.absorption,
+        energy_balance: rr + t + resp.absorption - 1.0,
     }
 }

@@ -1,0 +1,380 @@
+//! Stage 5c — appearance: from the solves of every realisation to what a
+//! person sees (METHOD §5–§6).
+//!
+//! Inputs are plain solve entries (orders, r00/t00, R, T, A) of `R`
+//! realisations; outputs are ensemble means with their standard errors
+//! (sample standard deviation / √R, present only when R ≥ 2):
+//! - per wavelength and incidence from above: R, T, A and the specular split
+//!   (coherent `|⟨r00⟩|²`, incoherent `⟨|r00|²⟩ − |⟨r00⟩|²`; the same for t00);
+//! - the diffuse BRDF (and on request BTDF) table of every illumination angle
+//!   ([`crate::farfield::table`]: power-preserving, orders (0,0) excluded) and
+//!   its values in the plane of incidence on the specular side
+//!   (`φ_o = φ_i`: the diagonal θo = θi holds the specular direction);
+//! - with paper: the layer's albedo for diffuse light from below `R_dd↑` and
+//!   its diffuse transmittance `T_d` (Gauss–Legendre in cos θ over the solves
+//!   from below; by reciprocity `2∫T_up μ dμ = 2∫T_down μ dμ`), the BRDF of
+//!   layer + paper `f = f_layer + ρ T(θi) T(θo) / (π (1 − ρ R_dd↑))`, and
+//!   the radiance factor under a uniform white sky
+//!   `R(θo) + ρ T_d T(θo) / (1 − ρ R_dd↑)` (all reflected orders, specular
+//!   included, by reciprocity);
+//! - colours (CIE 1931 2°, D65, sRGB) of the tile: the sky strip and `π f`
+//!   of the BRDF square, and CIELAB of the sky strip for comparing variants.
+//!
+//! Ensemble-mean quantities are combined (products of means), as METHOD §5
+//! describes the layer by its mean scattering functions.
+
+use crate::colour::{self, ColourError, Observer};
+use crate::farfield::table::{self, AngularTable, Part, TableSpec};
+use crate::farfield::{Side, SolveEntry};
+use crate::substrate::Hemisphere;
+use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
+use num_complex::Complex64 as C64;
+use std::f64::consts::PI;
+
+/// What to assemble; built by the pipeline from the scene and its plan.
+#[derive(Debug, Clone)]
+pub struct AppearanceSpec {
+    pub wavelengths_nm: Vec<f64>,
+    /// Azimuth of the plane of incidence (deg).
+    pub azimuth_deg: f64,
+    /// Illumination polar angles: the BRDF square's columns.
+    pub illumination_deg: Vec<f64>,
+    /// Viewing polar angles: the tile's rows.
+    pub viewing_deg: Vec<f64>,
+    /// Polar angles solved from above (⊇ illumination, and ⊇ viewing when
+    /// the paper term or the sky strip is wanted).
+    pub above_deg: Vec<f64>,
+    /// Quadrature for the solves from below (with paper), nodes = polar angles.
+    pub below: Option<Hemisphere>,
+    pub paper_albedo: Option<f64>,
+    pub table: TableSpec,
+    pub realisations: usize,
+    pub btdf: bool,
+    /// Compute the paper term, the sky strip and the colours (the tile).
+    pub tile: bool,
+}
+
+/// A mean over realisations and its standard error (None when R = 1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Estimate<D: Dimension> {
+    pub mean: Array<f64, D>,
+    pub se: Option<Array<f64, D>>,
+}
+
+/// The paper's part.
+#[derive(Debug, Clone)]
+pub struct PaperTerms {
+    pub albedo: f64,
+    /// Layer albedo for diffuse light from below, per wavelength.
+    pub r_dd_up: Estimate<Ix1>,
+    /// Layer diffuse transmittance, per wavelength.
+    pub t_d: Estimate<Ix1>,
+}
+
+/// Colours of the tile.
+#[derive(Debug, Clone)]
+pub struct Colours {
+    /// (viewing, 1 + illumination, 3): column 0 the sky strip, then the
+    /// BRDF square (`π f` as a reflectance factor).
+    pub tile_srgb8: Array3<u8>,
+    /// Sky strip per viewing angle: sRGB8 and CIELAB (D65 white).
+    pub natural_srgb8: Vec<[u8; 3]>,
+    pub natural_lab: Vec<[f64; 3]>,
+}
+
+/// Everything assembled; array axes are named in each field.
+#[derive(Debug, Clone)]
+pub struct Appearance {
+    pub spec: AppearanceSpec,
+    /// (wavelength, above angle).
+    pub reflectance: Estimate<Ix2>,
+    pub transmittance: Estimate<Ix2>,
+    pub absorption: Estimate<Ix2>,
+    pub specular_coherent: Array2<f64>,
+    pub specular_incoherent: Array2<f64>,
+    pub direct_coherent: Array2<f64>,
+    pub direct_incoherent: Array2<f64>,
+    /// Density tables `f cos θ`, (wavelength, illumination, j, i).
+    pub brdf_table: Estimate<Ix4>,
+    pub btdf_table: Option<Estimate<Ix4>>,
+    /// Layer-only diffuse BRDF in the plane of incidence, (wavelength,
+    /// illumination, viewing), 1/sr.
+    pub brdf_diffuse: Estimate<Ix3>,
+    /// Diffuse BTDF below the layer in the plane of incidence (forward side).
+    pub btdf_diffuse: Option<Estimate<Ix3>>,
+    pub paper: Option<PaperTerms>,
+    /// Diffuse BRDF of layer + substrate, (wavelength, illumination, viewing).
+    pub brdf_total: Option<Array3<f64>>,
+    /// Radiance factor under a uniform white sky, (wavelength, viewing).
+    pub natural: Option<Array2<f64>>,
+    pub colours: Option<Colours>,
+}
+
+/// Why the appearance cannot be assembled.
+#[derive(Debug, thiserror::Error)]
+pub enum AppearanceError {
+    #[error("appearance: no {side} solve for realisation {realisation} at {wavelength_nm} nm, polar {polar_deg}°")]
+    Missing {
+        side: Side,
+        realisation: usize,
+        wavelength_nm: f64,
+        polar_deg: f64,
+    },
+    #[error("appearance: viewing angle {0}° was not solved from above")]
+    NotSolved(f64),
+    #[error("appearance: colour: {0}")]
+    Colour(#[from] ColourError),
+}
+
+/// Mean and standard error along the first axis of `samples`.
+fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
+    let n = samples.len() as f64;
+    let mut mean = samples[0].clone();
+    for s in &samples[1..] {
+        mean += s;
+    }
+    mean /= n;
+    let se = (samples.len() > 1).then(|| {
+        let mut var: Array<f64, D> = Array::zeros(mean.raw_dim());
+        for s in samples {
+            var.zip_mut_with(&(s - &mean), |v, d| *v += d * d);
+        }
+        var.mapv(|v: f64| (v / (n - 1.0) / n).sqrt())
+    });
+    Estimate { mean, se }
+}
+
+fn index_of(list: &[f64], v: f64) -> Option<usize> {
+    list.iter().position(|&x| x == v)
+}
+
+/// Assemble the appearance of a scene from its solves.
+pub fn assemble(
+    spec: &AppearanceSpec,
+    entries: &[SolveEntry],
+    observer: &Observer,
+) -> Result<Appearance, AppearanceError> {
+    let nl = spec.wavelengths_nm.len();
+    let na = spec.above_deg.len();
+    let ni = spec.illumination_deg.len();
+    let nv = spec.viewing_deg.len();
+    let nt = spec.table.n();
+    let find = |side: Side, r: usize, wl: f64, polar: f64| {
+        entries
+            .iter()
+            .find(|e| {
+                e.side == side
+                    && e.realisation == r
+                    && e.wavelength_nm == wl
+                    && e.incidence.polar_deg == polar
+            })
+            .ok_or(AppearanceError::Missing {
+                side,
+                realisation: r,
+                wavelength_nm: wl,
+                polar_deg: polar,
+            })
+    };
+    let illum_idx: Vec<usize> = spec
+        .illumination_deg
+        .iter()
+        .map(|&a| index_of(&spec.above_deg, a).ok_or(AppearanceError::NotSolved(a)))
+        .collect::<Result<_, _>>()?;
+
+    let rr = spec.realisations;
+    let mut s_r = Vec::with_capacity(rr);
+    let mut s_t = Vec::with_capacity(rr);
+    let mut s_a = Vec::with_capacity(rr);
+    let mut s_brdf_tab = Vec::with_capacity(rr);
+    let mut s_btdf_tab = Vec::with_capacity(rr);
+    let mut s_brdf = Vec::with_capacity(rr);
+    let mut s_btdf = Vec::with_capacity(rr);
+    let mut s_rdd = Vec::with_capacity(rr);
+    let mut s_td = Vec::with_capacity(rr);
+    let mut r00 = Array2::<C64>::zeros((nl, na));
+    let mut r00_sq = Array2::<f64>::zeros((nl, na));
+    let mut t00 = Array2::<C64>::zeros((nl, na));
+    let mut t00_sq = Array2::<f64>::zeros((nl, na));
+    let az = spec.azimuth_deg;
+    for r in 0..rr {
+        let mut tr = Array2::zeros((nl, na));
+        let mut tt = Array2::zeros((nl, na));
+        let mut ta = Array2::zeros((nl, na));
+        let mut brdf_tab = Array4::zeros((nl, ni, nt, nt));
+        let mut btdf_tab = Array4::zeros((nl, ni, nt, nt));
+        let mut brdf = Array3::zeros((nl, ni, nv));
+        let mut btdf = Array3::zeros((nl, ni, nv));
+        let mut rdd = Array1::zeros(nl);
+        let mut td = Array1::zeros(nl);
+        for (l, &wl) in spec.wavelengths_nm.iter().enumerate() {
+            for (a, &polar) in spec.above_deg.iter().enumerate() {
+                let e = &find(Side::Above, r, wl, polar)?.efficiencies;
+                tr[[l, a]] = e.total_reflectance;
+                tt[[l, a]] = e.total_transmittance;
+                ta[[l, a]] = e.absorption;
+                r00[[l, a]] += e.r00;
+                r00_sq[[l, a]] += e.r00.norm_sqr();
+                t00[[l, a]] += e.t00;
+                t00_sq[[l, a]] += e.t00.norm_sqr();
+            }
+            for (i, &polar) in spec.illumination_deg.iter().enumerate() {
+                let e = &find(Side::Above, r, wl, polar)?.efficiencies;
+                let put = |tab: &AngularTable, dst: &mut Array4<f64>, vals: &mut Array3<f64>| {
+                    for (k, d) in tab.density.iter().enumerate() {
+                        dst[[l, i, k / nt, k % nt]] = *d;
+                    }
+                    for (o, &view) in spec.viewing_deg.iter().enumerate() {
+                        vals[[l, i, o]] = tab.value_at(view, az);
+                    }
+                };
+                put(
+                    &table::spread(e, Part::DiffuseReflection, spec.table),
+                    &mut brdf_tab,
+                    &mut brdf,
+                );
+                if spec.btdf {
+                    put(
+                        &table::spread(e, Part::DiffuseTransmission, spec.table),
+                        &mut btdf_tab,
+                        &mut btdf,
+                    );
+                }
+            }
+            if let (Some(h), Some(_)) = (&spec.below, spec.paper_albedo) {
+                let mut ru = Vec::with_capacity(h.mu.len());
+                let mut tu = Vec::with_capacity(h.mu.len());
+                for polar in h.polar_deg() {
+                    let e = &find(Side::Below, r, wl, polar)?.efficiencies;
+                    ru.push(e.total_reflectance);
+                    tu.push(e.total_transmittance);
+                }
+                rdd[l] = h.diffuse(&ru);
+                td[l] = h.diffuse(&tu);
+            }
+        }
+        s_r.push(tr);
+        s_t.push(tt);
+        s_a.push(ta);
+        s_brdf_tab.push(brdf_tab);
+        s_brdf.push(brdf);
+        if spec.btdf {
+            s_btdf_tab.push(btdf_tab);
+            s_btdf.push(btdf);
+        }
+        s_rdd.push(rdd);
+        s_td.push(td);
+    }
+    let n = rr as f64;
+    let coherent = |sum: &Array2<C64>| sum.mapv(|z| (z / n).norm_sqr());
+    let specular_coherent = coherent(&r00);
+    let direct_coherent = coherent(&t00);
+    let incoherent = |sq: &Array2<f64>, coh: &Array2<f64>| {
+        let mut out = sq / n - coh;
+        out.mapv_inplace(|v| v.max(0.0));
+        out
+    };
+    let specular_incoherent = incoherent(&r00_sq, &specular_coherent);
+    let direct_incoherent = incoherent(&t00_sq, &direct_coherent);
+    let reflectance = reduce(&s_r);
+    let transmittance = reduce(&s_t);
+    let absorption = reduce(&s_a);
+    let brdf_diffuse = reduce(&s_brdf);
+    let paper = match (&spec.below, spec.paper_albedo) {
+        (Some(_), Some(albedo)) => Some(PaperTerms {
+            albedo,
+            r_dd_up: reduce(&s_rdd),
+            t_d: reduce(&s_td),
+        }),
+        _ => None,
+    };
+
+    let (mut brdf_total, mut natural, mut colours) = (None, None, None);
+    if spec.tile {
+        let view_idx: Vec<usize> = spec
+            .viewing_deg
+            .iter()
+            .map(|&v| index_of(&spec.above_deg, v).ok_or(AppearanceError::NotSolved(v)))
+            .collect::<Result<_, _>>()?;
+        let t_mean = &transmittance.mean;
+        let mut total = brdf_diffuse.mean.clone();
+        let mut sky = Array2::zeros((nl, nv));
+        for l in 0..nl {
+            for (o, &vo) in view_idx.iter().enumerate() {
+                sky[[l, o]] = reflectance.mean[[l, vo]];
+            }
+            if let Some(p) = &paper {
+                let denom = 1.0 - p.albedo * p.r_dd_up.mean[l];
+                for (i, &ai) in illum_idx.iter().enumerate() {
+                    for (o, &vo) in view_idx.iter().enumerate() {
+                        total[[l, i, o]] +=
+                            p.albedo * t_mean[[l, ai]] * t_mean[[l, vo]] / (PI * denom);
+                    }
+                }
+                for (o, &vo) in view_idx.iter().enumerate() {
+                    sky[[l, o]] += p.albedo * p.t_d.mean[l] * t_mean[[l, vo]] / denom;
+                }
+            }
+        }
+        colours = Some(colours_of(spec, &total, &sky, observer)?);
+        brdf_total = Some(total);
+        natural = Some(sky);
+    }
+
+    Ok(Appearance {
+        spec: spec.clone(),
+        reflectance,
+        transmittance,
+        absorption,
+        specular_coherent,
+        specular_incoherent,
+        direct_coherent,
+        direct_incoherent,
+        brdf_table: reduce(&s_brdf_tab),
+        btdf_table: spec.btdf.then(|| reduce(&s_btdf_tab)),
+        brdf_diffuse,
+        btdf_diffuse: spec.btdf.then(|| reduce(&s_btdf)),
+        paper,
+        brdf_total,
+        natural,
+        colours,
+    })
+}
+
+/// Tile colours from the BRDF of layer + substrate and the sky strip.
+fn colours_of(
+    spec: &AppearanceSpec,
+    total: &Array3<f64>,
+    sky: &Array2<f64>,
+    obs: &Observer,
+) -> Result<Colours, AppearanceError> {
+    let wl = &spec.wavelengths_nm;
+    let (nv, ni) = (spec.viewing_deg.len(), spec.illumination_deg.len());
+    let mut tile = Array3::zeros((nv, 1 + ni, 3));
+    let mut natural_srgb8 = Vec::with_capacity(nv);
+    let mut natural_lab = Vec::with_capacity(nv);
+    let white = obs.white_xyz();
+    for o in 0..nv {
+        let spectrum: Vec<f64> = sky.column(o).to_vec();
+        let xyz = colour::xyz_from_reflectance(obs, wl, &spectrum)?;
+        let rgb = colour::to_srgb8(obs, xyz);
+        natural_srgb8.push(rgb);
+        natural_lab.push(colour::xyz_to_lab(xyz, white));
+        for c in 0..3 {
+            tile[[o, 0, c]] = rgb[c];
+        }
+        for i in 0..ni {
+            let spectrum: Vec<f64> = (0..wl.len())
+                .map(|l| colour::lambertian_reflectance(total[[l, i, o]]))
+                .collect();
+            let rgb = colour::reflectance_to_srgb8(obs, wl, &spectrum)?;
+            for c in 0..3 {
+                tile[[o, 1 + i, c]] = rgb[c];
+            }
+        }
+    }
+    Ok(Colours {
+        tile_srgb8: tile,
+        natural_srgb8,
+        natural_lab,
+    })
+}

@@ -157,6 +157,64 @@ pub struct AppearanceSummary {
     pub natural_lab: Vec<[f64; 3]>,
 }
 
+/// The ensemble-mean appearance arrays of a result file (`/appearance`),
+/// for comparing runs (docs/ACCURACY.md). Shapes as in the module docs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AppearanceArrays {
+    pub wavelengths_nm: Vec<f64>,
+    pub illumination_deg: Vec<f64>,
+    pub viewing_deg: Vec<f64>,
+    pub above_deg: Vec<f64>,
+    /// (L, A) each.
+    pub reflectance: ndarray::Array2<f64>,
+    pub transmittance: ndarray::Array2<f64>,
+    pub absorption: ndarray::Array2<f64>,
+    /// (L, I, V), present with the tile.
+    pub brdf_total: Option<ndarray::Array3<f64>>,
+    /// (L, V), present with the tile.
+    pub natural: Option<ndarray::Array2<f64>>,
+}
+
+/// Read the `/appearance` arrays of a result file (None when absent).
+pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    if !file.link_exists("appearance") {
+        return Ok(None);
+    }
+    let g = file.group("appearance").map_err(hdf)?;
+    let vec = |name: &str| -> Result<Vec<f64>, IoError> {
+        g.dataset(name).and_then(|d| d.read_raw()).map_err(hdf)
+    };
+    let arr2 = |name: &str| -> Result<ndarray::Array2<f64>, IoError> {
+        g.dataset(name).and_then(|d| d.read()).map_err(hdf)
+    };
+    let brdf_total = if g.link_exists("brdf_total") {
+        Some(g.dataset("brdf_total").and_then(|d| d.read()).map_err(hdf)?)
+    } else {
+        None
+    };
+    let natural = if g.link_exists("natural") {
+        Some(arr2("natural")?)
+    } else {
+        None
+    };
+    Ok(Some(AppearanceArrays {
+        wavelengths_nm: vec("wavelengths_nm")?,
+        illumination_deg: vec("illumination_deg")?,
+        viewing_deg: vec("viewing_deg")?,
+        above_deg: vec("above_deg")?,
+        reflectance: arr2("reflectance")?,
+        transmittance: arr2("transmittance")?,
+        absorption: arr2("absorption")?,
+        brdf_total,
+        natural,
+    }))
+}
+
 /// The per-solve numbers of a result file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EntrySummary {

@@ -1,0 +1,305 @@
+//! What accuracy costs in time (issue #6): for representative layers, vary
+//! one fidelity knob at a time from a baseline, run each variant through the
+//! `inksim` CLI (under `/usr/bin/time` for wall time, CPU time and peak
+//! memory) and compare what users look at against the knob's converged
+//! value: the tile's colours (CIEDE2000, max and mean over its cells), the
+//! BRDF of layer + paper (relative L2), and R, T, A (max abs difference).
+//!
+//! `cargo run --release --example accuracy -- [case ...] [--out DIR] [--knob K ...]`
+//!
+//! Cases: `weak` (red, 15 % PVC, 100 nm spheres), `typical` (red, 30 %,
+//! 200 nm), `hard` (blue, 50 %, 250 nm, dynamics packing); default all.
+//! Prints one Markdown table per case (the tables of docs/ACCURACY.md).
+//! Identical variants (the baseline recurs in every knob) run once.
+
+use inksim::colour::{self, Observer};
+use inksim::io::{read_appearance, AppearanceArrays};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use toml::Value;
+
+struct Case {
+    name: &'static str,
+    material: &'static str,
+    pvc: f64,
+    diameter_nm: f64,
+}
+
+const CASES: [Case; 3] = [
+    Case {
+        name: "weak",
+        material: "red",
+        pvc: 0.15,
+        diameter_nm: 100.0,
+    },
+    Case {
+        name: "typical",
+        material: "red",
+        pvc: 0.30,
+        diameter_nm: 200.0,
+    },
+    Case {
+        name: "hard",
+        material: "blue",
+        pvc: 0.50,
+        diameter_nm: 250.0,
+    },
+];
+
+/// Knob: TOML key, values (the last is the converged reference), baseline.
+fn knobs() -> Vec<(&'static str, Vec<Value>)> {
+    let f = |v: &[f64]| v.iter().map(|&x| Value::Float(x)).collect::<Vec<_>>();
+    let frag = |v: &[f64]| {
+        v.iter()
+            .map(|&x| Value::Array(vec![Value::Float(x), Value::Float(x)]))
+            .collect::<Vec<_>>()
+    };
+    let s = |v: &[&str]| v.iter().map(|&x| Value::String(x.into())).collect::<Vec<_>>();
+    let i = |v: &[i64]| v.iter().map(|&x| Value::Integer(x)).collect::<Vec<_>>();
+    vec![
+        ("grid.cell_nm", f(&[50.0, 33.4, 25.0, 20.0, 16.7])),
+        ("grid.z_cell_nm", f(&[25.0, 20.0, 10.0, 5.0])),
+        ("solver.tolerance", f(&[1e-2, 1e-3, 1e-4, 1e-6, 1e-9])),
+        ("illumination.wavelength_range_nm.step", f(&[100.0, 50.0, 30.0, 10.0])),
+        ("appearance.quadrature_points", i(&[2, 4, 6, 12])),
+        ("realisations", i(&[1, 2, 4, 8])),
+        ("layer.fragment_nm", frag(&[700.0, 1000.0, 1500.0, 2000.0])),
+        ("solver.method", s(&["time-marching", "gmres", "bicgstab"])),
+    ]
+}
+
+fn base(case: &Case, out: &Path) -> Value {
+    let text = format!(
+        r#"
+seed = 5
+realisations = 1
+[layer]
+thickness_nm = 1000.0
+fragment_nm = [1000.0, 1000.0]
+[[pigment]]
+name = "{m}"
+material = {{ builtin = "{m}" }}
+pvc = {pvc}
+diameter_nm = {d}
+[grid]
+cell_nm = 25.0
+z_cell_nm = 10.0
+[illumination]
+wavelength_range_nm = {{ start = 400.0, stop = 700.0, step = 50.0 }}
+polar_deg = [0.0, 30.0, 60.0]
+[solver]
+method = "auto"
+tolerance = 1e-6
+max_iterations = 20000
+[appearance]
+quadrature_points = 4
+[output]
+dir = "{dir}"
+name = "x"
+"#,
+        m = case.material,
+        pvc = case.pvc,
+        d = case.diameter_nm,
+        dir = out.display()
+    );
+    toml::from_str(&text).expect("valid base scene")
+}
+
+fn set(v: &mut Value, key: &str, value: Value) {
+    let mut cur = v;
+    let parts: Vec<&str> = key.split('.').collect();
+    for p in &parts[..parts.len() - 1] {
+        cur = cur.get_mut(*p).expect("key exists in the base scene");
+    }
+    cur.as_table_mut()
+        .expect("table")
+        .insert(parts[parts.len() - 1].to_string(), value);
+}
+
+struct Measured {
+    wall_s: f64,
+    cpu_s: f64,
+    peak_mb: f64,
+    result: AppearanceArrays,
+}
+
+fn run(exe: &Path, scene: &Value, dir: &Path, cache: &mut HashMap<String, PathBuf>) -> Measured {
+    let text = toml::to_string(scene).expect("serialisable");
+    let n = cache.len();
+    let cfg = cache.entry(text.clone()).or_insert_with(|| {
+        let d = dir.join(format!("v{n:03}"));
+        std::fs::create_dir_all(&d).unwrap();
+        let cfg = d.join("scene.toml");
+        std::fs::write(&cfg, &text).unwrap();
+        let timing = d.join("time.txt");
+        let status = Command::new("/usr/bin/time")
+            .args(["-f", "%e %U %S %M", "-o"])
+            .arg(&timing)
+            .arg(exe)
+            .args(["run"])
+            .arg(&cfg)
+            .arg("--output-dir")
+            .arg(&d)
+            .stderr(std::process::Stdio::null())
+            .stdout(std::process::Stdio::null())
+            .status()
+            .expect("inksim runs");
+        assert!(status.success(), "variant {} failed", cfg.display());
+        cfg
+    });
+    let d = cfg.parent().unwrap();
+    let t = std::fs::read_to_string(d.join("time.txt")).unwrap();
+    let nums: Vec<f64> = t
+        .split_whitespace()
+        .rev()
+        .take(4)
+        .collect::<Vec<_>>()
+        .into_iter()
+        .rev()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    Measured {
+        wall_s: nums[0],
+        cpu_s: nums[1] + nums[2],
+        peak_mb: nums[3] / 1024.0,
+        result: read_appearance(&d.join("x.h5")).unwrap().expect("appearance stored"),
+    }
+}
+
+/// Lab of every tile cell: the sky strip and π f of the BRDF square.
+fn tile_lab(a: &AppearanceArrays, obs: &Observer) -> Vec<[f64; 3]> {
+    let (f, sky) = (a.brdf_total.as_ref().unwrap(), a.natural.as_ref().unwrap());
+    let wl = &a.wavelengths_nm;
+    let white = obs.white_xyz();
+    let mut out = Vec::new();
+    for o in 0..a.viewing_deg.len() {
+        let s: Vec<f64> = (0..wl.len()).map(|l| sky[[l, o]]).collect();
+        out.push(colour::xyz_to_lab(colour::xyz_from_reflectance(obs, wl, &s).unwrap(), white));
+        for i in 0..a.illumination_deg.len() {
+            let s: Vec<f64> = (0..wl.len()).map(|l| std::f64::consts::PI * f[[l, i, o]]).collect();
+            out.push(colour::xyz_to_lab(colour::xyz_from_reflectance(obs, wl, &s).unwrap(), white));
+        }
+    }
+    out
+}
+
+struct Errors {
+    de_max: f64,
+    de_mean: f64,
+    brdf_l2: f64,
+    rta_max: f64,
+}
+
+fn compare(a: &AppearanceArrays, r: &AppearanceArrays, obs: &Observer) -> Errors {
+    let (la, lr) = (tile_lab(a, obs), tile_lab(r, obs));
+    let de: Vec<f64> = la.iter().zip(&lr).map(|(x, y)| colour::delta_e2000(*x, *y)).collect();
+    // Common wavelengths (the spectral-step knob uses nested grids).
+    let common: Vec<(usize, usize)> = a
+        .wavelengths_nm
+        .iter()
+        .enumerate()
+        .filter_map(|(i, w)| r.wavelengths_nm.iter().position(|x| x == w).map(|j| (i, j)))
+        .collect();
+    let (fa, fr) = (a.brdf_total.as_ref().unwrap(), r.brdf_total.as_ref().unwrap());
+    let (mut num, mut den, mut rta): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for &(i, j) in &common {
+        for ii in 0..a.illumination_deg.len() {
+            for o in 0..a.viewing_deg.len() {
+                num += (fa[[i, ii, o]] - fr[[j, ii, o]]).powi(2);
+                den += fr[[j, ii, o]].powi(2);
+            }
+        }
+        for k in 0..a.above_deg.len() {
+            for (x, y) in [
+                (&a.reflectance, &r.reflectance),
+                (&a.transmittance, &r.transmittance),
+                (&a.absorption, &r.absorption),
+            ] {
+                rta = rta.max((x[[i, k]] - y[[j, k]]).abs());
+            }
+        }
+    }
+    Errors {
+        de_max: de.iter().copied().fold(0.0, f64::max),
+        de_mean: de.iter().sum::<f64>() / de.len() as f64,
+        brdf_l2: (num / den).sqrt(),
+        rta_max: rta,
+    }
+}
+
+fn show(v: &Value) -> String {
+    match v {
+        Value::Array(a) => show(&a[0]),
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut out = PathBuf::from("runs/accuracy");
+    let mut cases: Vec<&str> = Vec::new();
+    let mut only: Vec<String> = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--out" => out = PathBuf::from(it.next().expect("--out DIR")),
+            "--knob" => only.push(it.next().expect("--knob KEY").clone()),
+            c => cases.push(c),
+        }
+    }
+    if cases.is_empty() {
+        cases = CASES.iter().map(|c| c.name).collect();
+    }
+    let exe = std::env::current_exe()?
+        .parent()
+        .and_then(|p| p.parent())
+        .map(|p| p.join("inksim"))
+        .filter(|p| p.is_file())
+        .ok_or_else(|| anyhow::anyhow!("build the CLI first: cargo build --release"))?;
+    let obs = Observer::cie1931_d65();
+    for case in CASES.iter().filter(|c| cases.contains(&c.name)) {
+        let dir = out.join(case.name);
+        let mut cache = HashMap::new();
+        println!(
+            "\n### {}: {} {} % PVC, {} nm spheres, 1 µm layer\n",
+            case.name,
+            case.material,
+            case.pvc * 100.0,
+            case.diameter_nm
+        );
+        println!("| knob | value | wall s | CPU s | peak MB | ΔE00 max | ΔE00 mean | BRDF rel. L2 | max abs ΔR/T/A | cost vs ref |");
+        println!("|---|---|---|---|---|---|---|---|---|---|");
+        for (key, values) in knobs() {
+            if !only.is_empty() && !only.iter().any(|k| k == key) {
+                continue;
+            }
+            let mut scene = base(case, &dir);
+            let reference = values.last().unwrap().clone();
+            set(&mut scene, key, reference.clone());
+            let r = run(&exe, &scene, &dir, &mut cache);
+            for v in &values {
+                let mut scene = base(case, &dir);
+                set(&mut scene, key, v.clone());
+                let m = run(&exe, &scene, &dir, &mut cache);
+                let e = compare(&m.result, &r.result, &obs);
+                let is_ref = *v == reference;
+                println!(
+                    "| {key} | {}{} | {:.1} | {:.1} | {:.0} | {:.2} | {:.2} | {:.1e} | {:.1e} | {:.0} % |",
+                    show(v),
+                    if is_ref { " (ref)" } else { "" },
+                    m.wall_s,
+                    m.cpu_s,
+                    m.peak_mb,
+                    e.de_max,
+                    e.de_mean,
+                    e.brdf_l2,
+                    e.rta_max,
+                    100.0 * m.cpu_s / r.cpu_s.max(1e-9)
+                );
+            }
+        }
+    }
+    Ok(())
+}

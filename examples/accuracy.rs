@@ -55,13 +55,20 @@ fn knobs() -> Vec<(&'static str, Vec<Value>)> {
             .map(|&x| Value::Array(vec![Value::Float(x), Value::Float(x)]))
             .collect::<Vec<_>>()
     };
-    let s = |v: &[&str]| v.iter().map(|&x| Value::String(x.into())).collect::<Vec<_>>();
+    let s = |v: &[&str]| {
+        v.iter()
+            .map(|&x| Value::String(x.into()))
+            .collect::<Vec<_>>()
+    };
     let i = |v: &[i64]| v.iter().map(|&x| Value::Integer(x)).collect::<Vec<_>>();
     vec![
         ("grid.cell_nm", f(&[50.0, 33.4, 25.0, 20.0, 16.7])),
         ("grid.z_cell_nm", f(&[25.0, 20.0, 10.0, 5.0])),
         ("solver.tolerance", f(&[1e-2, 1e-3, 1e-4, 1e-6, 1e-9])),
-        ("illumination.wavelength_range_nm.step", f(&[100.0, 50.0, 30.0, 10.0])),
+        (
+            "illumination.wavelength_range_nm.step",
+            f(&[100.0, 50.0, 30.0, 10.0]),
+        ),
         ("appearance.quadrature_points", i(&[2, 4, 6, 12])),
         ("realisations", i(&[1, 2, 4, 8])),
         ("layer.fragment_nm", frag(&[700.0, 1000.0, 1500.0, 2000.0])),
@@ -163,7 +170,9 @@ fn run(exe: &Path, scene: &Value, dir: &Path, cache: &mut HashMap<String, PathBu
         wall_s: nums[0],
         cpu_s: nums[1] + nums[2],
         peak_mb: nums[3] / 1024.0,
-        result: read_appearance(&d.join("x.h5")).unwrap().expect("appearance stored"),
+        result: read_appearance(&d.join("x.h5"))
+            .unwrap()
+            .expect("appearance stored"),
     }
 }
 
@@ -175,10 +184,18 @@ fn tile_lab(a: &AppearanceArrays, obs: &Observer) -> Vec<[f64; 3]> {
     let mut out = Vec::new();
     for o in 0..a.viewing_deg.len() {
         let s: Vec<f64> = (0..wl.len()).map(|l| sky[[l, o]]).collect();
-        out.push(colour::xyz_to_lab(colour::xyz_from_reflectance(obs, wl, &s).unwrap(), white));
+        out.push(colour::xyz_to_lab(
+            colour::xyz_from_reflectance(obs, wl, &s).unwrap(),
+            white,
+        ));
         for i in 0..a.illumination_deg.len() {
-            let s: Vec<f64> = (0..wl.len()).map(|l| std::f64::consts::PI * f[[l, i, o]]).collect();
-            out.push(colour::xyz_to_lab(colour::xyz_from_reflectance(obs, wl, &s).unwrap(), white));
+            let s: Vec<f64> = (0..wl.len())
+                .map(|l| std::f64::consts::PI * f[[l, i, o]])
+                .collect();
+            out.push(colour::xyz_to_lab(
+                colour::xyz_from_reflectance(obs, wl, &s).unwrap(),
+                white,
+            ));
         }
     }
     out
@@ -193,7 +210,11 @@ struct Errors {
 
 fn compare(a: &AppearanceArrays, r: &AppearanceArrays, obs: &Observer) -> Errors {
     let (la, lr) = (tile_lab(a, obs), tile_lab(r, obs));
-    let de: Vec<f64> = la.iter().zip(&lr).map(|(x, y)| colour::delta_e2000(*x, *y)).collect();
+    let de: Vec<f64> = la
+        .iter()
+        .zip(&lr)
+        .map(|(x, y)| colour::delta_e2000(*x, *y))
+        .collect();
     // Common wavelengths (the spectral-step knob uses nested grids).
     let common: Vec<(usize, usize)> = a
         .wavelengths_nm
@@ -201,7 +222,10 @@ fn compare(a: &AppearanceArrays, r: &AppearanceArrays, obs: &Observer) -> Errors
         .enumerate()
         .filter_map(|(i, w)| r.wavelengths_nm.iter().position(|x| x == w).map(|j| (i, j)))
         .collect();
-    let (fa, fr) = (a.brdf_total.as_ref().unwrap(), r.brdf_total.as_ref().unwrap());
+    let (fa, fr) = (
+        a.brdf_total.as_ref().unwrap(),
+        r.brdf_total.as_ref().unwrap(),
+    );
     let (mut num, mut den, mut rta): (f64, f64, f64) = (0.0, 0.0, 0.0);
     for &(i, j) in &common {
         for ii in 0..a.illumination_deg.len() {

@@ -193,7 +193,11 @@ pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError>
         g.dataset(name).and_then(|d| d.read()).map_err(hdf)
     };
     let brdf_total = if g.link_exists("brdf_total") {
-        Some(g.dataset("brdf_total").and_then(|d| d.read()).map_err(hdf)?)
+        Some(
+            g.dataset("brdf_total")
+                .and_then(|d| d.read())
+                .map_err(hdf)?,
+        )
     } else {
         None
     };

@@ -1,2 +1,50 @@
 //! The study driver: a sweep of scene variants run resumably on one machine
-//! or sharded over a cluster (issue #5).
+//! or sharded over a cluster (issue #5). The last stage: it reads sweep
+//! files, builds scene variants through `config`, runs them through
+//! [`pipeline::run`](crate::pipeline::run), reads results back through `io`
+//! and draws comparison grids with `render`.
+//!
+//! - [`sweep`]: the sweep file (base scene, profiles, axes, zips, explicit
+//!   variants, exclusions, grids) expanded into named, seeded, validated
+//!   variants — every error is found before any work starts.
+//! - [`plan`]: the work and the estimated time and memory of each variant.
+//! - [`run`]: runs the variants (in parallel, sharded, resumable).
+//! - [`merge`]: the summary HDF5, the comparison grids and the summary page.
+//! - [`slurm`]: a ready sbatch array script.
+//!
+//! The user documentation of the format and the commands is docs/STUDY.md.
+
+pub mod merge;
+pub mod plan;
+pub mod run;
+pub mod slurm;
+pub mod sweep;
+
+pub use sweep::{is_study_text, Study, Variant};
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in a study, each naming the file and what
+/// is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    #[error("{file}: cannot read: {source}")]
+    Read {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    /// A problem in the sweep file (or the variants it defines).
+    #[error("{file}: {message}")]
+    Sweep { file: PathBuf, message: String },
+    #[error(transparent)]
+    Io(#[from] crate::io::IoError),
+    #[error("{path}: HDF5 error: {source}")]
+    Hdf5 { path: PathBuf, source: hdf5::Error },
+    #[error("render: {0}")]
+    Render(#[from] crate::render::RenderError),
+    /// `merge` before every variant is finished.
+    #[error("{0}")]
+    Incomplete(String),
+    #[error("{0}")]
+    Usage(String),
+}

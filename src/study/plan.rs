@@ -1,0 +1,273 @@
+//! What a study will cost before it runs: the work of each variant and an
+//! estimate of its time and memory.
+//!
+//! Work: [`pipeline::planned_solves`] solves on an `nx × ny × nz` grid.
+//!
+//! Memory model (peak resident bytes of one variant):
+//! `BASELINE_BYTES + voxels × (B_method + 8 × species)`, with `B_method` the
+//! measured bytes per voxel of docs/PERFORMANCE.md (time-marching 238,
+//! BiCGStab 318, GMRES(20) 574; `auto` runs BiCGStab, so 318; Born is
+//! counted as time-marching) and 8 B per species for the raster's volume
+//! fractions.
+//!
+//! Time model (one variant, all threads): per solve
+//! `t_setup + applications × t_apply × KRYLOV_OVERHEAD`, where `t_setup`
+//! (building the solver's system: shift, Green's tables) and `t_apply` (one
+//! application of the shifted operator `x − G_s V' x`) are **timed at plan
+//! time on this machine** for each distinct grid of the plan — on the grid
+//! itself when it has at most [`CALIBRATION_VOXELS`] voxels, otherwise on a
+//! grid with the same `nz` and fewer lateral cells, scaled by
+//! `N log₂(nx ny)` (the FFTs). `applications` is the mean number of operator
+//! applications per solve of this study's finished results when there are
+//! any (BiCGStab counts 2 per iteration, GMRES and time-marching 1), else
+//! [`DEFAULT_APPLICATIONS`]. Geometry packing and output are not modelled
+//! (seconds per variant). The estimate is a guide (±2×), not a promise.
+
+use super::run::{self, State};
+use super::sweep::Variant;
+use crate::config::{Method, Scene};
+use crate::pipeline;
+use crate::solver::{MethodUsed, Problem, System};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Resident memory of the program before any field is allocated (binary,
+/// geometry, tables): the 23 MB baseline of docs/PERFORMANCE.md, rounded up.
+pub const BASELINE_BYTES: f64 = 25e6;
+/// Largest grid timed directly at plan time.
+pub const CALIBRATION_VOXELS: usize = 1 << 19;
+/// Operator applications per solve assumed when no result of the study
+/// exists yet: BiCGStab on the demo layer needed 84–348 (median 232) to
+/// 1e-6 (docs/PERFORMANCE.md); 200 is the round middle.
+pub const DEFAULT_APPLICATIONS: f64 = 200.0;
+/// Work per operator application beyond the timed operator (BiCGStab's
+/// vector updates and inner products), as a factor.
+pub const KRYLOV_OVERHEAD: f64 = 1.25;
+
+/// Bytes per voxel of a solve (docs/PERFORMANCE.md).
+pub fn bytes_per_voxel(m: Method) -> f64 {
+    match m {
+        Method::TimeMarching | Method::Born => 238.0,
+        Method::BiCgStab | Method::Auto => 318.0,
+        Method::Gmres => 574.0,
+    }
+}
+
+/// Timings of one grid.
+#[derive(Debug, Clone, Copy)]
+pub struct GridTiming {
+    /// The grid timed (may be smaller than the one estimated).
+    pub timed: [usize; 3],
+    pub setup_s: f64,
+    pub apply_s: f64,
+}
+
+/// The measured basis of the time model.
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// Per distinct grid (nx, ny, nz) → its timing, scaled to that grid.
+    pub grids: BTreeMap<[usize; 3], GridTiming>,
+    pub applications: f64,
+    /// Where `applications` came from.
+    pub applications_source: String,
+}
+
+/// Estimated cost of one variant.
+#[derive(Debug, Clone, Copy)]
+pub struct Estimate {
+    pub solves: usize,
+    pub grid: [usize; 3],
+    pub voxels: usize,
+    pub realisations: usize,
+    pub seconds: f64,
+    pub bytes: f64,
+}
+
+fn grid_of(s: &Scene) -> [usize; 3] {
+    [s.grid.nx, s.grid.ny, s.grid.nz]
+}
+
+/// Time setup and one application on `grid` (reduced if large) and scale.
+pub fn time_grid(grid: [usize; 3]) -> GridTiming {
+    let [nx, ny, nz] = grid;
+    let (mut tx, mut ty) = (nx, ny);
+    while tx * ty * nz > CALIBRATION_VOXELS && (tx > 4 || ty > 4) {
+        if tx >= ty {
+            tx = tx.div_ceil(2);
+        } else {
+            ty = ty.div_ceil(2);
+        }
+    }
+    let timed = [tx, ty, nz];
+    let (setup, apply) = time_exact(timed);
+    let work = |x: usize, y: usize| (x * y * nz) as f64 * ((x * y) as f64).log2().max(1.0);
+    let scale = work(nx, ny) / work(tx, ty);
+    GridTiming {
+        timed,
+        setup_s: setup * scale,
+        apply_s: apply * scale,
+    }
+}
+
+/// Median of three timings of the system setup and of one shifted operator
+/// application on a layer with grains of index 1.4 + 0.3i in the binder.
+fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
+    let eb = 1.558f64.powi(2);
+    let ep = C64::new(1.4, 0.3).powi(2);
+    let eps = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
+        if (i / 3 + j / 3 + k / 3) % 3 == 0 {
+            ep
+        } else {
+            C64::new(eb, 0.0)
+        }
+    });
+    let lattice = Problem::lattice(
+        [nx, ny, nz],
+        [25.0 * nx as f64, 25.0 * ny as f64, 10.0 * nz as f64],
+        550.0,
+        30.0,
+        0.0,
+    );
+    let p = Problem {
+        lattice,
+        eps: &eps,
+        eps_binder: eb,
+    };
+    let mut setups = vec![];
+    let mut applies = vec![];
+    let x = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
+        C64::new(((i + 2 * j) as f64 * 0.01).cos(), (k as f64 * 0.1).sin())
+    });
+    let mut out = Array3::zeros((nz, ny, nx));
+    for _ in 0..3 {
+        let t = Instant::now();
+        let Ok(mut sys) = System::new(&p) else {
+            return (f64::NAN, f64::NAN);
+        };
+        setups.push(t.elapsed().as_secs_f64());
+        sys.apply_a_shifted(&x, &mut out);
+        let t = Instant::now();
+        sys.apply_a_shifted(&x, &mut out);
+        applies.push(t.elapsed().as_secs_f64());
+    }
+    setups.sort_by(f64::total_cmp);
+    applies.sort_by(f64::total_cmp);
+    (setups[1], applies[1])
+}
+
+/// Mean operator applications per solve over the finished results among
+/// `variants`, if any.
+pub fn measured_applications(variants: &[Variant]) -> Option<(f64, usize)> {
+    let (mut sum, mut n, mut files) = (0.0, 0usize, 0usize);
+    for v in variants {
+        if run::state(v) != State::Done {
+            continue;
+        }
+        let Ok(s) = crate::io::read_summary(&run::paths(v).0) else {
+            continue;
+        };
+        files += 1;
+        for e in &s.entries {
+            sum += match e.method {
+                MethodUsed::BiCgStab => 2.0 * e.iterations as f64 + 2.0,
+                _ => e.iterations as f64 + 1.0,
+            };
+            n += 1;
+        }
+    }
+    (n > 0).then(|| (sum / n as f64, files))
+}
+
+/// Calibrate the time model for the grids of `variants`.
+pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
+    let mut grids = BTreeMap::new();
+    for v in variants {
+        let g = grid_of(&v.scene);
+        grids.entry(g).or_insert_with(|| time_grid(g));
+    }
+    let (applications, applications_source) = match measured_applications(finished) {
+        Some((a, files)) => (
+            a,
+            format!("mean of the {files} finished result(s) of this study"),
+        ),
+        None => (
+            DEFAULT_APPLICATIONS,
+            "assumed (no finished result yet; BiCGStab on the demo layer needed 84–348, \
+             docs/PERFORMANCE.md)"
+                .to_string(),
+        ),
+    };
+    Calibration {
+        grids,
+        applications,
+        applications_source,
+    }
+}
+
+/// The estimate of one variant.
+pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
+    let grid = grid_of(scene);
+    let voxels = grid.iter().product();
+    let solves = pipeline::planned_solves(scene);
+    let seconds = cal.grids.get(&grid).map_or(f64::NAN, |t| {
+        solves as f64 * (t.setup_s + cal.applications * t.apply_s * KRYLOV_OVERHEAD)
+    });
+    let bytes = BASELINE_BYTES
+        + voxels as f64 * (bytes_per_voxel(scene.solver.method) + 8.0 * scene.species.len() as f64);
+    Estimate {
+        solves,
+        grid,
+        voxels,
+        realisations: scene.realisations,
+        seconds,
+        bytes,
+    }
+}
+
+/// `1.5 s`, `12 min`, `3.4 h`.
+pub fn human_time(s: f64) -> String {
+    if !s.is_finite() {
+        "?".into()
+    } else if s < 90.0 {
+        format!("{s:.1} s")
+    } else if s < 5400.0 {
+        format!("{:.0} min", s / 60.0)
+    } else {
+        format!("{:.1} h", s / 3600.0)
+    }
+}
+
+/// `12 MB`, `3.4 GB`.
+pub fn human_bytes(b: f64) -> String {
+    if b < 1e9 {
+        format!("{:.0} MB", b / 1e6)
+    } else {
+        format!("{:.1} GB", b / 1e9)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_model_matches_the_documented_rates() {
+        assert_eq!(bytes_per_voxel(Method::TimeMarching), 238.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab), 318.0);
+        assert_eq!(bytes_per_voxel(Method::Gmres), 574.0);
+        assert_eq!(human_time(30.0), "30.0 s");
+        assert_eq!(human_time(600.0), "10 min");
+        assert_eq!(human_time(7200.0), "2.0 h");
+        assert_eq!(human_bytes(2.5e9), "2.5 GB");
+    }
+
+    #[test]
+    fn large_grids_are_timed_reduced_and_scaled() {
+        let t = time_grid([64, 64, 200]);
+        assert!(t.timed[0] * t.timed[1] * t.timed[2] <= CALIBRATION_VOXELS);
+        assert_eq!(t.timed[2], 200);
+        assert!(t.apply_s > 0.0 && t.setup_s > 0.0);
+    }
+}

@@ -1,0 +1,373 @@
+//! Running the variants of a study: resumable, sharded, in parallel.
+//!
+//! Each variant writes `<study dir>/variants/<name>.h5` and `<name>.png`
+//! through [`pipeline::run`], which writes both atomically (temporary file,
+//! sync, rename): an interrupted run (Ctrl-C, a killed job) leaves either no
+//! file or a complete one under the final names, at most a stale `*.tmp`
+//! that the next run of that variant removes first.
+//!
+//! Before running, each variant's [`State`] is read from its files: it is
+//! skipped only when its result file reads back ([`io::read_summary`]), its
+//! stored `input_hash` equals the hash of the variant's exact scene text,
+//! it holds the planned number of solves and its tile exists; otherwise it
+//! is (re)done and the reason is logged.
+//!
+//! Variants are split over shards round-robin by expansion index (variant
+//! `i` belongs to shard `i mod N`), so every shard gets a similar mix. Within
+//! a process, `jobs` worker threads take variants from a shared queue; each
+//! variant's solves use the rayon pool. Results never depend on either:
+//! a variant's seed is a function of its name.
+
+use super::sweep::Variant;
+use crate::io;
+use crate::pipeline;
+use crate::progress::Progress;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Which part of the study a process runs: shard `index` of `count` (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole study.
+    pub const ALL: Shard = Shard { index: 0, count: 1 };
+
+    /// Parse `I/N` (0 ≤ I < N).
+    pub fn parse(s: &str) -> Result<Shard, String> {
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("--shard must be I/N (e.g. 0/4), got `{s}`"))?;
+        let index: usize = i
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard: `{i}` is not a shard index"))?;
+        let count: usize = n
+            .trim()
+            .parse()
+            .map_err(|_| format!("--shard: `{n}` is not a shard count"))?;
+        if count == 0 || index >= count {
+            return Err(format!(
+                "--shard {s}: need 0 <= I < N (shards are numbered from 0)"
+            ));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// From Slurm's job-array variables, when set: `SLURM_ARRAY_TASK_ID`
+    /// minus `SLURM_ARRAY_TASK_MIN` (default 0) of `SLURM_ARRAY_TASK_COUNT`.
+    pub fn from_env(get: impl Fn(&str) -> Option<String>) -> Result<Option<Shard>, String> {
+        let (Some(id), Some(count)) = (get("SLURM_ARRAY_TASK_ID"), get("SLURM_ARRAY_TASK_COUNT"))
+        else {
+            return Ok(None);
+        };
+        let num = |k: &str, v: &str| {
+            v.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("{k}=`{v}` is not a number"))
+        };
+        let id = num("SLURM_ARRAY_TASK_ID", &id)?;
+        let count = num("SLURM_ARRAY_TASK_COUNT", &count)?;
+        let min = match get("SLURM_ARRAY_TASK_MIN") {
+            Some(m) => num("SLURM_ARRAY_TASK_MIN", &m)?,
+            None => 0,
+        };
+        let index = id
+            .checked_sub(min)
+            .ok_or("SLURM_ARRAY_TASK_ID < SLURM_ARRAY_TASK_MIN")?;
+        Shard::parse(&format!("{index}/{count}")).map(Some)
+    }
+
+    /// Whether variant number `index` belongs to this shard.
+    pub fn contains(&self, index: usize) -> bool {
+        index % self.count == self.index
+    }
+}
+
+/// What the files of a variant say about it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum State {
+    /// Complete, with the variant's input hash: skipped.
+    Done,
+    Missing,
+    /// The result file does not read back (truncated, corrupt).
+    Unreadable(String),
+    /// Written from a different scene text (the study or profile changed).
+    Mismatch {
+        stored: String,
+    },
+    /// Fewer or more solves than planned.
+    Incomplete {
+        found: usize,
+        planned: usize,
+    },
+    /// The result is there, its tile is not.
+    NoTile,
+}
+
+impl State {
+    /// Why the variant has to be (re)done, for the log.
+    pub fn reason(&self) -> String {
+        match self {
+            State::Done => "finished".into(),
+            State::Missing => "no result yet".into(),
+            State::Unreadable(e) => format!("result file unreadable (truncated or corrupt): {e}"),
+            State::Mismatch { stored } => format!(
+                "result was computed from a different configuration (stored input hash {}…)",
+                &stored[..stored.len().min(12)]
+            ),
+            State::Incomplete { found, planned } => {
+                format!("result holds {found} solves, {planned} planned")
+            }
+            State::NoTile => "tile picture missing".into(),
+        }
+    }
+}
+
+/// Result and tile paths of a variant.
+pub fn paths(v: &Variant) -> (PathBuf, PathBuf) {
+    pipeline::result_paths(&v.scene)
+}
+
+/// Read the state of a variant from its files.
+pub fn state(v: &Variant) -> State {
+    let (h5, png) = paths(v);
+    if !h5.exists() {
+        return State::Missing;
+    }
+    match io::read_summary(&h5) {
+        Err(e) => State::Unreadable(e.to_string()),
+        Ok(s) if s.input_hash != v.scene.provenance.input_hash => State::Mismatch {
+            stored: s.input_hash,
+        },
+        Ok(s) if s.entries.len() != pipeline::planned_solves(&v.scene) => State::Incomplete {
+            found: s.entries.len(),
+            planned: pipeline::planned_solves(&v.scene),
+        },
+        Ok(_) if !png.is_file() => State::NoTile,
+        Ok(_) => State::Done,
+    }
+}
+
+/// How a run goes.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// Variants run at the same time (≥ 1).
+    pub jobs: usize,
+    pub shard: Shard,
+    /// No progress output (tests).
+    pub quiet: bool,
+}
+
+/// What happened to one variant.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    pub name: String,
+    /// State found before the run.
+    pub before: State,
+    /// `None`: skipped (already done); `Some(Ok(seconds))`; `Some(Err(message))`.
+    pub result: Option<Result<f64, String>>,
+}
+
+/// The report of a run.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// One per variant of the shard, in expansion order.
+    pub outcomes: Vec<Outcome>,
+    pub wall_s: f64,
+    pub jobs: usize,
+}
+
+impl RunReport {
+    pub fn failed(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.outcomes.iter().filter_map(|o| match &o.result {
+            Some(Err(e)) => Some((o.name.as_str(), e.as_str())),
+            _ => None,
+        })
+    }
+    pub fn ran(&self) -> impl Iterator<Item = (&str, f64)> {
+        self.outcomes.iter().filter_map(|o| match &o.result {
+            Some(Ok(s)) => Some((o.name.as_str(), *s)),
+            _ => None,
+        })
+    }
+    pub fn skipped(&self) -> usize {
+        self.outcomes.iter().filter(|o| o.result.is_none()).count()
+    }
+
+    /// The final report: counts, timings, failures (one line each).
+    pub fn text(&self) -> String {
+        let ran: Vec<(&str, f64)> = self.ran().collect();
+        let failed: Vec<(&str, &str)> = self.failed().collect();
+        let mut out = format!(
+            "study run: {} variants in this shard: {} ran, {} skipped (already finished), {} \
+             failed; wall {:.1} s with {} job(s)\n",
+            self.outcomes.len(),
+            ran.len(),
+            self.skipped(),
+            failed.len(),
+            self.wall_s,
+            self.jobs
+        );
+        if !ran.is_empty() {
+            let total: f64 = ran.iter().map(|r| r.1).sum();
+            let (slow, s) = ran
+                .iter()
+                .fold(("", 0.0), |a, r| if r.1 > a.1 { *r } else { a });
+            out += &format!(
+                "variant time: total {total:.1} s, mean {:.1} s, slowest {slow} {s:.1} s\n",
+                total / ran.len() as f64
+            );
+        }
+        for (n, e) in &failed {
+            out += &format!("FAILED {n}: {e}\n");
+        }
+        out
+    }
+}
+
+/// Run the variants of `opts.shard` that are not finished.
+pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
+    let start = Instant::now();
+    let mine: Vec<&Variant> = variants
+        .iter()
+        .filter(|v| opts.shard.contains(v.index))
+        .collect();
+    let states: Vec<State> = mine.iter().map(|v| state(v)).collect();
+    let todo: Vec<usize> = (0..mine.len())
+        .filter(|&i| states[i] != State::Done)
+        .collect();
+    let progress = if opts.quiet {
+        Progress::hidden(todo.len() as u64, "study")
+    } else {
+        Progress::new(todo.len() as u64, "study")
+    };
+    let jobs = opts.jobs.max(1).min(todo.len().max(1));
+    progress.log(&format!(
+        "[inksim] study: {} variants in shard {}/{}: {} finished, {} to run, {} job(s)",
+        mine.len(),
+        opts.shard.index,
+        opts.shard.count,
+        mine.len() - todo.len(),
+        todo.len(),
+        jobs
+    ));
+    let results: Mutex<Vec<Option<Result<f64, String>>>> = Mutex::new(vec![None; mine.len()]);
+    let next = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                let Some(&i) = todo.get(k) else { break };
+                let v = mine[i];
+                progress.log(&format!(
+                    "[inksim] start {} ({}/{}): {}",
+                    v.name,
+                    k + 1,
+                    todo.len(),
+                    states[i].reason()
+                ));
+                let r = run_one(v);
+                let msg = match &r {
+                    Ok(t) => format!("{} done in {t:.1} s", v.name),
+                    Err(e) => format!("{} FAILED: {e}", v.name),
+                };
+                if r.is_err() {
+                    progress.log(&format!("[inksim] {msg}"));
+                }
+                progress.inc(1, &msg);
+                if let Ok(mut g) = results.lock() {
+                    g[i] = Some(r);
+                }
+            });
+        }
+    });
+    progress.finish("study shard done");
+    let results = results.into_inner().unwrap_or_else(|e| e.into_inner());
+    let outcomes = mine
+        .iter()
+        .zip(states)
+        .zip(results)
+        .map(|((v, before), result)| Outcome {
+            name: v.name.clone(),
+            before,
+            result,
+        })
+        .collect();
+    RunReport {
+        outcomes,
+        wall_s: start.elapsed().as_secs_f64(),
+        jobs,
+    }
+}
+
+/// Run one variant; a panic inside is caught so the others go on.
+fn run_one(v: &Variant) -> Result<f64, String> {
+    let t = Instant::now();
+    let (h5, png) = paths(v);
+    for p in [&h5, &png] {
+        let mut tmp = p.clone().into_os_string();
+        tmp.push(".tmp");
+        let _ = std::fs::remove_file(PathBuf::from(tmp));
+    }
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pipeline::run(&v.scene)));
+    match r {
+        Ok(Ok(_)) => Ok(t.elapsed().as_secs_f64()),
+        Ok(Err(e)) => Err(e.to_string()),
+        Err(p) => Err(format!(
+            "internal error (panic): {}",
+            p.downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| p.downcast_ref::<&str>().copied())
+                .unwrap_or("?")
+        )),
+    }
+}
+
+/// Default number of parallel variants: the smallest of the cores, what the
+/// available memory holds at 80 % (`MemAvailable` of /proc/meminfo over the
+/// largest per-variant estimate), and the variants to run; at least 1.
+pub fn default_jobs(threads: usize, peak_bytes: f64, to_run: usize) -> usize {
+    let by_mem = available_memory()
+        .map(|m| ((0.8 * m as f64) / peak_bytes.max(1.0)).floor() as usize)
+        .unwrap_or(usize::MAX);
+    threads.min(by_mem).min(to_run).max(1)
+}
+
+/// Available memory in bytes (Linux `MemAvailable`), if known.
+pub fn available_memory() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_partition() {
+        assert_eq!(Shard::parse("1/3"), Ok(Shard { index: 1, count: 3 }));
+        assert!(Shard::parse("3/3").is_err());
+        assert!(Shard::parse("0/0").is_err());
+        assert!(Shard::parse("x").is_err());
+        let s: Vec<usize> = (0..7)
+            .filter(|&i| Shard::parse("1/3").unwrap().contains(i))
+            .collect();
+        assert_eq!(s, [1, 4]);
+        let env = |k: &str| match k {
+            "SLURM_ARRAY_TASK_ID" => Some("5".to_string()),
+            "SLURM_ARRAY_TASK_COUNT" => Some("4".to_string()),
+            "SLURM_ARRAY_TASK_MIN" => Some("3".to_string()),
+            _ => None,
+        };
+        assert_eq!(Shard::from_env(env), Ok(Some(Shard { index: 2, count: 4 })));
+        assert_eq!(Shard::from_env(|_| None), Ok(None));
+    }
+}

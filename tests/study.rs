@@ -1,0 +1,549 @@
+//! The study driver end to end (issue #5): sweep expansion, naming and
+//! seeding; plan figures against what a run does; resume after a kill, and
+//! truncated or mismatched results redone; shards adding up to the
+//! unsharded run bit for bit; bad sweep files rejected before any work;
+//! merge. Scenes are tiny (8 × 8 × 4 grids) except the kill test's.
+use inksim::io::{read_summary, ResultSummary};
+use inksim::study::sweep::{variant_seed, Study};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Two pigments × two sizes, 8 × 8 × 4 grid, two wavelengths.
+const SWEEP: &str = r#"
+[study]
+name = "t"
+seed = 5
+output_dir = "out"
+profile = "quick"
+
+[base.layer]
+thickness_nm = 400.0
+fragment_nm = [400.0, 400.0]
+pvc = 0.15
+[[base.pigment]]
+name = "p"
+material = { builtin = "red" }
+diameter_nm = 100.0
+[base.grid]
+cell_nm = 50.0
+z_cell_nm = 100.0
+[base.illumination]
+wavelengths_nm = [450.0, 600.0]
+polar_deg = [0.0]
+
+[profiles.quick]
+"realisations" = 1
+[profiles.three]
+"illumination.wavelengths_nm" = [450.0, 550.0, 650.0]
+
+[[axis]]
+name = "pigment"
+key = "pigment.0.material.builtin"
+values = ["red", "yellow"]
+
+[[axis]]
+name = "d"
+key = "pigment.*.diameter_nm"
+values = [100.0, 150.0]
+"#;
+
+fn inksim_in(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT")
+        .output()
+        .expect("run inksim");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn zipped(text: &str) -> String {
+    text.replace(
+        "profile = \"quick\"",
+        "profile = \"quick\"\nzip = [\"pigment\", \"d\"]",
+    )
+}
+
+fn parse(text: &str) -> Study {
+    Study::parse(Path::new("/virtual/sweep.toml"), text).unwrap()
+}
+
+fn names(text: &str, profile: Option<&str>) -> Vec<String> {
+    parse(text)
+        .expand(profile)
+        .unwrap()
+        .variants
+        .into_iter()
+        .map(|v| v.name)
+        .collect()
+}
+
+/// Everything of a summary but its creation time.
+fn key(s: &ResultSummary) -> ResultSummary {
+    ResultSummary {
+        created_unix_s: 0,
+        ..s.clone()
+    }
+}
+
+/// All result summaries of a study folder, by variant name.
+fn results(variants: &Path) -> BTreeMap<String, ResultSummary> {
+    let mut m = BTreeMap::new();
+    for e in std::fs::read_dir(variants).unwrap().flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "h5") {
+            let n = p.file_stem().unwrap().to_string_lossy().into_owned();
+            m.insert(n, key(&read_summary(&p).unwrap()));
+        }
+    }
+    m
+}
+
+#[test]
+fn expansion_order_names_and_seeds() {
+    let s = parse(SWEEP);
+    let e = s.expand(None).unwrap();
+    let n: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(n, ["red_d100", "red_d150", "yellow_d100", "yellow_d150"]);
+    assert_eq!(e.profile.as_deref(), Some("quick"));
+    assert_eq!(e.study_dir, Path::new("out/quick"));
+    for v in &e.variants {
+        assert_eq!(v.seed, variant_seed(5, &v.name));
+        assert_eq!(v.scene.seed, v.seed);
+        assert_eq!(v.scene.output.name, v.name);
+        assert_eq!(v.scene.output.dir, Path::new("out/quick/variants"));
+        assert_eq!(v.scene.provenance.text, v.text);
+    }
+    let y150 = &e.variants[3];
+    assert_eq!(y150.scene.species[0].material.name, "yellow");
+    assert_eq!(y150.scene.species[0].diameter_nm, 150.0);
+    assert_eq!(y150.label("d"), Some("d150"));
+
+    // Seeds depend on the name only: other values, other order, same seed.
+    let other = SWEEP
+        .replace(
+            "values = [\"red\", \"yellow\"]",
+            "values = [\"yellow\", \"blue\", \"red\"]",
+        )
+        .replace("[100.0, 150.0]", "[150.0, 80.0, 100.0]");
+    let e2 = parse(&other).expand(None).unwrap();
+    assert_eq!(e2.variants.len(), 9);
+    let find = |name: &str| e2.variants.iter().find(|v| v.name == name).unwrap();
+    for v in &e.variants {
+        let w = find(&v.name);
+        assert_eq!(w.seed, v.seed, "{}", v.name);
+        assert_eq!(w.text, v.text, "{}", v.name);
+    }
+    // The profile changes the scenes but not the names or seeds.
+    let e3 = s.expand(Some("three")).unwrap();
+    assert_eq!(e3.variants[0].scene.wavelengths_nm, [450.0, 550.0, 650.0]);
+    assert_eq!(e3.variants[0].seed, e.variants[0].seed);
+    assert_eq!(e3.study_dir, Path::new("out/three"));
+}
+
+#[test]
+fn zip_exclude_explicit_and_compound_values() {
+    let text = format!(
+        "{}\n\
+         [[variant]]\nname = \"mix\"\nlabels = {{ d = \"d150\" }}\n\
+         set = {{ \"pigment\" = [ {{ name = \"y\", material = {{ builtin = \"yellow\" }} }}, \
+         {{ name = \"b\", material = {{ builtin = \"blue\" }}, share = 3.0 }} ] }}\n",
+        zipped(SWEEP)
+    );
+    // Zipped: red with 100, yellow with 150. The explicit variant takes the
+    // d axis value (label d150) and then its `set` replaces the pigments.
+    let text = text
+        .replace("share = 3.0 }", "share = 3.0, diameter_nm = 90.0 }")
+        .replace(
+            "{ name = \"y\", material = { builtin = \"yellow\" } }",
+            "{ name = \"y\", material = { builtin = \"yellow\" }, diameter_nm = 80.0 }",
+        );
+    let e = parse(&text).expand(None).unwrap();
+    let n: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(n, ["red_d100", "yellow_d150", "mix"]);
+    assert_eq!(e.variants[1].scene.species[0].diameter_nm, 150.0);
+    let mix = &e.variants[2];
+    assert_eq!(mix.label("d"), Some("d150"));
+    assert_eq!(mix.label("pigment"), None);
+    assert_eq!(mix.seed, variant_seed(5, "mix"));
+    let sp = &mix.scene.species;
+    assert_eq!(sp.len(), 2);
+    assert!((sp[0].volume_fraction - 0.15 / 4.0).abs() < 1e-12);
+    assert!((sp[1].volume_fraction - 0.15 * 3.0 / 4.0).abs() < 1e-12);
+    assert_eq!((sp[0].diameter_nm, sp[1].diameter_nm), (80.0, 90.0));
+
+    // Compound axis with wildcard over two pigments, and an exclusion.
+    let compound = format!(
+        "{}\n[[axis]]\nname = \"grain\"\n\
+         [[axis.value]]\nlabel = \"mol\"\nset = {{ \"pigment.*.shape\" = {{ kind = \"molecular\" }} }}\n\
+         [[axis.value]]\nlabel = \"cyl\"\nset = {{ \"pigment.*.shape\" = {{ kind = \"cylinder\", aspect = 3.0, spheres = 5 }}, \"pigment.*.orientation\" = \"in-plane\" }}\n\
+         [[exclude]]\npigment = \"yellow\"\ngrain = \"cyl\"\n",
+        SWEEP
+    );
+    let n = names(&compound, None);
+    assert_eq!(n.len(), 8 - 2);
+    assert!(n.contains(&"red_d150_cyl".to_string()));
+    assert!(!n
+        .iter()
+        .any(|x| x.starts_with("yellow") && x.ends_with("cyl")));
+}
+
+/// A bad sweep: the CLI fails with one `error:` line containing every
+/// needle, before any work (no output folder).
+fn expect_error(text: &str, needles: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", text);
+    for cmd in ["run", "plan"] {
+        let (ok, _, err) = inksim_in(dir.path(), &[cmd, p.to_str().unwrap()]);
+        assert!(!ok, "{cmd} should fail: {needles:?}");
+        assert!(!err.contains("panicked"), "{err}");
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "one line expected: {err}");
+        assert!(lines[0].starts_with("error: "), "{err}");
+        assert!(err.contains("sweep.toml"), "file not named: {err}");
+        for n in needles {
+            assert!(err.contains(n), "`{n}` not in: {err}");
+        }
+        assert!(!dir.path().join("out").exists(), "work started: {err}");
+    }
+}
+
+#[test]
+fn bad_sweep_files_are_rejected_before_any_work() {
+    // An axis naming an unknown key: the scene schema rejects it, the
+    // message names the axis and the key path.
+    expect_error(
+        &SWEEP.replace(
+            "key = \"pigment.*.diameter_nm\"",
+            "key = \"pigment.*.diametre_nm\"",
+        ),
+        &["axis `d`", "diametre_nm", "unknown field"],
+    );
+    expect_error(
+        &SWEEP.replace(
+            "key = \"pigment.0.material.builtin\"",
+            "key = \"layer.pigment_colour\"",
+        ),
+        &["axis `pigment`", "pigment_colour"],
+    );
+    // An out-of-range index.
+    expect_error(
+        &SWEEP.replace("pigment.*.diameter_nm", "pigment.1.diameter_nm"),
+        &["axis `d`", "index 1 is out of range"],
+    );
+    // An empty axis.
+    expect_error(
+        &SWEEP.replace("values = [100.0, 150.0]", "values = []"),
+        &["axis `d`", "no values"],
+    );
+    // An exclusion that matches nothing (zipped, red never meets d150).
+    expect_error(
+        &format!(
+            "{}\n[[exclude]]\npigment = \"red\"\nd = \"d150\"\n",
+            zipped(SWEEP)
+        ),
+        &["[[exclude]] 1", "matches no combination"],
+    );
+    // An exclusion naming a label that does not exist.
+    expect_error(
+        &format!("{SWEEP}\n[[exclude]]\nd = \"d999\"\n"),
+        &["axis `d` has no label `d999`", "d100, d150"],
+    );
+    // Two variants with the same name.
+    expect_error(
+        &format!("{SWEEP}\n[[variant]]\nname = \"red_d100\"\n"),
+        &["two variants are named `red_d100`"],
+    );
+    expect_error(
+        &SWEEP.replace(
+            "values = [100.0, 150.0]",
+            "values = [100.0, 150.0]\nlabels = [\"x+\", \"x*\"]",
+        ),
+        &["two variants are named `red_x-`"],
+    );
+    // An unknown profile, a reserved key, an invalid value.
+    expect_error(
+        &SWEEP.replace("profile = \"quick\"", "profile = \"fast\""),
+        &["unknown profile `fast`", "quick, three"],
+    );
+    expect_error(
+        &SWEEP.replace("key = \"pigment.*.diameter_nm\"", "key = \"seed\""),
+        &["axis `d`", "`seed`", "cannot be overridden"],
+    );
+    expect_error(
+        &SWEEP.replace("[100.0, 150.0]", "[100.0, 500.0]"),
+        &["variant `red_d500`", "diameter_nm", "axis `d`"],
+    );
+}
+
+#[test]
+fn plan_figures_match_the_run_and_merge_needs_every_variant() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let ps = p.to_str().unwrap();
+    let (ok, plan, err) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
+    assert!(ok, "{err}");
+    assert!(plan.contains("calibrated now on this machine"), "{plan}");
+    assert!(plan.contains("grid 8×8×4: setup"), "{plan}");
+    // Per-variant rows: "#  name  solves  grid  voxels  real. ..."
+    let mut planned = BTreeMap::new();
+    for l in plan.lines() {
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() > 5 && f[0].parse::<usize>().is_ok() {
+            assert_eq!(f[3], "8×8×4", "{l}");
+            assert_eq!(f[4], "256", "{l}");
+            planned.insert(f[1].to_string(), f[2].parse::<usize>().unwrap());
+        }
+    }
+    assert_eq!(planned.len(), 4, "{plan}");
+    let study = Study::load(&p).unwrap();
+    let quick: usize = study
+        .expand(Some("quick"))
+        .unwrap()
+        .variants
+        .iter()
+        .map(|v| inksim::pipeline::planned_solves(&v.scene))
+        .sum();
+    assert!(
+        plan.contains(&format!("quick      4 variants, {quick} solves")),
+        "{plan}"
+    );
+    let three = study.expand(Some("three")).unwrap();
+
+    let (ok, _, err) = inksim_in(dir.path(), &["merge", ps, "--profile", "three"]);
+    assert!(
+        !ok && err.contains("4 of 4 variants are not finished"),
+        "{err}"
+    );
+    assert!(err.contains("red_d100 (no result yet)"), "{err}");
+
+    let (ok, out, err) = inksim_in(dir.path(), &["run", ps, "--profile", "three"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("4 ran, 0 skipped"), "{out}");
+    let got = results(&dir.path().join("out/three/variants"));
+    for v in &three.variants {
+        let n = planned[&v.name];
+        assert_eq!(got[&v.name].entries.len(), n, "{}", v.name);
+        assert_eq!(n, inksim::pipeline::planned_solves(&v.scene));
+    }
+    let (ok, plan2, _) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
+    assert!(
+        ok && plan2.contains("mean of the 4 finished result(s)"),
+        "{plan2}"
+    );
+
+    let (ok, out, err) = inksim_in(dir.path(), &["merge", ps, "--profile", "three"]);
+    assert!(ok, "{err}");
+    let sd = dir.path().join("out/three");
+    assert!(out.contains("summary.h5"), "{out}");
+    let md = std::fs::read_to_string(sd.join("summary.md")).unwrap();
+    for name in planned.keys() {
+        assert!(
+            md.contains(&format!("[{name}](variants/{name}.png)")),
+            "{md}"
+        );
+    }
+    let grid = std::fs::read(sd.join("grids/pigment-by-d.png")).unwrap();
+    let c = inksim::render::canvas::Canvas::decode_png(&grid).unwrap();
+    assert!(c.w > 100 && c.h > 100);
+    // The summary file reaches every variant's file through its links.
+    let f = hdf5::File::open(sd.join("summary.h5")).unwrap();
+    let names: Vec<hdf5::types::VarLenUnicode> = f.dataset("name").unwrap().read_raw().unwrap();
+    assert_eq!(names.len(), 4);
+    let r: Vec<f64> = f.dataset("mean_reflectance").unwrap().read_raw().unwrap();
+    for (n, r) in names.iter().zip(&r) {
+        let g = f.group(&format!("variants/{}", n.as_str())).unwrap();
+        let h: hdf5::types::VarLenUnicode = g.attr("input_hash").unwrap().read_scalar().unwrap();
+        let s = &got[n.as_str()];
+        assert_eq!(h.as_str(), s.input_hash);
+        let mean =
+            s.entries.iter().map(|e| e.total_reflectance).sum::<f64>() / s.entries.len() as f64;
+        assert!((mean - r).abs() < 1e-15);
+    }
+}
+
+#[test]
+fn truncated_and_mismatched_results_are_redone() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let ps = p.to_str().unwrap();
+    let (ok, _, err) = inksim_in(dir.path(), &["run", ps]);
+    assert!(ok, "{err}");
+    let vd = dir.path().join("out/quick/variants");
+    let before = results(&vd);
+    // Truncate one result, overwrite another with a different variant's file.
+    let a = vd.join("red_d100.h5");
+    let bytes = std::fs::read(&a).unwrap();
+    std::fs::write(&a, &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::copy(vd.join("yellow_d100.h5"), vd.join("red_d150.h5")).unwrap();
+    let (ok, out, err) = inksim_in(dir.path(), &["run", ps]);
+    assert!(ok, "{err}");
+    assert!(out.contains("2 ran, 2 skipped"), "{out}");
+    assert!(
+        err.contains("start red_d100")
+            && err.contains("result file unreadable (truncated or corrupt)"),
+        "{err}"
+    );
+    assert!(
+        err.contains("start red_d150") && err.contains("computed from a different configuration"),
+        "{err}"
+    );
+    assert_eq!(results(&vd), before);
+}
+
+#[test]
+fn shards_together_give_the_unsharded_run() {
+    let whole = tempfile::tempdir().unwrap();
+    let parts = tempfile::tempdir().unwrap();
+    let text = SWEEP.replace("values = [100.0, 150.0]", "values = [100.0, 120.0, 150.0]");
+    let pw = write(whole.path(), "sweep.toml", &text);
+    let pp = write(parts.path(), "sweep.toml", &text);
+    let (ok, _, err) = inksim_in(
+        whole.path(),
+        &["--threads", "2", "run", pw.to_str().unwrap()],
+    );
+    assert!(ok, "{err}");
+    let mut ran = 0;
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let (ok, out, err) = if i < 2 {
+            inksim_in(
+                parts.path(),
+                &[
+                    "--threads",
+                    "1",
+                    "run",
+                    pp.to_str().unwrap(),
+                    "--shard",
+                    &shard,
+                ],
+            )
+        } else {
+            // The last shard as a Slurm array task would see it.
+            let o = Command::new(env!("CARGO_BIN_EXE_inksim"))
+                .args(["run", pp.to_str().unwrap()])
+                .current_dir(parts.path())
+                .env("SLURM_ARRAY_TASK_ID", "2")
+                .env("SLURM_ARRAY_TASK_COUNT", "3")
+                .output()
+                .unwrap();
+            (
+                o.status.success(),
+                String::from_utf8_lossy(&o.stdout).into_owned(),
+                String::from_utf8_lossy(&o.stderr).into_owned(),
+            )
+        };
+        assert!(ok, "{err}");
+        assert!(out.contains("2 variants in this shard: 2 ran"), "{out}");
+        assert!(err.contains(&format!("shard {i}/3")), "{err}");
+        ran += 2;
+    }
+    assert_eq!(ran, 6);
+    let a = results(&whole.path().join("out/quick/variants"));
+    let b = results(&parts.path().join("out/quick/variants"));
+    assert_eq!(a.len(), 6);
+    assert_eq!(a, b);
+}
+
+/// Slow enough variants (32 × 32 × 8, four wavelengths) that a kill lands
+/// mid-way.
+fn slow_sweep() -> String {
+    SWEEP
+        .replace("cell_nm = 50.0", "cell_nm = 12.5")
+        .replace("z_cell_nm = 100.0", "z_cell_nm = 50.0")
+        .replace(
+            "wavelengths_nm = [450.0, 600.0]",
+            "wavelengths_nm = [450.0, 500.0, 550.0, 600.0]",
+        )
+        .replace("values = [100.0, 150.0]", "values = [100.0, 120.0, 150.0]")
+}
+
+#[test]
+fn killed_run_resumes_to_the_uninterrupted_result() {
+    let text = slow_sweep();
+    let whole = tempfile::tempdir().unwrap();
+    let pw = write(whole.path(), "sweep.toml", &text);
+    let (ok, _, err) = inksim_in(
+        whole.path(),
+        &["--threads", "1", "run", pw.to_str().unwrap()],
+    );
+    assert!(ok, "{err}");
+    let reference = results(&whole.path().join("out/quick/variants"));
+    assert_eq!(reference.len(), 6);
+
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", &text);
+    let vd = dir.path().join("out/quick/variants");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(["--threads", "1", "run", p.to_str().unwrap(), "--jobs", "1"])
+        .current_dir(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let first = vd.join("red_d100.h5");
+    let t = Instant::now();
+    while !first.exists() {
+        assert!(t.elapsed() < Duration::from_secs(120), "no result appeared");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+    let partial = results(&vd);
+    assert!(
+        !partial.is_empty() && partial.len() < 6,
+        "kill should land mid-way: {} results",
+        partial.len()
+    );
+    // Whatever was left under a final name is complete (atomic writes).
+    for (n, s) in &partial {
+        assert_eq!(s, &reference[n]);
+    }
+    let (ok, out, err) = inksim_in(dir.path(), &["run", p.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains(&format!(
+            "{} ran, {} skipped",
+            6 - partial.len(),
+            partial.len()
+        )),
+        "{out}"
+    );
+    assert_eq!(results(&vd), reference);
+    let leftovers: Vec<_> = std::fs::read_dir(&vd)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().extension().is_some_and(|x| x == "tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn slurm_script_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let (ok, out, err) = inksim_in(
+        dir.path(),
+        &["slurm", p.to_str().unwrap(), "--shards", "3", "--cpus", "1"],
+    );
+    assert!(ok, "{err}");
+    let script = dir.path().join("out/quick/t-quick.sbatch");
+    assert!(out.contains("t-quick.sbatch"), "{out}");
+    let s = std::fs::read_to_string(script).unwrap();
+    assert!(s.contains("#SBATCH --array=0-2\n"), "{s}");
+    assert!(s.contains("--profile 'quick' --jobs 1"), "{s}");
+    assert!(dir.path().join("out/quick/slurm").is_dir());
+}

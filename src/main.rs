@@ -300,16 +300,21 @@ fn real_main() -> Result<ExitCode> {
                 g.nz,
                 g.nx * g.ny * g.nz
             );
+            let run_plan = inksim::pipeline::RunPlan::of(&scene);
             println!(
-                "{} wavelengths × {} angles = {} solves, method {:?}, tolerance {:.0e}",
+                "{} solves ({} wavelengths × {} realisations × {} incidences), method {:?}, \
+                 tolerance {:.0e}",
+                run_plan.solves(&scene),
                 scene.wavelengths_nm.len(),
-                scene.incidence.len(),
-                scene.wavelengths_nm.len() * scene.incidence.len(),
+                run_plan.realisations,
+                run_plan.solves_per_wavelength(),
                 scene.solver.method,
                 scene.solver.tolerance
             );
-            let (packer, why) = inksim::pipeline::packer_of(&scene);
-            println!("packer: {packer} ({why})");
+            println!("plan:");
+            for line in &run_plan.lines {
+                println!("  {line}");
+            }
             let (h5, png) = inksim::pipeline::result_paths(&scene);
             println!("would write {} and {}", h5.display(), png.display());
         }

@@ -553,8 +553,15 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
     }
 }
 
-/// Run a scene end to end and write its result files.
+/// Run a scene end to end and write its result files, with a progress bar
+/// (terminal) or log lines.
 pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
+    run_with(scene, false)
+}
+
+/// [`run`], optionally without any progress output (variants of a study
+/// running side by side report through the study's own bar).
+pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> {
     let (result_path, picture_path) = result_paths(scene);
     let orders_path = scene
         .output
@@ -562,7 +569,12 @@ pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
         .join(format!("{}-orders.png", scene.output.name));
     check_output_dir(&scene.output.dir)?;
     let plan = RunPlan::of(scene);
-    let progress = Progress::new(plan.solves(scene) as u64, &scene.output.name);
+    let total = plan.solves(scene) as u64;
+    let progress = if quiet {
+        Progress::hidden(total, &scene.output.name)
+    } else {
+        Progress::new(total, &scene.output.name)
+    };
     for l in &plan.lines {
         progress.log(l);
     }

@@ -4,10 +4,24 @@
 //! for a wavelength is then a per-voxel linear mix ([`Raster::epsilon_into`]),
 //! so the geometry is rasterised once for all wavelengths.
 //!
-//! Grid: `nx × ny × nz` voxels spanning exactly the fragment; voxel
-//! `(ix, iy, iz)` covers `[ix·dx, (ix+1)·dx) × [iy·dy, (iy+1)·dy) ×
-//! [iz·dz, (iz+1)·dz)` with `dz = H/nz`. Arrays are `(nz, ny, nx)`, so every
-//! x–y slice is contiguous (the solver FFTs those).
+//! Grid: `nx × ny × nz` voxels spanning the fragment; voxel `(ix, iy, iz)`
+//! covers `[ix·dx, (ix+1)·dx) × [iy·dy, (iy+1)·dy) × [z₀ + iz·dz,
+//! z₀ + (iz+1)·dz)` with `dz = size_nm[2]/nz`. Arrays are `(nz, ny, nx)`, so
+//! every x–y slice is contiguous (the solver FFTs those).
+//!
+//! Surface relief: light comes from `z < 0` and grains may protrude through
+//! the binder surface `z = 0`. A grid may then be taller than the layer:
+//! `size_nm[2] = H + k·dz` for a whole number `k` of cells, which lie above
+//! the binder (`z₀ = −k·dz`; without relief `k = 0`, `z₀ = 0`).
+//! [`Grid::covering_relief`] adds the cells a geometry needs. The binder
+//! surface stays flat at `z = 0`: above it, whatever is not grain is vacuum
+//! ([`Raster::top_cells`], used by [`Raster::epsilon_into`]). (A binder
+//! film wetting the protruding grains would need a model of its meniscus;
+//! the flat surface is the simplest choice and keeps the layer's binder
+//! volume exact.) The solver needs no change: it sees the whole grid as
+//! binder background plus a contrast, which is `1 − ε_binder` in the vacuum
+//! voxels; its reference plane `z = 0` then lies `k·dz` above the binder
+//! surface, which shifts reflection phases only, not intensities.
 //!
 //! Volume fraction, not a point sample: for each particle and each voxel of
 //! its bounding box (wrapped periodically in x and y) the voxel counts 1 when it
@@ -22,7 +36,7 @@
 //! Parallel over z-slices: every slice adds its particles' contributions in
 //! particle order, so the result is bit-identical for any thread count.
 //! Particles are assumed narrower than the lateral period (the packer ensures
-//! half of it); parts outside `0 ≤ z ≤ H` are not rasterised.
+//! half of it); parts outside the grid (`z₀ ≤ z ≤ H`) are not rasterised.
 
 use crate::geometry::{Geometry, Sphere};
 use ndarray::{Array3, ArrayViewMut2, Axis};
@@ -39,7 +53,8 @@ pub struct Grid {
     pub nx: usize,
     pub ny: usize,
     pub nz: usize,
-    /// `[Lx, Ly, H]`, nm; the same as the geometry's fragment.
+    /// `[Lx, Ly, Z]`, nm: the geometry's fragment, with `Z = H` or, with
+    /// relief cells above the binder, `Z = H + k·Z/nz` (module docs).
     pub size_nm: [f64; 3],
 }
 
@@ -107,6 +122,42 @@ impl Grid {
         let c = self.cell_nm();
         c[0] * c[1] * c[2]
     }
+
+    /// This grid (over the binder layer `0 ≤ z ≤ H`) extended upwards by
+    /// the fewest whole cells of the same `dz` that reach `top_nm` above
+    /// `z = 0` (`top_nm ≤ 0` or not finite: the grid as is). A relative
+    /// 1e-9 of slack keeps a height that lands on a cell face from adding a
+    /// cell.
+    pub fn with_top_nm(&self, top_nm: f64) -> Grid {
+        let dz = self.size_nm[2] / self.nz as f64;
+        let k = if top_nm.is_finite() && top_nm > 0.0 {
+            (top_nm / dz * (1.0 - 1e-9)).ceil() as usize
+        } else {
+            0
+        };
+        Grid {
+            nz: self.nz + k,
+            size_nm: [
+                self.size_nm[0],
+                self.size_nm[1],
+                self.size_nm[2] + k as f64 * dz,
+            ],
+            ..*self
+        }
+    }
+
+    /// [`Grid::with_top_nm`] for the highest grain point of `geometry`
+    /// above `z = 0` (none without relief: the grid as is).
+    pub fn covering_relief(&self, geometry: &Geometry) -> Grid {
+        let top = geometry
+            .particles
+            .iter()
+            .flat_map(|p| &p.spheres)
+            .map(|s| s.radius - s.center[2])
+            .filter(|t| t.is_finite())
+            .fold(0.0, f64::max);
+        self.with_top_nm(top)
+    }
 }
 
 /// Volume fraction of each species in each voxel, arrays of shape
@@ -115,6 +166,9 @@ impl Grid {
 pub struct Raster {
     pub grid: Grid,
     pub fractions: Vec<Array3<f64>>,
+    /// Top z-slices lying above the binder surface `z = 0` (vacuum
+    /// background; 0 without relief).
+    pub top_cells: usize,
 }
 
 /// A particle ready for rasterising: its spheres unwrapped next to the first
@@ -285,23 +339,32 @@ fn voxel_fraction(
 /// `supersample` midpoint sub-samples per axis in voxels cut by a surface
 /// (clamped to `1..=MAX_SUPERSAMPLE`; 4 or 5 is usual).
 ///
+/// The grid may extend above the binder by whole cells (relief, see the
+/// module docs); those become [`Raster::top_cells`].
+///
 /// # Panics
-/// If the grid fails [`Grid::check`] or its size differs from the geometry's
-/// fragment (relative 1e-9): both are programming errors, not input.
+/// If the grid fails [`Grid::check`], its lateral size differs from the
+/// geometry's fragment, or its height is not `H` plus a whole number of
+/// cells (relative 1e-9): programming errors, not input.
 pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster {
     if let Err(e) = grid.check() {
         panic!("rasterize: {e}");
     }
-    let same = geometry
-        .size_nm
-        .iter()
-        .zip(grid.size_nm)
-        .all(|(g, r)| (g - r).abs() <= 1e-9 * g.abs().max(r.abs()));
+    let close = |g: f64, r: f64| (g - r).abs() <= 1e-9 * g.abs().max(r.abs());
+    let dz = grid.size_nm[2] / grid.nz as f64;
+    let extra = (grid.size_nm[2] - geometry.size_nm[2]) / dz;
+    let top_cells = extra.round().max(0.0) as usize;
+    let same = close(geometry.size_nm[0], grid.size_nm[0])
+        && close(geometry.size_nm[1], grid.size_nm[1])
+        && close(geometry.size_nm[2] + top_cells as f64 * dz, grid.size_nm[2])
+        && top_cells < grid.nz;
     assert!(
         same,
-        "rasterize: grid size {:?} nm differs from the fragment {:?} nm",
+        "rasterize: grid size {:?} nm does not cover the fragment {:?} nm \
+         (height must be H plus whole cells)",
         grid.size_nm, geometry.size_nm
     );
+    let z_origin = -(top_cells as f64) * dz;
     let s = supersample.clamp(1, MAX_SUPERSAMPLE);
     let n_species = geometry
         .particles
@@ -311,17 +374,17 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         .unwrap_or(0)
         .max(geometry.stats.count.len());
     let (nx, ny, nz) = (grid.nx, grid.ny, grid.nz);
-    let [dx, dy, dz] = grid.cell_nm();
-    let h_total = grid.size_nm[2];
+    let [dx, dy, _] = grid.cell_nm();
+    let h_total = geometry.size_nm[2];
     let (preps, spheres) = prepare(geometry, grid.size_nm);
 
     // Particles touching each z-slice, in particle order.
     let mut per_slice: Vec<Vec<u32>> = vec![Vec::new(); nz];
     for (i, p) in preps.iter().enumerate() {
-        if p.hi[2] <= 0.0 || p.lo[2] >= h_total {
+        if p.hi[2] <= z_origin || p.lo[2] >= h_total {
             continue;
         }
-        let (z0, z1) = voxel_range(p.lo[2], p.hi[2], dz, nz);
+        let (z0, z1) = voxel_range(p.lo[2] - z_origin, p.hi[2] - z_origin, dz, nz);
         for iz in z0.max(0)..=z1.min(nz as i64 - 1) {
             per_slice[iz as usize].push(i as u32);
         }
@@ -344,7 +407,7 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         .enumerate()
         .for_each(|(iz, (mut views, members))| {
             let mut active = Vec::new();
-            let z_lo = iz as f64 * dz;
+            let z_lo = z_origin + iz as f64 * dz;
             let z_hi = z_lo + dz;
             for &pi in members {
                 let p = &preps[pi as usize];
@@ -386,13 +449,16 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
     Raster {
         grid: *grid,
         fractions,
+        top_cells,
     }
 }
 
 impl Raster {
-    /// `ε = (1 − Σ f_s) ε_binder + Σ f_s ε_s` per voxel, written into `out`
-    /// (shape `(nz, ny, nx)`); allocates nothing. Evaluated left to right as
-    /// `ε_binder·(1 − F) + ε_0·f_0 + ε_1·f_1 + …` with `F = f_0 + f_1 + …`.
+    /// `ε = (1 − Σ f_s) ε_bg + Σ f_s ε_s` per voxel, written into `out`
+    /// (shape `(nz, ny, nx)`); allocates nothing. The background `ε_bg` is
+    /// `eps_binder`, or vacuum (1) in the [`Raster::top_cells`] slices above
+    /// the binder. Evaluated left to right as `ε_bg·(1 − F) + ε_0·f_0 +
+    /// ε_1·f_1 + …` with `F = f_0 + f_1 + …`.
     ///
     /// # Panics
     /// If `eps_species` does not have one entry per species or `out` has the
@@ -420,6 +486,11 @@ impl Raster {
             Some(o) if contiguous && plane > 0 => {
                 o.par_chunks_mut(plane).enumerate().for_each(|(iz, chunk)| {
                     let range = iz * plane..(iz + 1) * plane;
+                    let eps_bg = if iz < self.top_cells {
+                        Complex64::new(1.0, 0.0)
+                    } else {
+                        eps_binder
+                    };
                     // The real part holds F until the binder term replaces it.
                     chunk.fill(Complex64::new(0.0, 0.0));
                     for f in &self.fractions {
@@ -429,7 +500,7 @@ impl Raster {
                         }
                     }
                     for e in chunk.iter_mut() {
-                        *e = eps_binder * (1.0 - e.re);
+                        *e = eps_bg * (1.0 - e.re);
                     }
                     for (f, &es) in self.fractions.iter().zip(eps_species) {
                         let Some(fs) = f.as_slice() else { continue };
@@ -442,7 +513,12 @@ impl Raster {
             _ => {
                 for ((iz, iy, ix), e) in out.indexed_iter_mut() {
                     let total: f64 = self.fractions.iter().map(|f| f[[iz, iy, ix]]).sum();
-                    *e = eps_binder * (1.0 - total);
+                    let eps_bg = if iz < self.top_cells {
+                        Complex64::new(1.0, 0.0)
+                    } else {
+                        eps_binder
+                    };
+                    *e = eps_bg * (1.0 - total);
                     for (f, &es) in self.fractions.iter().zip(eps_species) {
                         *e += es * f[[iz, iy, ix]];
                     }
@@ -451,12 +527,20 @@ impl Raster {
         }
     }
 
-    /// Mean volume fraction per species over the grid.
+    /// Rasterised grain volume per species over the binder layer's volume
+    /// (`Lx·Ly·H`, the cells above the binder excluded from the
+    /// denominator, included in the numerator): comparable with the PVC.
+    /// Without relief, the mean volume fraction over the grid.
     pub fn mean_fractions(&self) -> Vec<f64> {
-        let n = self.grid.voxels();
+        let n = self.grid.voxels() - self.top_cells * self.grid.nx * self.grid.ny;
         self.fractions
             .iter()
             .map(|f| if n == 0 { 0.0 } else { f.sum() / n as f64 })
             .collect()
+    }
+
+    /// Height of the grid above the binder surface, nm.
+    pub fn top_nm(&self) -> f64 {
+        self.top_cells as f64 * self.grid.cell_nm()[2]
     }
 }

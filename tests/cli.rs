@@ -211,7 +211,7 @@ fn sparse_spheres_use_random_addition() {
     let cfg = write_config(dir.path(), TINY);
     let (ok, out, err) = inksim(&["check", cfg.to_str().unwrap()]);
     assert!(ok, "{err}");
-    assert!(out.contains("packer: rsa"), "{out}");
+    assert!(out.contains("geometry: rsa"), "{out}");
 }
 
 #[test]

@@ -580,3 +580,95 @@ fn read_and_parse_errors() {
         assert!(!shown.contains('\n'), "{shown}");
     }
 }
+
+#[test]
+fn size_agglomeration_and_relief_keys() {
+    let text = edit(
+        "diameter_nm = 200.0",
+        "diameter_nm = 200.0\nsize = { kind = \"log-normal\", sigma = 0.2 }\nagglomeration = { cluster_size = 8 }",
+    )
+    .replacen("[layer]", "[layer]\nrelief_fraction = 0.3", 1);
+    let s = parse(&text).unwrap();
+    assert_eq!(s.species[0].size, GrainSize::LogNormal { sigma: 0.2 });
+    assert_eq!(s.species[0].cluster_size, 8);
+    assert_eq!(s.layer.relief_fraction, 0.3);
+    let s = parse(&edit(
+        "diameter_nm = 200.0",
+        "diameter_nm = 200.0\nsize = { kind = \"normal\", sigma = 0.1 }",
+    ))
+    .unwrap();
+    assert_eq!(s.species[0].size, GrainSize::Normal { sigma: 0.1 });
+    // Defaults: fixed size, no clusters, flat top.
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.species[0].size, GrainSize::Fixed);
+    assert_eq!(s.species[0].cluster_size, 1);
+    assert_eq!(s.layer.relief_fraction, 0.0);
+    // The limits are the geometry stage's.
+    assert_eq!(
+        MAX_NORMAL_SIGMA,
+        inksim::geometry::SizeDistribution::MAX_NORMAL_SIGMA
+    );
+    assert_eq!(
+        MAX_LOG_NORMAL_SIGMA,
+        inksim::geometry::SizeDistribution::MAX_LOG_NORMAL_SIGMA
+    );
+    assert_eq!(MAX_CLUSTER_SIZE, inksim::geometry::MAX_CLUSTER_SIZE);
+    assert_eq!(MAX_RELIEF_FRACTION, inksim::geometry::MAX_RELIEF_FRACTION);
+
+    let pig = |extra: &str| {
+        edit(
+            "diameter_nm = 200.0",
+            &format!("diameter_nm = 200.0\n{extra}"),
+        )
+    };
+    for (text, want, range) in [
+        (
+            pig("size = { kind = \"normal\", sigma = 0.4 }"),
+            "pigment[0].size.sigma",
+            "0.3",
+        ),
+        (
+            pig("size = { kind = \"log-normal\", sigma = -0.1 }"),
+            "pigment[0].size.sigma",
+            "0.5",
+        ),
+        (
+            pig("agglomeration = { cluster_size = 0 }"),
+            "pigment[0].agglomeration.cluster_size",
+            "10000",
+        ),
+        (
+            BASE.replacen("[layer]", "[layer]\nrelief_fraction = 0.7", 1),
+            "layer.relief_fraction",
+            "0.5",
+        ),
+        // Largest draw (3 σ) thicker than the 1000 nm layer: grain larger
+        // than the layer.
+        (
+            edit(
+                "diameter_nm = 200.0",
+                "diameter_nm = 600.0\nsize = { kind = \"log-normal\", sigma = 0.3 }",
+            ),
+            "pigment[0].size",
+            "1000",
+        ),
+    ] {
+        let (key, shown) = invalid(&text);
+        assert_eq!(key, want, "{shown}");
+        assert!(shown.contains(range), "{shown}");
+    }
+    // Unknown keys and kinds are parse errors naming them.
+    for (extra, word) in [
+        ("size = { kind = \"uniform\" }", "uniform"),
+        (
+            "size = { kind = \"normal\", sigma = 0.1, mean = 3 }",
+            "mean",
+        ),
+        ("agglomeration = { size = 3 }", "size"),
+    ] {
+        match parse(&pig(extra)) {
+            Err(ConfigError::Parse { message, .. }) => assert!(message.contains(word), "{message}"),
+            other => panic!("{extra}: expected a parse error, got {other:?}"),
+        }
+    }
+}

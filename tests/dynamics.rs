@@ -4,8 +4,9 @@
 mod common;
 use common::brute_min_gap;
 use inksim::geometry::{
-    axis_from_uniforms, order_parameter, pack_dynamics, particle_axis, union_volume, DynParams,
-    DynSpecies, Geometry, GeometryError, Orientation, Shape, ShapeTemplate,
+    analyse, axis_from_uniforms, order_parameter, pack_dynamics, particle_axis, union_volume,
+    DynParams, DynSpecies, Geometry, GeometryError, Orientation, Shape, ShapeTemplate,
+    SizeDistribution, SpeciesOptions, StatsParams,
 };
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -299,10 +300,10 @@ fn bad_input_is_rejected() {
     ));
 }
 
-/// CPU seconds of this thread (Linux `/proc`, 10 ms ticks; 0 elsewhere), so
-/// the timings do not depend on other load on the machine.
+/// CPU seconds of this process, all threads (Linux `/proc`, 10 ms ticks; 0
+/// elsewhere), so the timings do not depend on other load on the machine.
 fn cpu_seconds() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/stat")
+    std::fs::read_to_string("/proc/self/stat")
         .ok()
         .and_then(|s| {
             let rest = s.rsplit_once(')')?.1;
@@ -426,4 +427,209 @@ fn big_rice_report() {
         t.elapsed().as_secs_f64()
     );
     assert!(g.stats.worst_overlap_nm < 0.5);
+}
+
+fn opts(size: SizeDistribution, cluster_size: usize) -> SpeciesOptions {
+    SpeciesOptions { size, cluster_size }
+}
+
+#[test]
+fn size_distribution_packs_without_overlap() {
+    let mut params = DynParams::new(
+        [700.0, 700.0, 300.0],
+        vec![sp(RICE, 60.0, 0.4, Orientation::Random, 0.0)],
+    );
+    params.options = vec![opts(SizeDistribution::LogNormal { sigma: 0.25 }, 1)];
+    let g = pack_dynamics(&params, 4).unwrap();
+    let tol = params.overlap_tolerance * min_radius(&g);
+    let worst = brute_worst_overlap(&g);
+    assert!(worst < tol, "overlap {worst} ≥ {tol}");
+    check_inside_and_rigid(&g, tol);
+    let s = analyse(&g, &StatsParams::default());
+    // Exact union volumes agree with what the packer placed, and with the
+    // target within half a grain.
+    let a = g.stats.achieved_fraction[0];
+    assert!((s.pvc[0] - a).abs() < 1e-9 * a, "{} vs {a}", s.pvc[0]);
+    assert!((a - 0.4).abs() < 0.005 * 0.4, "{a}");
+    // Effective diameters spread as drawn (ln d within ±3σ of ln 60).
+    let ds: Vec<f64> = g
+        .particles
+        .iter()
+        .map(|p| {
+            let v = union_volume(
+                &p.spheres
+                    .iter()
+                    .enumerate()
+                    .map(|(k, sph)| {
+                        let o = p.spheres[0].center;
+                        let mut dd = 0.0f64;
+                        for (ax, l) in g.size_nm.iter().enumerate() {
+                            let mut x = sph.center[ax] - o[ax];
+                            if ax < 2 {
+                                x -= l * (x / l).round();
+                            }
+                            dd += x * x;
+                        }
+                        (if k == 0 { 0.0 } else { dd.sqrt() }, sph.radius)
+                    })
+                    .collect::<Vec<_>>(),
+            );
+            (6.0 * v / PI).cbrt()
+        })
+        .collect();
+    let lo = ds.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = ds.iter().copied().fold(0.0, f64::max);
+    eprintln!(
+        "log-normal rice: {} grains, d in [{lo:.1}, {hi:.1}] nm",
+        ds.len()
+    );
+    assert!(
+        lo >= 60.0 * (-0.75f64).exp() * (1.0 - 1e-9) && hi <= 60.0 * 0.75f64.exp() * (1.0 + 1e-9)
+    );
+    assert!(hi / lo > 1.8);
+}
+
+#[test]
+fn agglomeration_keeps_seeded_clusters_together() {
+    let run = |c: usize| {
+        let mut params = DynParams::new(
+            [1000.0, 1000.0, 400.0],
+            vec![sp(Shape::Sphere, 50.0, 0.15, Orientation::Random, 0.0)],
+        );
+        params.options = vec![opts(SizeDistribution::Fixed, c)];
+        let g = pack_dynamics(&params, 6).unwrap();
+        let worst = brute_worst_overlap(&g);
+        assert!(worst < 0.01 * 25.0, "overlap {worst}");
+        analyse(&g, &StatsParams::default())
+    };
+    let free = run(1);
+    let clumped = run(8);
+    eprintln!(
+        "dynamics 15 %: clusters of 1 → mean {:.2} (weighted {:.2}); of 8 → mean {:.2} \
+         (weighted {:.2}), largest {}",
+        free.cluster_mean(),
+        free.cluster_weighted_mean(),
+        clumped.cluster_mean(),
+        clumped.cluster_weighted_mean(),
+        clumped.cluster_sizes[0]
+    );
+    assert!(clumped.cluster_weighted_mean() > 2.0 * free.cluster_weighted_mean());
+    assert!(clumped.cluster_mean() > 4.0);
+}
+
+#[test]
+fn relief_lets_grains_protrude_and_raster_covers_them() {
+    let mut params = DynParams::new(
+        [800.0, 800.0, 300.0],
+        vec![sp(RICE, 60.0, 0.5, Orientation::Random, 0.0)],
+    );
+    params.relief_fraction = 0.3;
+    let g = pack_dynamics(&params, 2).unwrap();
+    let tol = params.overlap_tolerance * min_radius(&g);
+    assert!(brute_worst_overlap(&g) < tol);
+    let s = analyse(&g, &StatsParams::default());
+    eprintln!(
+        "rice 50 %, relief 0.3: protrusion {:.2} nm",
+        s.protrusion_nm
+    );
+    assert!(s.protrusion_nm <= 0.3 * 60.0 + tol);
+    assert!(s.protrusion_nm > 0.2 * 60.0);
+    assert!(s.bottom_excess_nm <= tol);
+    // The profile starts above z = 0 and holds grains there.
+    assert!(s.profile_z_nm[0] < 0.0 && s.profile_fraction[0] > 0.0);
+    let grid = inksim::raster::Grid::new(40, 40, 30, g.size_nm)
+        .unwrap()
+        .covering_relief(&g);
+    assert_eq!(grid.nz, 30 + (s.protrusion_nm / 10.0).ceil() as usize);
+    let r = inksim::raster::rasterize(&g, &grid, 4);
+    let f = r.mean_fractions()[0];
+    assert!(
+        (f - s.pvc_total).abs() < 0.01,
+        "raster {f} vs {}",
+        s.pvc_total
+    );
+}
+
+/// Same seed ⇒ bit-identical particles with 1 and 2 threads (mixture, size
+/// distribution, clusters, alignment field).
+#[test]
+fn thread_count_does_not_change_the_packing() {
+    let mut params = DynParams::new(
+        [700.0, 700.0, 300.0],
+        vec![
+            sp(RICE, 50.0, 0.25, Orientation::InPlane, 0.5),
+            sp(Shape::Sphere, 40.0, 0.2, Orientation::Random, 0.0),
+        ],
+    );
+    params.options = vec![
+        opts(SizeDistribution::Normal { sigma: 0.1 }, 1),
+        opts(SizeDistribution::Fixed, 4),
+    ];
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| pack_dynamics(&params, 9).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert!(a.particles.len() > 1000);
+    assert_eq!(a.particles, b.particles);
+    assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
+}
+
+/// g(r) of the dynamics packer at 25 % (for the docs):
+/// `cargo test --release --test dynamics rdf_report -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn rdf_report() {
+    let params = DynParams::new(
+        [1600.0, 1600.0, 480.0],
+        vec![sp(Shape::Sphere, 40.0, 0.25, Orientation::Random, 0.0)],
+    );
+    let g = pack_dynamics(&params, 1).unwrap();
+    let s = analyse(&g, &StatsParams::default());
+    eprintln!(
+        "dynamics φ = 0.25: g(σ+) = {:?}, first bins {:?}",
+        s.contact_value(40.0, 4.0),
+        &s.rdf[48..56]
+    );
+}
+
+/// Overlap-free density ladder in slabs 3, 5 and 10 diameters thick (100 nm
+/// spheres, 20 × 20 diameters laterally), for the LAMMPS side-by-side of
+/// scripts/lammps_compare.py, which runs and parses this:
+/// `cargo test --release --test dynamics slab_density_ladder -- --ignored --nocapture`.
+/// Prints `SLAB t phi ok|fail reached seconds worst_overlap_nm` per run and
+/// stops a slab at its first failure.
+#[test]
+#[ignore]
+fn slab_density_ladder() {
+    for t in [3.0, 5.0, 10.0] {
+        for k in 0..8 {
+            let phi = 0.50 + 0.02 * k as f64;
+            let params = DynParams::new(
+                [2000.0, 2000.0, 100.0 * t],
+                vec![sp(Shape::Sphere, 100.0, phi, Orientation::Random, 0.0)],
+            );
+            let start = Instant::now();
+            let result = pack_dynamics(&params, 1);
+            let secs = start.elapsed().as_secs_f64();
+            match result {
+                Ok(g) => println!(
+                    "SLAB {t} {phi:.2} ok {:.4} {secs:.3} {:.4}",
+                    g.stats.achieved_fraction[0], g.stats.worst_overlap_nm
+                ),
+                Err(GeometryError::DynamicsNotReached {
+                    reached,
+                    worst_overlap_nm,
+                    ..
+                }) => {
+                    println!("SLAB {t} {phi:.2} fail {reached:.4} {secs:.3} {worst_overlap_nm:.4}");
+                    break;
+                }
+                Err(e) => panic!("{e}"),
+            }
+        }
+    }
 }

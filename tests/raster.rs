@@ -326,3 +326,50 @@ fn grid_checks() {
     assert_eq!(g.cell_nm(), [25.0, 25.0, 25.0]);
     assert_eq!(g.voxels(), 8000);
 }
+
+/// Surface relief: a sphere protruding through z = 0 by 18 nm. The grid
+/// grows by whole cells above the binder; the whole sphere is rasterised;
+/// above z = 0 the background is vacuum, below it binder.
+#[test]
+fn relief_cells_hold_protruding_grains_over_vacuum() {
+    let r = 60.0;
+    let c = [500.0, 500.0, r - 18.0];
+    let g = geometry(SIZE, vec![ball(0, c, r)], 1);
+    let base = grid(); // dz = 25 nm
+    let grid = base.covering_relief(&g);
+    assert_eq!(grid.nz, base.nz + 1);
+    assert_eq!(grid.size_nm[2], SIZE[2] + 25.0);
+    // No protrusion: the grid is unchanged.
+    let flat = geometry(SIZE, vec![ball(0, [500.0, 500.0, r], r)], 1);
+    assert_eq!(base.covering_relief(&flat), base);
+    let ras = rasterize(&g, &grid, 8);
+    assert_eq!(ras.top_cells, 1);
+    assert_eq!(ras.top_nm(), 25.0);
+    let v = volume(&ras, 0);
+    assert!((v / sphere_volume(r) - 1.0).abs() < 5e-3, "{v}");
+    // The cap above z = 0 sits in the top slice.
+    let cap = std::f64::consts::PI * 18.0 * 18.0 * (3.0 * r - 18.0) / 3.0;
+    let top: f64 =
+        ras.fractions[0].index_axis(ndarray::Axis(0), 0).sum() * ras.grid.voxel_volume_nm3();
+    assert!((top / cap - 1.0).abs() < 0.02, "{top} vs {cap}");
+    // Mean fraction is per binder volume.
+    assert!((ras.mean_fractions()[0] - v / SIZE.iter().product::<f64>()).abs() < 1e-12);
+    let eb = Complex64::new(2.4, 0.0);
+    let es = Complex64::new(5.0, 1.0);
+    let mut eps = Array3::zeros((grid.nz, grid.ny, grid.nx));
+    ras.epsilon_into(eb, &[es], &mut eps);
+    assert_eq!(eps[[0, 0, 0]], Complex64::new(1.0, 0.0));
+    assert_eq!(eps[[1, 0, 0]], eb);
+    let f = ras.fractions[0][[0, 16, 16]];
+    assert!(f > 0.0);
+    let want = Complex64::new(1.0, 0.0) * (1.0 - f) + es * f;
+    assert!((eps[[0, 16, 16]] - want).norm() < 1e-12);
+}
+
+#[test]
+#[should_panic(expected = "whole cells")]
+fn grid_taller_by_a_fraction_of_a_cell_is_refused() {
+    let g = geometry(SIZE, vec![], 1);
+    let grid = Grid::new(32, 32, 21, [SIZE[0], SIZE[1], SIZE[2] + 10.0]).unwrap();
+    rasterize(&g, &grid, 2);
+}

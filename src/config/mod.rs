@@ -64,6 +64,44 @@ pub struct Layer {
     pub fragment_y_nm: f64,
     /// Real refractive index of the (transparent) binder.
     pub binder_index: f64,
+    /// Grains may protrude through the top surface `z = 0` by up to this
+    /// fraction of their diameter, `[0, MAX_RELIEF_FRACTION]` (0: flat).
+    pub relief_fraction: f64,
+}
+
+/// Largest `layer.relief_fraction`.
+pub const MAX_RELIEF_FRACTION: f64 = 0.5;
+/// Largest relative `sigma` of a normal grain-size distribution.
+pub const MAX_NORMAL_SIGMA: f64 = 0.3;
+/// Largest `sigma` (of ln d) of a log-normal grain-size distribution.
+pub const MAX_LOG_NORMAL_SIGMA: f64 = 0.5;
+/// Largest `agglomeration.cluster_size`.
+pub const MAX_CLUSTER_SIZE: usize = 10_000;
+
+/// Distribution of a pigment's effective diameter `d` (`diameter_nm`),
+/// truncated at 3 standard deviations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GrainSize {
+    Fixed,
+    /// Mean `d`, relative standard deviation `sigma` (range `d (1 ± 3σ)`).
+    Normal {
+        sigma: f64,
+    },
+    /// Median `d`, standard deviation `sigma` of `ln d` (range `d e^{±3σ}`).
+    LogNormal {
+        sigma: f64,
+    },
+}
+
+impl GrainSize {
+    /// Largest diameter a grain of nominal diameter `d` can get.
+    pub fn max_diameter(&self, d: f64) -> f64 {
+        match *self {
+            GrainSize::Fixed => d,
+            GrainSize::Normal { sigma } => d * (1.0 + 3.0 * sigma),
+            GrainSize::LogNormal { sigma } => d * (3.0 * sigma).exp(),
+        }
+    }
 }
 
 /// One pigment species in the layer.
@@ -80,6 +118,10 @@ pub struct Species {
     pub orientation: GrainOrientation,
     /// Strength of the "magnetic" aligning torque (0: none).
     pub alignment_field: f64,
+    /// Grain-size distribution around `diameter_nm`.
+    pub size: GrainSize,
+    /// Grains per seeded cluster (1: no agglomeration).
+    pub cluster_size: usize,
 }
 
 /// Grain shape: a rigid cluster of spheres (METHOD §2).

@@ -32,6 +32,9 @@ pub struct RawLayer {
     pub binder_index: Option<f64>,
     /// Total PVC, shared among the pigments by their `share`.
     pub pvc: Option<f64>,
+    /// Grains may protrude through the top surface by this fraction of
+    /// their diameter.
+    pub relief_fraction: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -45,6 +48,25 @@ pub struct RawPigment {
     pub shape: Option<RawShape>,
     pub orientation: Option<RawOrientation>,
     pub alignment_field: Option<f64>,
+    pub size: Option<RawSize>,
+    pub agglomeration: Option<RawAgglomeration>,
+}
+
+/// `{ kind = "fixed" }`, `{ kind = "normal", sigma = 0.1 }` (relative),
+/// `{ kind = "log-normal", sigma = 0.2 }` (of ln d).
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawSize {
+    Fixed,
+    Normal { sigma: f64 },
+    LogNormal { sigma: f64 },
+}
+
+/// `{ cluster_size = 8 }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAgglomeration {
+    pub cluster_size: i64,
 }
 
 /// `{ kind = "sphere" }`, `{ kind = "cylinder", aspect = 3, spheres = 5 }`,

@@ -18,15 +18,22 @@
 //! - A pigment's diameter must fit the layer (≤ thickness) and the periodic
 //!   fragment (≤ min(fragment x, y)); the total PVC is limited to
 //!   [`MAX_PVC`], what the dynamics packer reaches.
+//! - Geometry keys: `pigment.size = { kind = "fixed" | "normal" |
+//!   "log-normal", sigma }` (normal: relative σ ≤ [`MAX_NORMAL_SIGMA`];
+//!   log-normal: σ of ln d ≤ [`MAX_LOG_NORMAL_SIGMA`]); the largest draw
+//!   (3 σ) must fit the layer and the fragment like `diameter_nm`.
+//!   `pigment.agglomeration = { cluster_size }` in `[1, MAX_CLUSTER_SIZE]`;
+//!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`.
 //! - `Provenance::input_hash` is SHA-256 over the config text followed by each
 //!   pigment's table text, in pigment order.
 
 use super::raw::{RawAppearance, RawProduct, RawSubstrate};
 use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
-use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSolver};
+use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSize, RawSolver};
 use super::{
-    Appearance, ConfigError, GrainOrientation, GrainShape, GridSpec, Incidence, Layer, Material,
-    Method, OutputSpec, Products, Provenance, Scene, SolverSpec, Species, Substrate, MAX_PVC,
+    Appearance, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence, Layer,
+    Material, Method, OutputSpec, Products, Provenance, Scene, SolverSpec, Species, Substrate,
+    MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA, MAX_PVC, MAX_RELIEF_FRACTION,
 };
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
@@ -311,11 +318,19 @@ impl Checker<'_> {
         let b = raw.binder_index.unwrap_or(DEFAULT_BINDER_INDEX);
         let binder_index =
             self.range("layer.binder_index", b, (1.0..=3.0).contains(&b), "[1, 3]")?;
+        let r = raw.relief_fraction.unwrap_or(0.0);
+        let relief_fraction = self.range(
+            "layer.relief_fraction",
+            r,
+            (0.0..=MAX_RELIEF_FRACTION).contains(&r),
+            &format!("[0, {MAX_RELIEF_FRACTION}] (fraction of a grain's diameter)"),
+        )?;
         Ok(Layer {
             thickness_nm,
             fragment_x_nm: frag[0],
             fragment_y_nm: frag[1],
             binder_index,
+            relief_fraction,
         })
     }
 
@@ -451,6 +466,62 @@ impl Checker<'_> {
                     "spheres and dissolved pigments have no axis to align",
                 ));
             }
+            let size = match &p.size {
+                None | Some(RawSize::Fixed) => GrainSize::Fixed,
+                Some(RawSize::Normal { sigma }) => GrainSize::Normal {
+                    sigma: self.range(
+                        &key("size.sigma"),
+                        *sigma,
+                        (0.0..=MAX_NORMAL_SIGMA).contains(sigma),
+                        &format!("[0, {MAX_NORMAL_SIGMA}] (relative to diameter_nm)"),
+                    )?,
+                },
+                Some(RawSize::LogNormal { sigma }) => GrainSize::LogNormal {
+                    sigma: self.range(
+                        &key("size.sigma"),
+                        *sigma,
+                        (0.0..=MAX_LOG_NORMAL_SIGMA).contains(sigma),
+                        &format!("[0, {MAX_LOG_NORMAL_SIGMA}] (standard deviation of ln d)"),
+                    )?,
+                },
+            };
+            if shape != GrainShape::Molecular {
+                let largest = size.max_diameter(diameter_nm);
+                if largest > max_d * (1.0 + REL_EPS) {
+                    return Err(self.invalid(
+                        key("size"),
+                        format!(
+                            "the largest grain (3 sigma) is {largest} nm; it must be at most \
+                             {max_d} nm (the layer thickness and the fragment size)"
+                        ),
+                    ));
+                }
+            }
+            let cluster_size = match &p.agglomeration {
+                None => 1,
+                Some(a) => {
+                    let c = a.cluster_size;
+                    if !(1..=MAX_CLUSTER_SIZE as i64).contains(&c) {
+                        return Err(self.invalid(
+                            key("agglomeration.cluster_size"),
+                            format!(
+                                "must be in [1, {MAX_CLUSTER_SIZE}] (grains per cluster), got {c}"
+                            ),
+                        ));
+                    }
+                    c as usize
+                }
+            };
+            if shape == GrainShape::Molecular && (p.size.is_some() || cluster_size > 1) {
+                return Err(self.invalid(
+                    key(if p.size.is_some() {
+                        "size"
+                    } else {
+                        "agglomeration"
+                    }),
+                    "a dissolved (molecular) pigment has no grains to size or cluster",
+                ));
+            }
             species.push(Species {
                 name: name.to_string(),
                 material,
@@ -459,6 +530,8 @@ impl Checker<'_> {
                 shape,
                 orientation,
                 alignment_field,
+                size,
+                cluster_size,
             });
         }
         let total: f64 = species.iter().map(|s| s.volume_fraction).sum();

@@ -1,8 +1,9 @@
 //! First-order dynamics packer for high PVC (METHOD §2).
 //!
-//! Particles are rigid sphere clusters on an axis ([`ShapeTemplate`]). They
-//! are thrown in batches into the (overlap-free) ensemble with overlaps
-//! allowed, then pushed apart:
+//! Particles are rigid sphere clusters on an axis ([`ShapeTemplate`]), each
+//! scaled to its own effective diameter (size distributions, see
+//! [`SpeciesOptions`]). They are thrown in batches into the (overlap-free)
+//! ensemble with overlaps allowed, then pushed apart:
 //! - two spheres of different particles with overlap depth
 //!   `L = R1 + R2 − |AB|` repel along `AB` with `F = k (L + δ)` for `L > 0`
 //!   (0 otherwise; largest when the centres coincide, then along +z);
@@ -11,7 +12,14 @@
 //!   creeping towards contact, while touching particles (`L ≤ 0`) feel
 //!   nothing and can rest;
 //! - a wall pushes a sphere back along its normal with `k (d + δ)` for
-//!   `d > 0`, `d` how far the sphere sticks out of `[0, H]`;
+//!   `d > 0`, `d` how far the sphere sticks out of `[−ρ D, H]` (`ρ` the
+//!   relief fraction, `D` the particle's effective diameter: grains may
+//!   protrude through the top surface `z = 0` by up to `ρ D`);
+//! - agglomeration: spheres of two particles seeded in the same cluster
+//!   attract with `k_a g` (`k_a` = [`ATTRACTION`] k) when their surface gap
+//!   `g` lies in `(δ, a (R1 + R2))`, `a` = [`ATTRACTION_RANGE`]; zero within
+//!   `δ` of contact so that bonded pairs come to rest, and zero beyond the
+//!   range (a bond that is torn apart stays broken);
 //! - each particle is a rigid body without inertia: `η v = F`, `J Ω = M`,
 //!   `M = Σ r_i × F_i`, with `k = η = 1` (only the path matters, not the time
 //!   scale) and `J = η (⟨s²⟩ + 0.4 ⟨r²⟩)`, volume-weighted over its spheres:
@@ -29,24 +37,37 @@
 //!   (perpendicular mode, +) or towards the plane (in-plane mode, −); it acts
 //!   on particles that are being pushed (resting particles do not move);
 //! - neighbours come from a grid of particle centres (periodic in x, y) whose
-//!   cells are at least one particle length wide, so the 3×3×3 block around a
-//!   particle holds every particle it can touch;
+//!   cells are at least one particle length (plus the attraction range) wide,
+//!   so the 3×3×3 block around a particle holds every particle it can touch;
 //! - the moving list holds the particles that moved in the previous step; any
 //!   new contact involves one of them, so resting particles cost nothing. A
 //!   pair is evaluated once: by the moving particle, or by the lower index
 //!   when both move; a resting particle that is pushed moves in that step.
 //!
+//! Parallel and deterministic: the moving list is cut into chunks of a fixed
+//! [`CHUNK`] particles (independent of the thread count); rayon evaluates the
+//! chunks' pairs into per-chunk lists of force contributions, which are then
+//! added serially in chunk order; the moves are computed in parallel and
+//! applied serially. Every floating-point sum is thus taken in an order that
+//! depends on the seed only, and the result is bit-identical for any number
+//! of threads. The work per step is linear in the number of moving
+//! particles.
+//!
 //! A batch is relaxed until the worst overlap (pairs and walls) is below the
 //! tolerance, or fails after `max_steps_per_batch` steps with
 //! [`GeometryError::DynamicsNotReached`] and the density of the last
-//! overlap-free ensemble. The code is sequential with one RNG stream, so the
-//! result depends on the seed only.
+//! overlap-free ensemble. [`DynamicsPacker`] exposes the batches and steps
+//! (for benchmarks); [`pack_dynamics`] runs it to the end.
 
 use super::cells::{min_image, near_image};
 use super::shapes::{axis_from_uniforms, order_parameter, Orientation, Shape, ShapeTemplate};
-use super::{min_gap_nm, Geometry, GeometryError, GeometryStats, Particle, Sphere, MAX_PARTICLES};
+use super::{
+    check_relief, draw_diameters, min_gap_nm, options_of, size_rng, Geometry, GeometryError,
+    GeometryStats, Particle, SpeciesOptions, Sphere, MAX_PARTICLES,
+};
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use rayon::prelude::*;
 
 const EMPTY: u32 = u32::MAX;
 /// Spring constant and drag (arbitrary units; only ratios matter).
@@ -55,12 +76,25 @@ const K: f64 = 1.0;
 const DT_MAX: f64 = 0.5;
 /// Largest sphere displacement per step, in units of the smallest radius.
 const MAX_MOVE: f64 = 0.2;
+/// Cluster attraction constant, in units of `K`.
+pub const ATTRACTION: f64 = 0.5;
+/// Largest cluster attraction per sphere pair, in units of `K δ` (δ = half
+/// the overlap tolerance): small enough that a grain pulled by up to
+/// `3 / ATTRACTION_CAP` cluster mates into a third one stays within the
+/// overlap tolerance (`K (L + δ) = n F` gives `L < 2δ`).
+pub const ATTRACTION_CAP: f64 = 0.5;
+/// Cluster attraction range, in units of the sum of the two sphere radii.
+pub const ATTRACTION_RANGE: f64 = 0.25;
+/// Moving particles per parallel work unit (fixed, so results do not depend
+/// on the thread count).
+pub const CHUNK: usize = 256;
 
 /// One species for [`pack_dynamics`].
 #[derive(Debug, Clone)]
 pub struct DynSpecies {
     pub shape: Shape,
-    /// Diameter of the equal-volume sphere, nm (> 0).
+    /// Diameter of the equal-volume sphere, nm (> 0); the nominal one with a
+    /// size distribution ([`DynParams::options`]).
     pub effective_diameter_nm: f64,
     /// Target volume fraction of the fragment, in `[0, 1)`.
     pub volume_fraction: f64,
@@ -77,12 +111,18 @@ pub struct DynParams {
     pub size_nm: [f64; 3],
     pub species: Vec<DynSpecies>,
     /// Largest overlap accepted, as a fraction of the smallest sphere radius
-    /// of all species, in `(0, 0.5]` (default 0.01).
+    /// of all particles, in `(0, 0.5]` (default 0.01).
     pub overlap_tolerance: f64,
     /// Volume fraction added per batch, in `(0, 1]` (default 0.1).
     pub batch_fraction: f64,
     /// Relaxation steps allowed per batch (≥ 1, default 20 000).
     pub max_steps_per_batch: u64,
+    /// Size distribution and clustering per species; empty: defaults.
+    pub options: Vec<SpeciesOptions>,
+    /// Grains may protrude through the top surface `z = 0` by up to this
+    /// fraction of their effective diameter, `[0, MAX_RELIEF_FRACTION]`
+    /// (default 0: flat top).
+    pub relief_fraction: f64,
 }
 
 impl DynParams {
@@ -94,11 +134,14 @@ impl DynParams {
             overlap_tolerance: 0.01,
             batch_fraction: 0.1,
             max_steps_per_batch: 20_000,
+            options: Vec::new(),
+            relief_fraction: 0.0,
         }
     }
 }
 
-/// One species after validation, lengths in nm.
+/// One species after validation, lengths for effective diameter 1.
+#[derive(Debug, Clone)]
 struct Spec {
     /// `(axial offset, radius)`.
     spheres: Vec<(f64, f64)>,
@@ -107,11 +150,14 @@ struct Spec {
     r_max: f64,
     s_max: f64,
     inertia: f64,
-    volume: f64,
-    count: usize,
+    /// Signed alignment strength (+ towards z, − towards the plane).
+    field: f64,
+    /// Grains per seeded cluster.
+    group: usize,
 }
 
-fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
+/// Checks the parameters; returns the species and their diameters.
+fn validate(p: &DynParams, seed: u64) -> Result<(Vec<Spec>, Vec<Vec<f64>>), GeometryError> {
     let [lx, ly, h] = p.size_nm;
     for (name, v) in [("Lx", lx), ("Ly", ly), ("H", h)] {
         if !(v.is_finite() && v > 0.0) {
@@ -137,6 +183,8 @@ fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
             "max_steps_per_batch must be ≥ 1".into(),
         ));
     }
+    let options = options_of(&p.options, p.species.len())?;
+    check_relief(p.relief_fraction)?;
     let volume = lx * ly * h;
     let mut total = 0.0;
     let mut out = Vec::with_capacity(p.species.len());
@@ -149,14 +197,15 @@ fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
                 "species {i}: effective diameter {d} nm must be finite and > 0"
             )));
         }
-        let spheres: Vec<(f64, f64)> = tpl.spheres.iter().map(|&(o, r)| (o * d, r * d)).collect();
-        let half_length = tpl.half_length() * d;
-        let r_max = tpl.max_radius() * d;
-        // Thinnest extent along z the particle can take in its mode.
-        let need_z = match s.orientation {
-            Orientation::Perpendicular => 2.0 * half_length,
-            _ => 2.0 * r_max,
-        };
+        let dmax = options[i].size.range(d).1;
+        let half_length = tpl.half_length();
+        let r_max = tpl.max_radius();
+        // Thinnest extent along z the largest particle can take in its mode.
+        let need_z = dmax
+            * match s.orientation {
+                Orientation::Perpendicular => 2.0 * half_length,
+                _ => 2.0 * r_max,
+            };
         if need_z > h {
             return Err(GeometryError::GrainTooLarge {
                 species: i,
@@ -165,11 +214,11 @@ fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
             });
         }
         let half = 0.5 * lx.min(ly);
-        if 2.0 * half_length > half {
+        if 2.0 * half_length * dmax > half {
             return Err(GeometryError::Invalid(format!(
                 "species {i}: particle length {} nm exceeds half the lateral period \
                  ({half} nm); allowed length ≤ min(Lx, Ly)/2",
-                2.0 * half_length
+                2.0 * half_length * dmax
             )));
         }
         let f = s.volume_fraction;
@@ -191,27 +240,26 @@ fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
             )));
         }
         total += f;
-        let v = std::f64::consts::PI / 6.0 * d * d * d;
-        let n = (f * volume / v).round();
-        if n > MAX_PARTICLES as f64 {
-            return Err(GeometryError::Invalid(format!(
-                "species {i}: {n} particles needed; at most {MAX_PARTICLES} allowed"
-            )));
-        }
+        let spheres = tpl.spheres.clone();
         let w: f64 = spheres.iter().map(|&(_, r)| r * r * r).sum();
         let inertia = spheres
             .iter()
             .map(|&(o, r)| r * r * r * (o * o + 0.4 * r * r))
             .sum::<f64>()
             / w;
+        let sign = match s.orientation {
+            Orientation::Perpendicular => 1.0,
+            Orientation::InPlane => -1.0,
+            Orientation::Random => 0.0,
+        };
         out.push(Spec {
             half_length,
-            r_min: tpl.min_radius() * d,
+            r_min: tpl.min_radius(),
             r_max,
             s_max: spheres.iter().map(|&(o, _)| o.abs()).fold(0.0, f64::max),
             inertia,
-            volume: v,
-            count: n as usize,
+            field: sign * fld,
+            group: options[i].cluster_size,
             spheres,
         });
     }
@@ -222,15 +270,30 @@ fn validate(p: &DynParams) -> Result<Vec<Spec>, GeometryError> {
             "total volume fraction {total} beyond reach; allowed < 0.74"
         )));
     }
-    if out.iter().map(|s| s.count).sum::<usize>() > MAX_PARTICLES {
+    let mut rng = size_rng(seed);
+    let mut diameters = Vec::with_capacity(p.species.len());
+    let mut n = 0;
+    for (i, s) in p.species.iter().enumerate() {
+        let ds = draw_diameters(
+            i,
+            s.effective_diameter_nm,
+            s.volume_fraction,
+            volume,
+            options[i].size,
+            &mut rng,
+        )?;
+        n += ds.len();
+        diameters.push(ds);
+    }
+    if n > MAX_PARTICLES {
         return Err(GeometryError::Invalid(format!(
-            "more than {MAX_PARTICLES} particles in total"
+            "{n} particles in total; at most {MAX_PARTICLES} allowed"
         )));
     }
-    Ok(out)
+    Ok((out, diameters))
 }
-
 /// Grid of particle centres with doubly linked lists per cell.
+#[derive(Debug, Clone)]
 struct Grid {
     n: [usize; 3],
     cell: [f64; 3],
@@ -328,14 +391,31 @@ impl Grid {
     }
 }
 
+/// A force contribution to one particle: `(particle, force, torque)`.
+type Contribution = (u32, [f64; 3], [f64; 3]);
+
+/// Forces of one pair, on `i` (`f`, `mi`) and on `j` (`−f`, `mj`).
+struct PairForce {
+    f: [f64; 3],
+    mi: [f64; 3],
+    mj: [f64; 3],
+    /// Worst overlap depth of the pair (−inf when none).
+    worst: f64,
+}
+
 /// Dynamic state of the ensemble.
+#[derive(Debug, Clone)]
 struct State {
     size: [f64; 3],
+    relief: f64,
     specs: Vec<Spec>,
     center: Vec<[f64; 3]>,
     axis: Vec<[f64; 3]>,
     species: Vec<u32>,
-    field: Vec<(f64, f64)>, // per species: (signed strength, k r_max²)
+    /// Effective diameter, nm.
+    scale: Vec<f64>,
+    /// Seeded cluster (`EMPTY`: none).
+    cluster: Vec<u32>,
     grid: Grid,
     force: Vec<[f64; 3]>,
     torque: Vec<[f64; 3]>,
@@ -344,6 +424,10 @@ struct State {
     epoch: u64,
     moving: Vec<u32>,
     touched: Vec<u32>,
+    /// Per-chunk contribution lists (reused).
+    bufs: Vec<Vec<Contribution>>,
+    /// New (centre, axis) of the touched particles (reused).
+    moves: Vec<Option<([f64; 3], [f64; 3])>>,
     skin: f64,
 }
 
@@ -408,10 +492,12 @@ fn norm(a: &[f64; 3]) -> f64 {
 }
 
 impl State {
-    fn add_particle(&mut self, s: usize, c: [f64; 3], a: [f64; 3]) {
+    fn add_particle(&mut self, s: usize, d: f64, cluster: u32, c: [f64; 3], a: [f64; 3]) {
         self.center.push(c);
         self.axis.push(a);
         self.species.push(s as u32);
+        self.scale.push(d);
+        self.cluster.push(cluster);
         self.grid.push(&c);
         self.force.push([0.0; 3]);
         self.torque.push([0.0; 3]);
@@ -422,7 +508,8 @@ impl State {
 
     /// Renumbers the particles by grid cell (stable, so deterministic) for
     /// memory locality and rebuilds the cell lists; keeps the moving list.
-    fn reorder(&mut self) {
+    /// Returns the new index of every old one.
+    fn reorder(&mut self) -> Vec<u32> {
         let n = self.center.len();
         let mut order: Vec<u32> = (0..n as u32).collect();
         order.sort_by_key(|&p| self.grid.cell_of[p as usize]);
@@ -433,6 +520,8 @@ impl State {
         self.center = order.iter().map(|&p| self.center[p as usize]).collect();
         self.axis = order.iter().map(|&p| self.axis[p as usize]).collect();
         self.species = order.iter().map(|&p| self.species[p as usize]).collect();
+        self.scale = order.iter().map(|&p| self.scale[p as usize]).collect();
+        self.cluster = order.iter().map(|&p| self.cluster[p as usize]).collect();
         for m in self.moving.iter_mut() {
             *m = inv[*m as usize];
         }
@@ -444,11 +533,11 @@ impl State {
             let f = self.grid.flat(self.grid.coords(&self.center[p]));
             self.grid.link(p, f);
         }
+        inv
     }
 
-    /// Forces of the pair `(i, j)` added to both; returns the worst overlap
-    /// depth and whether any force acted.
-    fn pair(&mut self, i: usize, j: usize) -> (f64, bool) {
+    /// Forces of the pair `(i, j)`; `None` when none acts.
+    fn pair(&self, i: usize, j: usize) -> Option<PairForce> {
         let (ci, cj) = (self.center[i], self.center[j]);
         let d = [
             near_image(cj[0] - ci[0], self.size[0]),
@@ -459,27 +548,36 @@ impl State {
             &self.specs[self.species[i] as usize],
             &self.specs[self.species[j] as usize],
         );
-        let reach = si.half_length + sj.half_length + self.skin;
+        let (di, dj) = (self.scale[i], self.scale[j]);
+        let bonded = self.cluster[i] != EMPTY && self.cluster[i] == self.cluster[j];
+        // Farthest surface gap at which a force can act.
+        let reach_gap = if bonded {
+            ATTRACTION_RANGE * 2.0 * (si.r_max * di).max(sj.r_max * dj)
+        } else {
+            self.skin
+        };
+        let reach = si.half_length * di + sj.half_length * dj + reach_gap;
         let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if d2 >= reach * reach {
-            return (f64::NEG_INFINITY, false);
+            return None;
         }
         let (ai, aj) = (self.axis[i], self.axis[j]);
         if si.spheres.len() > 1 || sj.spheres.len() > 1 {
             // Exact reject: every sphere centre lies on its particle's axis
             // segment, so segments farther apart than the largest radii plus
-            // the skin cannot touch (1e-9 relative slack for rounding).
-            let g = segment_distance2(&ai, si.s_max, &aj, sj.s_max, &d);
-            let r = (si.r_max + sj.r_max + self.skin) * (1.0 + 1e-9);
+            // the reach cannot interact (1e-9 relative slack for rounding).
+            let g = segment_distance2(&ai, si.s_max * di, &aj, sj.s_max * dj, &d);
+            let r = (si.r_max * di + sj.r_max * dj + reach_gap) * (1.0 + 1e-9);
             if g >= r * r {
-                return (f64::NEG_INFINITY, false);
+                return None;
             }
         }
         let mut worst = f64::NEG_INFINITY;
         let mut any = false;
         let (mut fi, mut mi, mut mj) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        let reach_j = sj.half_length + self.skin;
+        let reach_j = sj.half_length * dj + reach_gap;
         for &(oi, ri) in &si.spheres {
+            let (oi, ri) = (oi * di, ri * di);
             let pi = [oi * ai[0], oi * ai[1], oi * ai[2]];
             // Skip spheres that cannot reach particle j's bounding sphere.
             let q = [pi[0] - d[0], pi[1] - d[1], pi[2] - d[2]];
@@ -488,16 +586,20 @@ impl State {
                 continue;
             }
             for &(oj, rj) in &sj.spheres {
+                let (oj, rj) = (oj * dj, rj * dj);
                 let pj = [d[0] + oj * aj[0], d[1] + oj * aj[1], d[2] + oj * aj[2]];
                 let ab = [pi[0] - pj[0], pi[1] - pj[1], pi[2] - pj[2]];
                 let dist = norm(&ab);
                 let l = ri + rj - dist;
-                if l <= 0.0 {
+                let mag = if l > 0.0 {
+                    worst = worst.max(l);
+                    K * (l + self.skin)
+                } else if bonded && -l > self.skin && -l < ATTRACTION_RANGE * (ri + rj) {
+                    (K * ATTRACTION * l).max(-ATTRACTION_CAP * self.skin)
+                } else {
                     continue;
-                }
-                worst = worst.max(l);
+                };
                 any = true;
-                let mag = K * (l + self.skin);
                 let f = if dist > 1e-12 * (ri + rj) {
                     [mag * ab[0] / dist, mag * ab[1] / dist, mag * ab[2] / dist]
                 } else {
@@ -509,25 +611,27 @@ impl State {
                 add(&mut mj, &cross(&rj_vec, &f), -1.0);
             }
         }
-        if any {
-            add(&mut self.force[i], &fi, 1.0);
-            add(&mut self.torque[i], &mi, 1.0);
-            add(&mut self.force[j], &fi, -1.0);
-            add(&mut self.torque[j], &mj, 1.0);
-        }
-        (worst, any)
+        any.then_some(PairForce {
+            f: fi,
+            mi,
+            mj,
+            worst,
+        })
     }
 
-    /// Wall forces on particle `i`; returns the worst penetration.
-    fn walls(&mut self, i: usize) -> f64 {
+    /// Wall force and torque on particle `i` and its worst penetration.
+    fn walls(&self, i: usize) -> ([f64; 3], [f64; 3], f64) {
         let (c, a) = (self.center[i], self.axis[i]);
         let h = self.size[2];
         let spec = &self.specs[self.species[i] as usize];
+        let d = self.scale[i];
+        let top = -self.relief * d;
         let mut worst = f64::NEG_INFINITY;
         let (mut f, mut m) = ([0.0; 3], [0.0; 3]);
         for &(o, r) in &spec.spheres {
+            let (o, r) = (o * d, r * d);
             let z = c[2] + o * a[2];
-            let below = r - z;
+            let below = top + r - z;
             let above = z + r - h;
             worst = worst.max(below).max(above);
             let fz = if below > 0.0 {
@@ -541,9 +645,91 @@ impl State {
             f[2] += fz;
             add(&mut m, &cross(&[o * a[0], o * a[1], o * a[2]], &fv), 1.0);
         }
-        add(&mut self.force[i], &f, 1.0);
-        add(&mut self.torque[i], &m, 1.0);
+        (f, m, worst)
+    }
+
+    /// Forces on moving particle `i` from the walls and from every neighbour
+    /// whose pair it owns; contributions go to `buf` (neighbours first, then
+    /// `i` itself). Returns the worst overlap seen.
+    fn gather(&self, i: usize, ep: u64, buf: &mut Vec<Contribution>) -> f64 {
+        let (mut fi, mut mi, mut worst) = self.walls(i);
+        let cc = self.grid.coords(&self.center[i]);
+        let (z0, z1) = self.grid.range(2, cc[2]);
+        let (y0, y1) = self.grid.range(1, cc[1]);
+        let (x0, x1) = self.grid.range(0, cc[0]);
+        let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
+        for cz in z0..=z1 {
+            for cy in y0..=y1 {
+                let wy = cy.rem_euclid(ny) as usize;
+                for cx in x0..=x1 {
+                    let wx = cx.rem_euclid(nx) as usize;
+                    let mut j = self.grid.head[self.grid.flat([wx, wy, cz as usize])];
+                    while j != EMPTY {
+                        let ju = j as usize;
+                        j = self.grid.next[ju];
+                        if ju == i || (self.moving_mark[ju] == ep && ju < i) {
+                            continue;
+                        }
+                        if let Some(pf) = self.pair(i, ju) {
+                            worst = worst.max(pf.worst);
+                            add(&mut fi, &pf.f, 1.0);
+                            add(&mut mi, &pf.mi, 1.0);
+                            buf.push((ju as u32, [-pf.f[0], -pf.f[1], -pf.f[2]], pf.mj));
+                        }
+                    }
+                }
+            }
+        }
+        buf.push((i as u32, fi, mi));
         worst
+    }
+
+    /// New centre and axis of particle `p` after one Euler step under its
+    /// accumulated force and torque; `None` when neither acts.
+    fn advance(&self, p: usize) -> Option<([f64; 3], [f64; 3])> {
+        let f = self.force[p];
+        let mut m = self.torque[p];
+        if norm(&f) == 0.0 && norm(&m) == 0.0 {
+            return None;
+        }
+        let spec = &self.specs[self.species[p] as usize];
+        let d = self.scale[p];
+        let a = self.axis[p];
+        if spec.field != 0.0 {
+            let t = cross(&a, &[0.0, 0.0, 1.0]);
+            let r_max = spec.r_max * d;
+            add(&mut m, &t, spec.field * K * r_max * r_max * a[2]);
+        }
+        let inertia = spec.inertia * d * d;
+        let v = f; // η = 1
+        let om = [m[0] / inertia, m[1] / inertia, m[2] / inertia];
+        let speed = norm(&v) + norm(&om) * spec.s_max * d;
+        let mut dt = DT_MAX;
+        if speed * dt > MAX_MOVE * spec.r_min * d {
+            dt = MAX_MOVE * spec.r_min * d / speed;
+        }
+        let c0 = self.center[p];
+        let c = [
+            wrap(c0[0] + v[0] * dt, self.size[0]),
+            wrap(c0[1] + v[1] * dt, self.size[1]),
+            c0[2] + v[2] * dt,
+        ];
+        let phi = norm(&om) * dt;
+        let mut axis = a;
+        if phi > 0.0 {
+            let no = norm(&om);
+            let k = [om[0] / no, om[1] / no, om[2] / no];
+            let kxa = cross(&k, &a);
+            let kd = k[0] * a[0] + k[1] * a[1] + k[2] * a[2];
+            let (s, co) = phi.sin_cos();
+            let mut b = [0.0; 3];
+            for ax in 0..3 {
+                b[ax] = a[ax] * co + kxa[ax] * s + k[ax] * kd * (1.0 - co);
+            }
+            let nb = norm(&b);
+            axis = [b[0] / nb, b[1] / nb, b[2] / nb];
+        }
+        Some((c, axis))
     }
 
     /// One relaxation step. Returns the worst overlap at the current
@@ -551,105 +737,380 @@ impl State {
     fn step(&mut self, tol: f64) -> f64 {
         self.epoch += 1;
         let ep = self.epoch;
-        self.touched.clear();
         for k in 0..self.moving.len() {
             let p = self.moving[k] as usize;
             self.moving_mark[p] = ep;
-            self.touched_mark[p] = ep;
-            self.force[p] = [0.0; 3];
-            self.torque[p] = [0.0; 3];
-            self.touched.push(p as u32);
         }
-        let mut worst = f64::NEG_INFINITY;
-        for k in 0..self.moving.len() {
-            let i = self.moving[k] as usize;
-            worst = worst.max(self.walls(i));
-            let cc = self.grid.coords(&self.center[i]);
-            let (z0, z1) = self.grid.range(2, cc[2]);
-            let (y0, y1) = self.grid.range(1, cc[1]);
-            let (x0, x1) = self.grid.range(0, cc[0]);
-            let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
-            for cz in z0..=z1 {
-                for cy in y0..=y1 {
-                    let wy = cy.rem_euclid(ny) as usize;
-                    for cx in x0..=x1 {
-                        let wx = cx.rem_euclid(nx) as usize;
-                        let mut j = self.grid.head[self.grid.flat([wx, wy, cz as usize])];
-                        while j != EMPTY {
-                            let ju = j as usize;
-                            j = self.grid.next[ju];
-                            if ju == i || (self.moving_mark[ju] == ep && ju < i) {
-                                continue;
-                            }
-                            let fresh = self.touched_mark[ju] != ep;
-                            if fresh {
-                                self.force[ju] = [0.0; 3];
-                                self.torque[ju] = [0.0; 3];
-                            }
-                            let (w, any) = self.pair(i, ju);
-                            worst = worst.max(w);
-                            if any && fresh {
-                                self.touched_mark[ju] = ep;
-                                self.touched.push(ju as u32);
-                            }
-                        }
-                    }
+        let n_chunks = self.moving.len().div_ceil(CHUNK);
+        if self.bufs.len() < n_chunks {
+            self.bufs.resize_with(n_chunks, Vec::new);
+        }
+        let mut bufs = std::mem::take(&mut self.bufs);
+        let this = &*self;
+        let worst = bufs[..n_chunks]
+            .par_iter_mut()
+            .enumerate()
+            .map(|(c, buf)| {
+                buf.clear();
+                let lo = c * CHUNK;
+                let hi = (lo + CHUNK).min(this.moving.len());
+                let mut worst = f64::NEG_INFINITY;
+                for &i in &this.moving[lo..hi] {
+                    worst = worst.max(this.gather(i as usize, ep, buf));
                 }
-            }
-        }
+                worst
+            })
+            .reduce(|| f64::NEG_INFINITY, f64::max);
         if worst < tol {
+            self.bufs = bufs;
             return worst;
         }
-        // Move every particle that felt a force; they form the next moving list.
-        self.moving.clear();
-        for k in 0..self.touched.len() {
-            let p = self.touched[k] as usize;
-            let f = self.force[p];
-            let mut m = self.torque[p];
-            if norm(&f) == 0.0 && norm(&m) == 0.0 {
-                continue;
-            }
-            let sp = self.species[p] as usize;
-            let a = self.axis[p];
-            let (strength, scale) = self.field[sp];
-            if strength != 0.0 {
-                let t = cross(&a, &[0.0, 0.0, 1.0]);
-                add(&mut m, &t, strength * scale * a[2]);
-            }
-            let spec = &self.specs[sp];
-            let v = f; // η = 1
-            let om = [
-                m[0] / spec.inertia,
-                m[1] / spec.inertia,
-                m[2] / spec.inertia,
-            ];
-            let speed = norm(&v) + norm(&om) * spec.s_max;
-            let mut dt = DT_MAX;
-            if speed * dt > MAX_MOVE * spec.r_min {
-                dt = MAX_MOVE * spec.r_min / speed;
-            }
-            let c = &mut self.center[p];
-            c[0] = wrap(c[0] + v[0] * dt, self.size[0]);
-            c[1] = wrap(c[1] + v[1] * dt, self.size[1]);
-            c[2] += v[2] * dt;
-            let phi = norm(&om) * dt;
-            if phi > 0.0 {
-                let k = [om[0] / norm(&om), om[1] / norm(&om), om[2] / norm(&om)];
-                let kxa = cross(&k, &a);
-                let kd = k[0] * a[0] + k[1] * a[1] + k[2] * a[2];
-                let (s, co) = phi.sin_cos();
-                let mut b = [0.0; 3];
-                for ax in 0..3 {
-                    b[ax] = a[ax] * co + kxa[ax] * s + k[ax] * kd * (1.0 - co);
+        // Add the contributions in chunk order (deterministic).
+        self.touched.clear();
+        for buf in &bufs[..n_chunks] {
+            for &(p, f, m) in buf {
+                let pu = p as usize;
+                if self.touched_mark[pu] != ep {
+                    self.touched_mark[pu] = ep;
+                    self.force[pu] = [0.0; 3];
+                    self.torque[pu] = [0.0; 3];
+                    self.touched.push(p);
                 }
-                let nb = norm(&b);
-                self.axis[p] = [b[0] / nb, b[1] / nb, b[2] / nb];
+                add(&mut self.force[pu], &f, 1.0);
+                add(&mut self.torque[pu], &m, 1.0);
             }
-            let c = self.center[p];
-            self.grid.update(p, &c);
-            self.moving.push(p as u32);
         }
+        self.bufs = bufs;
+        // Move every particle that felt a force; they form the next moving list.
+        let mut moves = std::mem::take(&mut self.moves);
+        let this = &*self;
+        this.touched
+            .par_iter()
+            .map(|&p| this.advance(p as usize))
+            .collect_into_vec(&mut moves);
+        self.moving.clear();
+        for (k, mv) in moves.iter().enumerate() {
+            let p = self.touched[k] as usize;
+            if let Some((c, a)) = *mv {
+                self.center[p] = c;
+                self.axis[p] = a;
+                self.grid.update(p, &c);
+                self.moving.push(p as u32);
+            }
+        }
+        self.moves = moves;
         worst
+    }
+}
+
+/// What one relaxation step saw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    /// Particles on the moving list when the step started.
+    pub moving: usize,
+    /// Worst overlap (pairs and walls) at the start of the step, nm.
+    pub worst_overlap_nm: f64,
+}
+
+/// The dynamics packer step by step: [`DynamicsPacker::insert_batch`] adds
+/// the next batch, [`DynamicsPacker::step`] / [`DynamicsPacker::relax`]
+/// relax it, [`DynamicsPacker::geometry`] returns the particles.
+/// [`pack_dynamics`] is the whole loop.
+#[derive(Debug, Clone)]
+pub struct DynamicsPacker {
+    params: DynParams,
+    st: State,
+    rng: Xoshiro256PlusPlus,
+    /// Diameters per species, in placement order.
+    diameters: Vec<Vec<f64>>,
+    /// Current particle index of every placed grain, per species.
+    index_of: Vec<Vec<u32>>,
+    batches: usize,
+    next_batch: usize,
+    tol: f64,
+    steps: u64,
+    placed_volume: f64,
+    /// Placed volume before the last batch.
+    volume_before: f64,
+    next_cluster: u32,
+}
+
+impl DynamicsPacker {
+    /// Checks `params`, draws the diameters; no particle placed yet.
+    pub fn new(params: &DynParams, seed: u64) -> Result<Self, GeometryError> {
+        let (specs, diameters) = validate(params, seed)?;
+        let size = params.size_nm;
+        let total: usize = diameters.iter().map(Vec::len).sum();
+        let target: f64 = params.species.iter().map(|s| s.volume_fraction).sum();
+        let r_min_all = specs
+            .iter()
+            .zip(&diameters)
+            .flat_map(|(s, ds)| ds.iter().map(move |&d| s.r_min * d))
+            .fold(f64::INFINITY, f64::min);
+        let tol = params.overlap_tolerance
+            * if r_min_all.is_finite() {
+                r_min_all
+            } else {
+                0.0
+            };
+        let cell = specs
+            .iter()
+            .zip(&diameters)
+            .filter(|(_, ds)| !ds.is_empty())
+            .map(|(s, ds)| {
+                let d = ds.iter().copied().fold(0.0, f64::max);
+                let attract = if s.group > 1 {
+                    ATTRACTION_RANGE * 2.0 * s.r_max * d
+                } else {
+                    0.0
+                };
+                2.0 * s.half_length * d + attract
+            })
+            .fold(0.0, f64::max)
+            + 0.5 * tol;
+        let st = State {
+            size,
+            relief: params.relief_fraction,
+            grid: Grid::new(size, cell.max(f64::MIN_POSITIVE), total),
+            specs,
+            center: Vec::with_capacity(total),
+            axis: Vec::with_capacity(total),
+            species: Vec::with_capacity(total),
+            scale: Vec::with_capacity(total),
+            cluster: Vec::with_capacity(total),
+            force: Vec::with_capacity(total),
+            torque: Vec::with_capacity(total),
+            moving_mark: Vec::with_capacity(total),
+            touched_mark: Vec::with_capacity(total),
+            epoch: 0,
+            moving: Vec::with_capacity(total),
+            touched: Vec::with_capacity(total),
+            bufs: Vec::new(),
+            moves: Vec::new(),
+            skin: 0.5 * tol,
+        };
+        let batches = ((target / params.batch_fraction).ceil() as usize).max(1);
+        Ok(DynamicsPacker {
+            params: params.clone(),
+            st,
+            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
+            index_of: diameters
+                .iter()
+                .map(|d| Vec::with_capacity(d.len()))
+                .collect(),
+            diameters,
+            batches,
+            next_batch: 0,
+            tol,
+            steps: 0,
+            placed_volume: 0.0,
+            volume_before: 0.0,
+            next_cluster: 0,
+        })
+    }
+
+    /// Number of batches the target is split into.
+    pub fn batches(&self) -> usize {
+        self.batches
+    }
+
+    /// Particles placed so far.
+    pub fn particles(&self) -> usize {
+        self.st.center.len()
+    }
+
+    /// Particles on the moving list.
+    pub fn moving(&self) -> usize {
+        self.st.moving.len()
+    }
+
+    /// Overlap tolerance in nm (the fraction times the smallest radius).
+    pub fn tolerance_nm(&self) -> f64 {
+        self.tol
+    }
+
+    /// Relaxation steps taken so far.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Adds the next batch of random particles (overlaps allowed); false
+    /// when every batch is in.
+    pub fn insert_batch(&mut self) -> bool {
+        if self.next_batch >= self.batches {
+            return false;
+        }
+        let b = self.next_batch;
+        self.next_batch += 1;
+        self.volume_before = self.placed_volume;
+        let size = self.params.size_nm;
+        let relief = self.params.relief_fraction;
+        for s in 0..self.diameters.len() {
+            let count = self.diameters[s].len();
+            let want =
+                ((count as f64 * (b + 1) as f64 / self.batches as f64).round() as usize).min(count);
+            let mode = self.params.species[s].orientation;
+            let group = self.st.specs[s].group;
+            while self.index_of[s].len() < want {
+                let k = self.index_of[s].len();
+                let d = self.diameters[s][k];
+                let spec = &self.st.specs[s];
+                let a = axis_from_uniforms(mode, self.rng.gen(), self.rng.gen());
+                let ext = d * spec
+                    .spheres
+                    .iter()
+                    .map(|&(o, r)| (o * a[2]).abs() + r)
+                    .fold(0.0, f64::max);
+                let (z_lo, z_hi) = (ext - relief * d, size[2] - ext);
+                let cluster = if group > 1 {
+                    if k.is_multiple_of(group) {
+                        self.next_cluster += 1;
+                    }
+                    self.next_cluster - 1
+                } else {
+                    EMPTY
+                };
+                let c = if group > 1 && !k.is_multiple_of(group) {
+                    // Next to a random earlier member of the same group.
+                    let first = k - k % group;
+                    let m = self.index_of[s][first + self.rng.gen_range(0..k - first)] as usize;
+                    let u = axis_from_uniforms(Orientation::Random, self.rng.gen(), self.rng.gen());
+                    let dist = spec.r_max * (d + self.st.scale[m]);
+                    let cm = self.st.center[m];
+                    let z = cm[2] + dist * u[2];
+                    [
+                        wrap(cm[0] + dist * u[0], size[0]),
+                        wrap(cm[1] + dist * u[1], size[1]),
+                        if z_hi > z_lo {
+                            z.clamp(z_lo, z_hi)
+                        } else {
+                            0.5 * (z_lo + z_hi)
+                        },
+                    ]
+                } else {
+                    let u: f64 = self.rng.gen();
+                    let z = if z_hi > z_lo {
+                        z_lo + u * (z_hi - z_lo)
+                    } else {
+                        0.5 * (z_lo + z_hi)
+                    };
+                    let x = (self.rng.gen::<f64>() * size[0]).min(size[0] * (1.0 - f64::EPSILON));
+                    let y = (self.rng.gen::<f64>() * size[1]).min(size[1] * (1.0 - f64::EPSILON));
+                    [x, y, z]
+                };
+                self.index_of[s].push(self.st.center.len() as u32);
+                self.st.add_particle(s, d, cluster, c, a);
+                self.placed_volume += std::f64::consts::PI / 6.0 * d * d * d;
+            }
+        }
+        let inv = self.st.reorder();
+        for list in self.index_of.iter_mut() {
+            for p in list.iter_mut() {
+                *p = inv[*p as usize];
+            }
+        }
+        true
+    }
+
+    /// One relaxation step (moves particles only while the worst overlap is
+    /// at or above the tolerance).
+    pub fn step(&mut self) -> StepReport {
+        let moving = self.st.moving.len();
+        let worst = self.st.step(self.tol);
+        StepReport {
+            moving,
+            worst_overlap_nm: worst.max(0.0),
+        }
+    }
+
+    /// Relaxes until the worst overlap is below the tolerance; returns the
+    /// steps taken, or [`GeometryError::DynamicsNotReached`] after
+    /// `max_steps_per_batch` steps.
+    pub fn relax(&mut self) -> Result<u64, GeometryError> {
+        let mut steps = 0u64;
+        loop {
+            let worst = self.st.step(self.tol);
+            if worst < self.tol {
+                self.steps += steps;
+                return Ok(steps);
+            }
+            steps += 1;
+            if steps > self.params.max_steps_per_batch {
+                let box_volume: f64 = self.params.size_nm.iter().product();
+                return Err(GeometryError::DynamicsNotReached {
+                    target: self.params.species.iter().map(|s| s.volume_fraction).sum(),
+                    reached: self.volume_before / box_volume,
+                    worst_overlap_nm: worst,
+                    steps: self.steps + steps,
+                });
+            }
+        }
+    }
+
+    /// The particles as they are now, with their statistics.
+    pub fn geometry(&self) -> Geometry {
+        let st = &self.st;
+        let size = self.params.size_nm;
+        let box_volume = size[0] * size[1] * size[2];
+        let particles: Vec<Particle> = (0..st.center.len())
+            .map(|p| {
+                let (c, a) = (st.center[p], st.axis[p]);
+                let s = st.species[p] as usize;
+                let d = st.scale[p];
+                let spheres = st.specs[s]
+                    .spheres
+                    .iter()
+                    .map(|&(o, r)| Sphere {
+                        center: [
+                            wrap(c[0] + o * d * a[0], size[0]),
+                            wrap(c[1] + o * d * a[1], size[1]),
+                            c[2] + o * d * a[2],
+                        ],
+                        radius: r * d,
+                    })
+                    .collect();
+                Particle {
+                    species: s,
+                    spheres,
+                }
+            })
+            .collect();
+        let axes: Vec<[f64; 3]> = (0..st.center.len())
+            .filter(|&p| st.specs[st.species[p] as usize].spheres.len() > 1)
+            .map(|p| st.axis[p])
+            .collect();
+        let min_gap = min_gap_nm(size, &particles);
+        let unit = std::f64::consts::PI / 6.0;
+        Geometry {
+            size_nm: size,
+            particles,
+            stats: GeometryStats {
+                count: self.index_of.iter().map(Vec::len).collect(),
+                target_fraction: self
+                    .params
+                    .species
+                    .iter()
+                    .map(|s| s.volume_fraction)
+                    .collect(),
+                achieved_fraction: self
+                    .diameters
+                    .iter()
+                    .zip(&self.index_of)
+                    .map(|(ds, placed)| {
+                        ds[..placed.len()]
+                            .iter()
+                            .map(|d| unit * d * d * d)
+                            .sum::<f64>()
+                            / box_volume
+                    })
+                    .collect(),
+                min_gap_nm: min_gap,
+                attempts: st.center.len() as u64,
+                worst_overlap_nm: (-min_gap).max(0.0),
+                order_parameter: order_parameter(&axes),
+                relax_steps: self.steps,
+            },
+        }
     }
 }
 
@@ -659,162 +1120,13 @@ impl State {
 /// Particles come out ordered by grid cell (renumbered after every batch for
 /// memory locality), not in insertion order. `stats.attempts` counts the
 /// particles inserted, `stats.relax_steps` the relaxation steps of all
-/// batches. Deterministic for a seed.
+/// batches. Deterministic for a seed, whatever the number of threads.
 pub fn pack_dynamics(params: &DynParams, seed: u64) -> Result<Geometry, GeometryError> {
-    let specs = validate(params)?;
-    let size = params.size_nm;
-    let box_volume = size[0] * size[1] * size[2];
-    let total: usize = specs.iter().map(|s| s.count).sum();
-    let target: f64 = params.species.iter().map(|s| s.volume_fraction).sum();
-    let r_min_all = specs
-        .iter()
-        .filter(|s| s.count > 0)
-        .map(|s| s.r_min)
-        .fold(f64::INFINITY, f64::min);
-    let tol = params.overlap_tolerance
-        * if r_min_all.is_finite() {
-            r_min_all
-        } else {
-            0.0
-        };
-    let cell = specs
-        .iter()
-        .filter(|s| s.count > 0)
-        .map(|s| 2.0 * s.half_length)
-        .fold(0.0, f64::max)
-        + 0.5 * tol;
-    let field = params
-        .species
-        .iter()
-        .zip(&specs)
-        .map(|(s, sp)| {
-            let sign = match s.orientation {
-                Orientation::Perpendicular => 1.0,
-                Orientation::InPlane => -1.0,
-                Orientation::Random => 0.0,
-            };
-            (sign * s.field, K * sp.r_max * sp.r_max)
-        })
-        .collect();
-    let mut st = State {
-        size,
-        grid: Grid::new(size, cell.max(f64::MIN_POSITIVE), total),
-        specs,
-        center: Vec::with_capacity(total),
-        axis: Vec::with_capacity(total),
-        species: Vec::with_capacity(total),
-        field,
-        force: Vec::with_capacity(total),
-        torque: Vec::with_capacity(total),
-        moving_mark: Vec::with_capacity(total),
-        touched_mark: Vec::with_capacity(total),
-        epoch: 0,
-        moving: Vec::with_capacity(total),
-        touched: Vec::with_capacity(total),
-        skin: 0.5 * tol,
-    };
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    let batches = ((target / params.batch_fraction).ceil() as usize).max(1);
-    let mut steps_total = 0u64;
-    let mut placed = vec![0usize; st.specs.len()];
-    let mut placed_volume = 0.0;
-    for b in 0..batches {
-        let volume_before = placed_volume;
-        for (s, placed_s) in placed.iter_mut().enumerate() {
-            let want =
-                (st.specs[s].count as f64 * (b + 1) as f64 / batches as f64).round() as usize;
-            let mode = params.species[s].orientation;
-            while *placed_s < want.min(st.specs[s].count) {
-                let a = axis_from_uniforms(mode, rng.gen(), rng.gen());
-                let ext = st.specs[s]
-                    .spheres
-                    .iter()
-                    .map(|&(o, r)| (o * a[2]).abs() + r)
-                    .fold(0.0, f64::max);
-                let span = size[2] - 2.0 * ext;
-                let u: f64 = rng.gen();
-                let z = if span > 0.0 {
-                    ext + u * span
-                } else {
-                    0.5 * size[2]
-                };
-                let x = (rng.gen::<f64>() * size[0]).min(size[0] * (1.0 - f64::EPSILON));
-                let y = (rng.gen::<f64>() * size[1]).min(size[1] * (1.0 - f64::EPSILON));
-                st.add_particle(s, [x, y, z], a);
-                *placed_s += 1;
-                placed_volume += st.specs[s].volume;
-            }
-        }
-        st.reorder();
-        let mut steps = 0u64;
-        loop {
-            let worst = st.step(tol);
-            if worst < tol {
-                break;
-            }
-            steps += 1;
-            if steps > params.max_steps_per_batch {
-                return Err(GeometryError::DynamicsNotReached {
-                    target,
-                    reached: volume_before / box_volume,
-                    worst_overlap_nm: worst,
-                    steps: steps_total + steps,
-                });
-            }
-        }
-        steps_total += steps;
+    let mut packer = DynamicsPacker::new(params, seed)?;
+    while packer.insert_batch() {
+        packer.relax()?;
     }
-    Ok(finish(params, &st, steps_total, total as u64))
-}
-
-fn finish(params: &DynParams, st: &State, relax_steps: u64, attempts: u64) -> Geometry {
-    let size = params.size_nm;
-    let box_volume = size[0] * size[1] * size[2];
-    let particles: Vec<Particle> = (0..st.center.len())
-        .map(|p| {
-            let (c, a) = (st.center[p], st.axis[p]);
-            let s = st.species[p] as usize;
-            let spheres = st.specs[s]
-                .spheres
-                .iter()
-                .map(|&(o, r)| Sphere {
-                    center: [
-                        wrap(c[0] + o * a[0], size[0]),
-                        wrap(c[1] + o * a[1], size[1]),
-                        c[2] + o * a[2],
-                    ],
-                    radius: r,
-                })
-                .collect();
-            Particle {
-                species: s,
-                spheres,
-            }
-        })
-        .collect();
-    let axes: Vec<[f64; 3]> = (0..st.center.len())
-        .filter(|&p| st.specs[st.species[p] as usize].spheres.len() > 1)
-        .map(|p| st.axis[p])
-        .collect();
-    let min_gap = min_gap_nm(size, &particles);
-    Geometry {
-        size_nm: size,
-        particles,
-        stats: GeometryStats {
-            count: st.specs.iter().map(|s| s.count).collect(),
-            target_fraction: params.species.iter().map(|s| s.volume_fraction).collect(),
-            achieved_fraction: st
-                .specs
-                .iter()
-                .map(|s| s.count as f64 * s.volume / box_volume)
-                .collect(),
-            min_gap_nm: min_gap,
-            attempts,
-            worst_overlap_nm: (-min_gap).max(0.0),
-            order_parameter: order_parameter(&axes),
-            relax_steps,
-        },
-    }
+    Ok(packer.geometry())
 }
 
 /// Unit axes of the particles of `g` (first to last sphere, nearest periodic

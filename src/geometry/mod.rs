@@ -23,13 +23,144 @@ mod cells;
 mod dynamics;
 mod rsa;
 mod shapes;
+pub mod stats;
 
-pub use dynamics::{pack_dynamics, particle_axis, DynParams, DynSpecies};
+pub use dynamics::{pack_dynamics, particle_axis, DynParams, DynSpecies, DynamicsPacker};
 pub use shapes::{
     axis_from_uniforms, order_parameter, union_volume, Orientation, Shape, ShapeTemplate,
+    SizeDistribution,
 };
+pub use stats::{analyse, Statistics, StatsParams};
 
 use cells::{dist2, CellList};
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+/// Largest number of grains per seeded cluster ([`SpeciesOptions::cluster_size`]).
+pub const MAX_CLUSTER_SIZE: usize = 10_000;
+/// Largest [`PackParams::relief_fraction`] / [`DynParams::relief_fraction`].
+pub const MAX_RELIEF_FRACTION: f64 = 0.5;
+
+/// Per-species options shared by both packers (size distribution and
+/// agglomeration). `Default`: fixed size, no clusters.
+///
+/// Agglomeration model: the grains of a species are taken in consecutive
+/// groups of `cluster_size` (the last group may be smaller); the first grain
+/// of a group is placed at random, every further one next to a random
+/// earlier member of its group (centre distance = sum of their largest
+/// sphere radii, random direction). RSA keeps such a seed only if it
+/// overlaps nothing (up to [`rsa::CLUSTER_TRIES`] directions, then the grain
+/// starts a new group at a random place); the dynamics packer lets it
+/// overlap and, during relaxation, pulls members of one group together with
+/// a short-range attraction (see `dynamics`). Whether grains end up in
+/// contact is measured independently by [`stats::analyse`] (connected
+/// components of grains closer than a contact gap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpeciesOptions {
+    pub size: SizeDistribution,
+    /// Grains per seeded cluster, `1..=MAX_CLUSTER_SIZE` (1: no clusters).
+    pub cluster_size: usize,
+}
+
+impl Default for SpeciesOptions {
+    fn default() -> Self {
+        SpeciesOptions {
+            size: SizeDistribution::Fixed,
+            cluster_size: 1,
+        }
+    }
+}
+
+/// Options of species `i` (`options` empty: defaults for every species).
+pub(crate) fn options_of(
+    options: &[SpeciesOptions],
+    n_species: usize,
+) -> Result<Vec<SpeciesOptions>, GeometryError> {
+    if options.is_empty() {
+        return Ok(vec![SpeciesOptions::default(); n_species]);
+    }
+    if options.len() != n_species {
+        return Err(GeometryError::Invalid(format!(
+            "{} species options for {n_species} species; give one per species or none",
+            options.len()
+        )));
+    }
+    for (i, o) in options.iter().enumerate() {
+        o.size
+            .check()
+            .map_err(|e| GeometryError::Invalid(format!("species {i}: {e}")))?;
+        if !(1..=MAX_CLUSTER_SIZE).contains(&o.cluster_size) {
+            return Err(GeometryError::Invalid(format!(
+                "species {i}: cluster size {} must be in [1, {MAX_CLUSTER_SIZE}]",
+                o.cluster_size
+            )));
+        }
+    }
+    Ok(options.to_vec())
+}
+
+/// Checks a relief fraction against `[0, MAX_RELIEF_FRACTION]`.
+pub(crate) fn check_relief(f: f64) -> Result<f64, GeometryError> {
+    if f.is_finite() && (0.0..=MAX_RELIEF_FRACTION).contains(&f) {
+        Ok(f)
+    } else {
+        Err(GeometryError::Invalid(format!(
+            "relief fraction {f} must be in [0, {MAX_RELIEF_FRACTION}]"
+        )))
+    }
+}
+
+/// Effective diameters of the grains of one species whose equal-volume
+/// sphere has volume `unit_volume · D³` (π/6 for every template).
+///
+/// Fixed size: `round(f V / v)` grains. Otherwise diameters are drawn from
+/// `rng` until the drawn volume reaches `f V`; the last draw is kept only if
+/// that brings the total closer to `f V`, so the achieved fraction is within
+/// half a grain's volume of the target.
+pub(crate) fn draw_diameters(
+    species: usize,
+    d: f64,
+    fraction: f64,
+    box_volume: f64,
+    size: SizeDistribution,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Result<Vec<f64>, GeometryError> {
+    let unit = std::f64::consts::PI / 6.0;
+    let target = fraction * box_volume;
+    let estimate = target / (unit * d * d * d * size.mean_cube_ratio());
+    if estimate.round() > MAX_PARTICLES as f64 {
+        return Err(GeometryError::Invalid(format!(
+            "species {species}: about {} grains of {d} nm needed; at most {MAX_PARTICLES} allowed",
+            estimate.round()
+        )));
+    }
+    if size == SizeDistribution::Fixed {
+        return Ok(vec![d; (target / (unit * d * d * d)).round() as usize]);
+    }
+    let mut out = Vec::with_capacity(estimate as usize + 16);
+    let mut total = 0.0;
+    while total < target {
+        let di = size.sample(d, rng);
+        let v = unit * di * di * di;
+        if total + v > target && total + v - target > target - total {
+            break;
+        }
+        total += v;
+        out.push(di);
+        if out.len() > MAX_PARTICLES {
+            return Err(GeometryError::Invalid(format!(
+                "species {species}: more than {MAX_PARTICLES} grains needed"
+            )));
+        }
+    }
+    Ok(out)
+}
+
+/// The RNG stream of the size draws of a packing with `seed` (separate from
+/// the placement stream, so fixed-size packings are unchanged by it).
+pub(crate) fn size_rng(seed: u64) -> Xoshiro256PlusPlus {
+    Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5157_e5d1_a7b3_c0de)
+}
 
 /// Most particles one fragment may hold (guards memory against tiny grains).
 pub const MAX_PARTICLES: usize = 50_000_000;
@@ -53,7 +184,9 @@ pub struct Particle {
 /// One species to pack.
 #[derive(Debug, Clone)]
 pub struct SpeciesParams {
-    /// Sphere diameter, nm (> 0, ≤ H, ≤ half the lateral period).
+    /// Sphere diameter, nm (> 0, ≤ H, ≤ half the lateral period); the
+    /// nominal one with a size distribution ([`PackParams::options`]), whose
+    /// largest draw must fit.
     pub diameter_nm: f64,
     /// Target volume fraction of the fragment, in `[0, 1)`.
     pub volume_fraction: f64,
@@ -69,6 +202,11 @@ pub struct PackParams {
     /// Consecutive rejected draws after which one particle counts as
     /// unplaceable and packing stops (≥ 1).
     pub max_attempts_per_particle: u64,
+    /// Size distribution and clustering per species; empty: defaults.
+    pub options: Vec<SpeciesOptions>,
+    /// Grains may protrude through the top surface `z = 0` by up to this
+    /// fraction of their diameter, `[0, MAX_RELIEF_FRACTION]` (0: flat).
+    pub relief_fraction: f64,
 }
 
 /// The METHOD §1 default fragment (10 × 10 µm, 1 µm thick), no species,
@@ -89,6 +227,8 @@ impl PackParams {
             size_nm,
             species,
             max_attempts_per_particle: Self::DEFAULT_MAX_ATTEMPTS,
+            options: Vec::new(),
+            relief_fraction: 0.0,
         }
     }
 }
@@ -183,7 +323,9 @@ pub fn sphere_volume(r: f64) -> f64 {
     4.0 / 3.0 * std::f64::consts::PI * r * r * r
 }
 
-fn validate(params: &PackParams) -> Result<Vec<usize>, GeometryError> {
+/// Checks the parameters and draws every species' diameters (sizes RNG
+/// stream of `seed`).
+fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryError> {
     let [lx, ly, h] = params.size_nm;
     for (name, v) in [("Lx", lx), ("Ly", ly), ("H", h)] {
         if !(v.is_finite() && v > 0.0) {
@@ -197,9 +339,10 @@ fn validate(params: &PackParams) -> Result<Vec<usize>, GeometryError> {
             "max_attempts_per_particle must be ≥ 1".into(),
         ));
     }
+    let options = options_of(&params.options, params.species.len())?;
+    check_relief(params.relief_fraction)?;
     let volume = lx * ly * h;
     let mut total_fraction = 0.0;
-    let mut counts = Vec::with_capacity(params.species.len());
     for (i, s) in params.species.iter().enumerate() {
         let d = s.diameter_nm;
         if !(d.is_finite() && d > 0.0) {
@@ -207,17 +350,18 @@ fn validate(params: &PackParams) -> Result<Vec<usize>, GeometryError> {
                 "species {i}: diameter {d} nm must be finite and > 0"
             )));
         }
-        if d > h {
+        let dmax = options[i].size.range(d).1;
+        if dmax > h {
             return Err(GeometryError::GrainTooLarge {
                 species: i,
-                diameter_nm: d,
+                diameter_nm: dmax,
                 thickness_nm: h,
             });
         }
         let half = 0.5 * lx.min(ly);
-        if d > half {
+        if dmax > half {
             return Err(GeometryError::Invalid(format!(
-                "species {i}: diameter {d} nm exceeds half the lateral period ({half} nm); \
+                "species {i}: diameter {dmax} nm exceeds half the lateral period ({half} nm); \
                  allowed 0 < diameter ≤ min(Lx, Ly)/2"
             )));
         }
@@ -228,41 +372,48 @@ fn validate(params: &PackParams) -> Result<Vec<usize>, GeometryError> {
             )));
         }
         total_fraction += f;
-        let n = (f * volume / sphere_volume(0.5 * d)).round();
-        if n > MAX_PARTICLES as f64 {
-            return Err(GeometryError::Invalid(format!(
-                "species {i}: {n} particles of {d} nm needed; at most {MAX_PARTICLES} allowed"
-            )));
-        }
-        counts.push(n as usize);
     }
     if total_fraction >= 1.0 {
         return Err(GeometryError::Invalid(format!(
             "total volume fraction {total_fraction} must be < 1"
         )));
     }
-    if counts.iter().sum::<usize>() > MAX_PARTICLES {
+    let mut rng = size_rng(seed);
+    let mut out = Vec::with_capacity(params.species.len());
+    let mut n = 0usize;
+    for (i, s) in params.species.iter().enumerate() {
+        let ds = draw_diameters(
+            i,
+            s.diameter_nm,
+            s.volume_fraction,
+            volume,
+            options[i].size,
+            &mut rng,
+        )?;
+        n += ds.len();
+        out.push(ds);
+    }
+    if n > MAX_PARTICLES {
         return Err(GeometryError::Invalid(format!(
-            "{} particles in total; at most {MAX_PARTICLES} allowed",
-            counts.iter().sum::<usize>()
+            "{n} particles in total; at most {MAX_PARTICLES} allowed"
         )));
     }
-    Ok(counts)
+    Ok(out)
 }
 
 /// Packs one fragment by random sequential addition (see the module docs).
 ///
 /// Deterministic: the same parameters and `seed` give identical particles.
 pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryError> {
-    let counts = validate(params)?;
-    let (particles, attempts) = rsa::pack(params, &counts, seed)?;
+    let diameters = validate(params, seed)?;
+    let options = options_of(&params.options, params.species.len())?;
+    let (particles, attempts) = rsa::pack(params, &diameters, &options, seed)?;
     let volume = params.size_nm.iter().product::<f64>();
-    let achieved_fraction = params
-        .species
+    let achieved_fraction = diameters
         .iter()
-        .zip(&counts)
-        .map(|(s, &n)| n as f64 * sphere_volume(0.5 * s.diameter_nm) / volume)
+        .map(|ds| ds.iter().map(|&d| sphere_volume(0.5 * d)).sum::<f64>() / volume)
         .collect();
+    let counts = diameters.iter().map(Vec::len).collect();
     let min_gap_nm = min_gap_nm(params.size_nm, &particles);
     Ok(Geometry {
         size_nm: params.size_nm,

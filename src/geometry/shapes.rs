@@ -204,3 +204,100 @@ pub fn order_parameter<'a>(axes: impl IntoIterator<Item = &'a [f64; 3]>) -> Opti
     }
     (n > 0).then(|| sum / n as f64)
 }
+
+/// Distribution of the effective diameter of the grains of one species
+/// around the species' nominal diameter `d`. Draws are truncated at
+/// [`SizeDistribution::TRUNCATION`] standard deviations (redrawn when
+/// outside), so every diameter lies in the documented
+/// [`SizeDistribution::range`] and the layer checks can use its upper end.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum SizeDistribution {
+    /// Every grain has the nominal diameter `d`.
+    #[default]
+    Fixed,
+    /// `d (1 + σ z)`, `z` standard normal: `d` is the mean, `sigma` the
+    /// relative standard deviation, in `[0, 0.3]` (so the range
+    /// `d (1 ± 3σ)` stays positive).
+    Normal { sigma: f64 },
+    /// `d exp(σ z)`: `d` is the median, `sigma` the standard deviation of
+    /// `ln d`, in `[0, 0.5]` (range `d e^{±3σ}`).
+    LogNormal { sigma: f64 },
+}
+
+impl SizeDistribution {
+    /// Draws lie within this many standard deviations of the centre.
+    pub const TRUNCATION: f64 = 3.0;
+    /// Largest `sigma` of [`SizeDistribution::Normal`].
+    pub const MAX_NORMAL_SIGMA: f64 = 0.3;
+    /// Largest `sigma` of [`SizeDistribution::LogNormal`].
+    pub const MAX_LOG_NORMAL_SIGMA: f64 = 0.5;
+
+    /// Checks `sigma` against its documented range.
+    pub fn check(&self) -> Result<(), String> {
+        let (s, max, name) = match *self {
+            SizeDistribution::Fixed => return Ok(()),
+            SizeDistribution::Normal { sigma } => (sigma, Self::MAX_NORMAL_SIGMA, "normal"),
+            SizeDistribution::LogNormal { sigma } => {
+                (sigma, Self::MAX_LOG_NORMAL_SIGMA, "log-normal")
+            }
+        };
+        if s.is_finite() && (0.0..=max).contains(&s) {
+            Ok(())
+        } else {
+            Err(format!("{name} size sigma {s} must be in [0, {max}]"))
+        }
+    }
+
+    /// Smallest and largest diameter a draw can give for nominal `d`.
+    pub fn range(&self, d: f64) -> (f64, f64) {
+        let t = Self::TRUNCATION;
+        match *self {
+            SizeDistribution::Fixed => (d, d),
+            SizeDistribution::Normal { sigma } => (d * (1.0 - t * sigma), d * (1.0 + t * sigma)),
+            SizeDistribution::LogNormal { sigma } => {
+                (d * (-t * sigma).exp(), d * (t * sigma).exp())
+            }
+        }
+    }
+
+    /// Mean of `D³` over the (truncated) distribution divided by `d³`, by
+    /// Gauss–Hermite-free quadrature on the truncated normal (2 000 midpoint
+    /// nodes in `z`; relative error < 1e-6). Used to estimate particle counts.
+    pub fn mean_cube_ratio(&self) -> f64 {
+        let f: &dyn Fn(f64) -> f64 = match *self {
+            SizeDistribution::Fixed => return 1.0,
+            SizeDistribution::Normal { sigma } => &move |z: f64| (1.0 + sigma * z).powi(3),
+            SizeDistribution::LogNormal { sigma } => &move |z: f64| (3.0 * sigma * z).exp(),
+        };
+        let (n, t) = (2000, Self::TRUNCATION);
+        let (mut num, mut den) = (0.0, 0.0);
+        for k in 0..n {
+            let z = -t + 2.0 * t * (k as f64 + 0.5) / n as f64;
+            let w = (-0.5 * z * z).exp();
+            num += w * f(z);
+            den += w;
+        }
+        num / den
+    }
+
+    /// One diameter for nominal `d`, from `rng` (a standard normal by
+    /// Box–Muller, redrawn until within the truncation).
+    pub fn sample<R: rand::Rng>(&self, d: f64, rng: &mut R) -> f64 {
+        let sigma = match *self {
+            SizeDistribution::Fixed => return d,
+            SizeDistribution::Normal { sigma } | SizeDistribution::LogNormal { sigma } => sigma,
+        };
+        let z = loop {
+            let u1: f64 = 1.0 - rng.gen::<f64>(); // (0, 1]
+            let u2: f64 = rng.gen();
+            let z = (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos();
+            if z.abs() <= Self::TRUNCATION {
+                break z;
+            }
+        };
+        match *self {
+            SizeDistribution::Normal { .. } => d * (1.0 + sigma * z),
+            _ => d * (sigma * z).exp(),
+        }
+    }
+}

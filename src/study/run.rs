@@ -1,7 +1,8 @@
 //! Running the variants of a study: resumable, sharded, in parallel.
 //!
 //! Each variant writes `<study dir>/variants/<name>.h5` and `<name>.png`
-//! through [`pipeline::run`], which writes both atomically (temporary file,
+//! through [`pipeline::run_with`] (quietly: the study reports per variant),
+//! which writes both atomically (temporary file,
 //! sync, rename): an interrupted run (Ctrl-C, a killed job) leaves either no
 //! file or a complete one under the final names, at most a stale `*.tmp`
 //! that the next run of that variant removes first.
@@ -315,7 +316,9 @@ fn run_one(v: &Variant) -> Result<f64, String> {
         tmp.push(".tmp");
         let _ = std::fs::remove_file(PathBuf::from(tmp));
     }
-    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| pipeline::run(&v.scene)));
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        pipeline::run_with(&v.scene, true)
+    }));
     match r {
         Ok(Ok(_)) => Ok(t.elapsed().as_secs_f64()),
         Ok(Err(e)) => Err(e.to_string()),

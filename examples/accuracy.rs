@@ -11,6 +11,7 @@
 //! 200 nm), `hard` (blue, 50 %, 250 nm, dynamics packing); default all.
 //! Prints one Markdown table per case (the tables of docs/ACCURACY.md).
 //! Identical variants (the baseline recurs in every knob) run once.
+//! Colours are the ones the run stored (`/appearance/tile_lab`).
 
 use inksim::colour::{self, Observer};
 use inksim::io::{read_appearance, AppearanceArrays};
@@ -176,8 +177,15 @@ fn run(exe: &Path, scene: &Value, dir: &Path, cache: &mut HashMap<String, PathBu
     }
 }
 
-/// Lab of every tile cell: the sky strip and π f of the BRDF square.
+/// Lab of every tile cell as the run stored it (colour through the spectral
+/// proxy), else computed from the stored spectra by linear interpolation.
 fn tile_lab(a: &AppearanceArrays, obs: &Observer) -> Vec<[f64; 3]> {
+    if let Some(t) = &a.tile_lab {
+        let (nv, nc, _) = t.dim();
+        return (0..nv)
+            .flat_map(|o| (0..nc).map(move |c| [t[[o, c, 0]], t[[o, c, 1]], t[[o, c, 2]]]))
+            .collect();
+    }
     let (f, sky) = (a.brdf_total.as_ref().unwrap(), a.natural.as_ref().unwrap());
     let wl = &a.wavelengths_nm;
     let white = obs.white_xyz();

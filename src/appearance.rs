@@ -26,6 +26,7 @@
 use crate::colour::{self, ColourError, Observer};
 use crate::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::farfield::{Side, SolveEntry};
+use crate::solver::airy;
 use crate::substrate::Hemisphere;
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
 use num_complex::Complex64 as C64;
@@ -52,6 +53,94 @@ pub struct AppearanceSpec {
     pub btdf: bool,
     /// Compute the paper term, the sky strip and the colours (the tile).
     pub tile: bool,
+    /// Spectral proxy for colour (with paper): see [`SpectralProxy`].
+    pub proxy: Option<SpectralProxy>,
+}
+
+/// The homogeneous slab of the volume-averaged ε (the molecular mixture of
+/// the same pigments) on the same paper, known in closed form at any
+/// wavelength. Colours integrate spectra over 1 nm; the layer is solved at a
+/// few wavelengths only, and pigment absorption bands are narrower than a
+/// coarse step, so linear interpolation of the layer's spectra misses the
+/// bands' shape (ΔE00 ≈ 9 at a 50 nm step, docs/ACCURACY.md). Instead the
+/// *ratio* layer / proxy is interpolated linearly and multiplied by the proxy
+/// on the fine grid: the proxy carries the bands' shape, the solves the
+/// effect of the grains. At the solved wavelengths the result is exact.
+#[derive(Debug, Clone)]
+pub struct SpectralProxy {
+    /// Fine grid (includes every solved wavelength), nm.
+    pub wavelengths_nm: Vec<f64>,
+    /// ⟨ε⟩ on the fine grid.
+    pub eps: Vec<C64>,
+    pub thickness_nm: f64,
+}
+
+impl SpectralProxy {
+    /// Proxy BRDF square `(fine λ, illumination, viewing)` and sky strip
+    /// `(fine λ, viewing)` of the slab on paper of albedo `albedo`.
+    fn spectra(
+        &self,
+        spec: &AppearanceSpec,
+        albedo: f64,
+        h: &Hemisphere,
+    ) -> (Array3<f64>, Array2<f64>) {
+        let nf = self.wavelengths_nm.len();
+        let (ni, nv) = (spec.illumination_deg.len(), spec.viewing_deg.len());
+        let mut f = Array3::zeros((nf, ni, nv));
+        let mut sky = Array2::zeros((nf, nv));
+        for (l, (&wl, &eps)) in self.wavelengths_nm.iter().zip(&self.eps).enumerate() {
+            let rt = |polar: f64| {
+                let r = airy::slab(eps, self.thickness_nm, wl, polar);
+                (r.r.norm_sqr(), r.t.norm_sqr())
+            };
+            let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(rt).collect();
+            let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
+            let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
+            let denom = 1.0 - albedo * rdd;
+            let ti: Vec<f64> = spec.illumination_deg.iter().map(|&a| rt(a).1).collect();
+            for (o, &v) in spec.viewing_deg.iter().enumerate() {
+                let (ro, to) = rt(v);
+                sky[[l, o]] = ro + albedo * td * to / denom;
+                for i in 0..ni {
+                    f[[l, i, o]] = albedo * ti[i] * to / (PI * denom);
+                }
+            }
+        }
+        (f, sky)
+    }
+}
+
+/// Spectrum on the proxy's fine grid: `ratio(λ) · proxy(λ)` with the ratio
+/// interpolated linearly between the solved wavelengths (held at the ends).
+fn through_proxy(wl: &[f64], values: &[f64], fine: &[f64], proxy_fine: &[f64]) -> Vec<f64> {
+    let at = |x: f64| fine.iter().position(|&f| f == x);
+    let ratio: Vec<f64> = wl
+        .iter()
+        .zip(values)
+        .map(|(&w, &v)| {
+            let p = at(w).map_or(0.0, |k| proxy_fine[k]);
+            if p > 0.0 {
+                v / p
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    fine.iter()
+        .zip(proxy_fine)
+        .map(|(&x, &p)| {
+            let r = if x <= wl[0] {
+                ratio[0]
+            } else if x >= wl[wl.len() - 1] {
+                ratio[wl.len() - 1]
+            } else {
+                let k = wl.windows(2).position(|w| x < w[1]).unwrap_or(0);
+                let t = (x - wl[k]) / (wl[k + 1] - wl[k]);
+                ratio[k] * (1.0 - t) + ratio[k + 1] * t
+            };
+            r * p
+        })
+        .collect()
 }
 
 /// A mean over realisations and its standard error (None when R = 1).
@@ -77,6 +166,8 @@ pub struct Colours {
     /// (viewing, 1 + illumination, 3): column 0 the sky strip, then the
     /// BRDF square (`π f` as a reflectance factor).
     pub tile_srgb8: Array3<u8>,
+    /// CIELAB (D65 white) of the same cells.
+    pub tile_lab: Array3<f64>,
     /// Sky strip per viewing angle: sRGB8 and CIELAB (D65 white).
     pub natural_srgb8: Vec<[u8; 3]>,
     pub natural_lab: Vec<[f64; 3]>,
@@ -349,31 +440,59 @@ fn colours_of(
 ) -> Result<Colours, AppearanceError> {
     let wl = &spec.wavelengths_nm;
     let (nv, ni) = (spec.viewing_deg.len(), spec.illumination_deg.len());
+    let proxy = match (&spec.proxy, spec.paper_albedo, &spec.below) {
+        (Some(p), Some(albedo), Some(h)) => Some((p, p.spectra(spec, albedo, h))),
+        _ => None,
+    };
+    // XYZ of a spectrum sampled at the solved wavelengths.
+    let xyz = |values: Vec<f64>, proxy_fine: Option<Vec<f64>>| match (&proxy, proxy_fine) {
+        (Some((p, _)), Some(pf)) => {
+            let fine = through_proxy(wl, &values, &p.wavelengths_nm, &pf);
+            colour::xyz_from_reflectance(obs, &p.wavelengths_nm, &fine)
+        }
+        _ => colour::xyz_from_reflectance(obs, wl, &values),
+    };
     let mut tile = Array3::zeros((nv, 1 + ni, 3));
+    let mut tile_lab = Array3::zeros((nv, 1 + ni, 3));
     let mut natural_srgb8 = Vec::with_capacity(nv);
     let mut natural_lab = Vec::with_capacity(nv);
     let white = obs.white_xyz();
     for o in 0..nv {
-        let spectrum: Vec<f64> = sky.column(o).to_vec();
-        let xyz = colour::xyz_from_reflectance(obs, wl, &spectrum)?;
-        let rgb = colour::to_srgb8(obs, xyz);
+        let pf = proxy.as_ref().map(|(_, (_, s))| s.column(o).to_vec());
+        let x = xyz(sky.column(o).to_vec(), pf)?;
+        let rgb = colour::to_srgb8(obs, x);
         natural_srgb8.push(rgb);
-        natural_lab.push(colour::xyz_to_lab(xyz, white));
-        for c in 0..3 {
-            tile[[o, 0, c]] = rgb[c];
+        natural_lab.push(colour::xyz_to_lab(x, white));
+        for (c, v) in colour::xyz_to_lab(x, white).into_iter().enumerate() {
+            tile_lab[[o, 0, c]] = v;
         }
+        tile.slice_mut(ndarray::s![o, 0, ..])
+            .iter_mut()
+            .zip(rgb)
+            .for_each(|(t, c)| *t = c);
         for i in 0..ni {
             let spectrum: Vec<f64> = (0..wl.len())
                 .map(|l| colour::lambertian_reflectance(total[[l, i, o]]))
                 .collect();
-            let rgb = colour::reflectance_to_srgb8(obs, wl, &spectrum)?;
-            for c in 0..3 {
-                tile[[o, 1 + i, c]] = rgb[c];
+            let pf = proxy.as_ref().map(|(_, (f, _))| {
+                (0..f.dim().0)
+                    .map(|l| colour::lambertian_reflectance(f[[l, i, o]]))
+                    .collect()
+            });
+            let x = xyz(spectrum, pf)?;
+            for (c, v) in colour::xyz_to_lab(x, white).into_iter().enumerate() {
+                tile_lab[[o, 1 + i, c]] = v;
             }
+            let rgb = colour::to_srgb8(obs, x);
+            tile.slice_mut(ndarray::s![o, 1 + i, ..])
+                .iter_mut()
+                .zip(rgb)
+                .for_each(|(t, c)| *t = c);
         }
     }
     Ok(Colours {
         tile_srgb8: tile,
+        tile_lab,
         natural_srgb8,
         natural_lab,
     })

@@ -68,7 +68,7 @@
 //! - with paper: attribute `paper_albedo`, `r_dd_up`, `t_d` (L);
 //! - with the tile: `brdf_total` (L × I × V, layer + substrate, 1/sr),
 //!   `natural` (L × V, radiance factor under a uniform white sky),
-//!   `tile_srgb8` (V × (1 + I) × 3 u8), `natural_srgb8` (V × 3 u8),
+//!   `tile_srgb8` (V × (1 + I) × 3 u8), `tile_lab` (V × (1 + I) × 3 f64), `natural_srgb8` (V × 3 u8),
 //!   `natural_lab` (V × 3 f64), `tile_png` (u8).
 
 use std::fs;
@@ -173,6 +173,8 @@ pub struct AppearanceArrays {
     pub brdf_total: Option<ndarray::Array3<f64>>,
     /// (L, V), present with the tile.
     pub natural: Option<ndarray::Array2<f64>>,
+    /// CIELAB of the tile's cells (V, 1 + I, 3), present with the tile.
+    pub tile_lab: Option<ndarray::Array3<f64>>,
 }
 
 /// Read the `/appearance` arrays of a result file (None when absent).
@@ -206,7 +208,13 @@ pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError>
     } else {
         None
     };
+    let tile_lab = if g.link_exists("tile_lab") {
+        Some(g.dataset("tile_lab").and_then(|d| d.read()).map_err(hdf)?)
+    } else {
+        None
+    };
     Ok(Some(AppearanceArrays {
+        tile_lab,
         wavelengths_nm: vec("wavelengths_nm")?,
         illumination_deg: vec("illumination_deg")?,
         viewing_deg: vec("viewing_deg")?,
@@ -679,6 +687,9 @@ fn write_appearance(
         g.new_dataset_builder()
             .with_data(c.tile_srgb8.view())
             .create("tile_srgb8")?;
+        g.new_dataset_builder()
+            .with_data(c.tile_lab.view())
+            .create("tile_lab")?;
         let rgb = Array2::from_shape_fn((c.natural_srgb8.len(), 3), |(i, j)| c.natural_srgb8[i][j]);
         g.new_dataset_builder()
             .with_data(&rgb)

@@ -7,7 +7,7 @@
 //! results are written atomically (temp file + rename), so an interrupted run
 //! leaves either the previous file or the complete new one.
 
-use crate::appearance::{self, Appearance, AppearanceSpec};
+use crate::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
 use crate::colour::Observer;
 use crate::config::{GrainOrientation, GrainShape, Incidence, Scene, Substrate};
 use crate::farfield::table::TableSpec;
@@ -550,7 +550,53 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         realisations: plan.realisations,
         btdf: scene.appearance.products.btdf,
         tile: scene.appearance.products.tile,
+        proxy: spectral_proxy(scene),
     }
+}
+
+/// Fine grid of the colour proxy, nm.
+pub const PROXY_STEP_NM: f64 = 5.0;
+
+/// The molecular-mixture slab on a 5 nm grid (plus every solved wavelength)
+/// over the scene's band, for colour with a substrate; None for a single
+/// wavelength or when a material lacks data on the grid.
+fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
+    let wl = &scene.wavelengths_nm;
+    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
+        return None;
+    }
+    let (lo, hi) = (wl[0], wl[wl.len() - 1]);
+    let mut fine: Vec<f64> = wl.clone();
+    let mut x = (lo / PROXY_STEP_NM).ceil() * PROXY_STEP_NM;
+    while x < hi {
+        if !fine.contains(&x) {
+            fine.push(x);
+        }
+        x += PROXY_STEP_NM;
+    }
+    fine.sort_by(f64::total_cmp);
+    let eps_b = C64::new(scene.layer.binder_index.powi(2), 0.0);
+    let total = scene.total_pvc();
+    let eps = fine
+        .iter()
+        .map(|&l| {
+            let es = species_eps(scene, l).ok()?;
+            Some(
+                scene
+                    .species
+                    .iter()
+                    .zip(&es)
+                    .fold(eps_b * (1.0 - total), |acc, (s, e)| {
+                        acc + e * s.volume_fraction
+                    }),
+            )
+        })
+        .collect::<Option<Vec<_>>>()?;
+    Some(SpectralProxy {
+        wavelengths_nm: fine,
+        eps,
+        thickness_nm: scene.layer.thickness_nm,
+    })
 }
 
 /// Run a scene end to end and write its result files, with a progress bar

@@ -471,3 +471,44 @@ fn merl_export_of_bare_paper_is_albedo_over_pi_everywhere() {
     }
     assert!(valid >= 3);
 }
+
+#[test]
+fn colour_between_solved_wavelengths_follows_the_proxy() {
+    // For a clear binder layer the spectral proxy (the molecular-mixture
+    // slab) is the layer itself, so the colour from 3 solved wavelengths must
+    // equal the colour of the closed-form spectrum on the proxy's 5 nm grid
+    // (where linear interpolation of 3 samples would not).
+    let dir = tempfile::tempdir().unwrap();
+    let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.558, 32));
+    let a = rep.appearance.unwrap();
+    let eps = 1.558f64.powi(2);
+    let obs = inksim::colour::Observer::cie1931_d65();
+    let fine: Vec<f64> = (0..=40).map(|k| 450.0 + 5.0 * k as f64).collect();
+    for (o, &view) in a.spec.viewing_deg.iter().enumerate() {
+        let spectrum: Vec<f64> = fine
+            .iter()
+            .map(|&wl| {
+                let rdd = hemispherical(|mu| airy_rt(eps, 1000.0, wl, mu.acos().to_degrees()).0);
+                let (r, t) = airy_rt(eps, 1000.0, wl, view);
+                r + 0.9 * (1.0 - rdd) * t / (1.0 - 0.9 * rdd)
+            })
+            .collect();
+        let xyz = inksim::colour::xyz_from_reflectance(&obs, &fine, &spectrum).unwrap();
+        let lab = inksim::colour::xyz_to_lab(xyz, obs.white_xyz());
+        let got = a.colours.as_ref().unwrap().natural_lab[o];
+        let de = inksim::colour::delta_e2000(lab, got);
+        assert!(de < 1e-3, "view {view}°: ΔE00 {de}");
+        // Linear interpolation of the 3 solved samples is far off.
+        let coarse: Vec<f64> = (0..3)
+            .map(|l| a.natural.as_ref().unwrap()[[l, o]])
+            .collect();
+        let lin =
+            inksim::colour::xyz_from_reflectance(&obs, &a.spec.wavelengths_nm, &coarse).unwrap();
+        let de_lin =
+            inksim::colour::delta_e2000(lab, inksim::colour::xyz_to_lab(lin, obs.white_xyz()));
+        assert!(
+            de_lin > 10.0 * de.max(1e-4),
+            "linear {de_lin} vs proxy {de}"
+        );
+    }
+}

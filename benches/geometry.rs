@@ -39,8 +39,8 @@ fn bench(c: &mut Criterion) {
         spheres: 7,
     };
     for (name, shape) in [("sphere", Shape::Sphere), ("rice", rice)] {
-        // N ≈ 100, 1 000, 10 000, 100 000 particles.
-        for side in [420.0, 1320.0, 4180.0, 13_200.0] {
+        // N ≈ 130, 1 000, 10 000, 100 000 particles.
+        for side in [480.0, 1320.0, 4180.0, 13_200.0] {
             let p = packer(shape, side);
             g.throughput(Throughput::Elements(p.moving() as u64));
             g.bench_with_input(BenchmarkId::new(name, p.moving()), &p, |b, p| {

@@ -10,6 +10,7 @@
 //! The physics and numerics follow `METHOD.md` (shipped beside the project);
 //! each stage's module docs state what it owns and which choices it made.
 
+pub mod accuracy;
 pub mod appearance;
 pub mod colour;
 pub mod config;

@@ -315,6 +315,10 @@ fn real_main() -> Result<ExitCode> {
             for line in &run_plan.lines {
                 println!("  {line}");
             }
+            println!("expected error of these settings:");
+            for line in inksim::accuracy::expected_error(&scene) {
+                println!("  {line}");
+            }
             let (h5, png) = inksim::pipeline::result_paths(&scene);
             println!("would write {} and {}", h5.display(), png.display());
         }
@@ -493,6 +497,20 @@ fn plan_study(
         human_bytes(peak),
         human_bytes(peak * jobs as f64)
     );
+    if let Some(v) = chosen
+        .variants
+        .iter()
+        .find(|v| !v.scene.is_molecular())
+        .or(chosen.variants.first())
+    {
+        println!(
+            "expected error of this profile's settings (variant {}):",
+            v.name
+        );
+        for line in inksim::accuracy::expected_error(&v.scene) {
+            println!("  {line}");
+        }
+    }
     if !others.is_empty() {
         println!("other profiles (same model):");
         for exp in &others {
@@ -506,8 +524,16 @@ fn plan_study(
                 .iter()
                 .map(|e| format!("{}×{}×{}", e.grid[0], e.grid[1], e.grid[2]))
                 .collect();
+            let de = exp
+                .variants
+                .iter()
+                .find(|v| !v.scene.is_molecular())
+                .or(exp.variants.first())
+                .and_then(|v| inksim::accuracy::expected_error(&v.scene).pop())
+                .unwrap_or_default();
             println!(
-                "  {:<10} {} variants, {} solves, grid {}, est. {} total, peak memory {} per variant",
+                "  {:<10} {} variants, {} solves, grid {}, est. {} total, peak memory {} per \
+                 variant; {de}",
                 exp.profile.as_deref().unwrap_or(""),
                 exp.variants.len(),
                 est.iter().map(|e| e.solves).sum::<usize>(),

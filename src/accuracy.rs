@@ -86,7 +86,7 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
             lookup(&CELL_NM, cell, true),
         ));
         rows.push((format!("z cell {zc:.1} nm"), lookup(&Z_CELL_NM, zc, true)));
-        rows.push((format!("{} realisation(s)", scene.realisations), de_real));
+        rows.push((format!("realisations {}", scene.realisations), de_real));
         rows.push((
             format!("tolerance {:.0e}", scene.solver.tolerance),
             lookup(&TOLERANCE, scene.solver.tolerance, true),
@@ -105,7 +105,7 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
         },
     ));
     rows.push((
-        format!("{} quadrature nodes", scene.appearance.quadrature_points),
+        format!("quadrature nodes {}", scene.appearance.quadrature_points),
         lookup(
             &QUADRATURE,
             scene.appearance.quadrature_points as f64,

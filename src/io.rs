@@ -26,7 +26,14 @@
 //!   `species_names` (S variable-length UTF-8 strings),
 //!   `target_fraction`, `achieved_fraction`, `raster_fraction` (S f64 each);
 //! - attribute `min_gap_nm` (f64; absent for a molecular mixture, which has
-//!   no grains).
+//!   no grains);
+//! - group `statistics` (absent without grains): attributes `pvc_total`,
+//!   `min_gap_nm`, `worst_overlap_nm`, `mean_diameter_nm`, `protrusion_nm`,
+//!   `bottom_excess_nm`, `rdf_slab_nm`, `contact_gap_nm`, `order_parameter`
+//!   (when the grains have axes); datasets `count` (S u64), `volume_nm3`,
+//!   `pvc` (S f64), `profile_z_nm` (B+1) and `profile_fraction` (B: grain
+//!   volume fraction per z bin), `rdf_r_nm`, `rdf` (pair correlation of the
+//!   centres), `cluster_sizes` (u64, largest first); see `geometry::stats`.
 //!
 //! `/realisations` (group): `seed` (R u64), `achieved_pvc` (R f64), the
 //! geometry of each random fragment (`/geometry` holds realisation 0's).
@@ -82,6 +89,7 @@ use ndarray::Array2;
 
 use crate::appearance::{Appearance, Estimate};
 use crate::farfield::{Side, SolveEntry};
+use crate::geometry::Statistics;
 use crate::solver::MethodUsed;
 
 /// Version of the layout described in the module docs, stored as `format_version`.
@@ -128,6 +136,8 @@ pub struct GeometrySummary<'a> {
     pub raster_fraction: &'a [f64],
     /// Smallest surface gap between grains (None: no grains).
     pub min_gap_nm: Option<f64>,
+    /// Full statistics of the fragment (None: no grains).
+    pub statistics: Option<&'a Statistics>,
 }
 
 /// What [`read_summary`] returns.
@@ -570,6 +580,9 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     if let Some(gap) = g.min_gap_nm {
         write_scalar_attr(&geo, "min_gap_nm", gap)?;
     }
+    if let Some(st) = g.statistics {
+        write_statistics(&geo.create_group("statistics")?, st)?;
+    }
     let real = file.create_group("realisations")?;
     let seeds: Vec<u64> = set.realisations.iter().map(|r| r.0).collect();
     let pvc: Vec<f64> = set.realisations.iter().map(|r| r.1).collect();
@@ -611,6 +624,43 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
         write_appearance(file, app, set.tile_png)?;
     }
     file.flush()
+}
+
+fn write_statistics(g: &hdf5::Group, st: &Statistics) -> hdf5::Result<()> {
+    for (name, v) in [
+        ("pvc_total", st.pvc_total),
+        ("min_gap_nm", st.min_gap_nm),
+        ("worst_overlap_nm", st.worst_overlap_nm),
+        ("mean_diameter_nm", st.mean_diameter_nm),
+        ("protrusion_nm", st.protrusion_nm),
+        ("bottom_excess_nm", st.bottom_excess_nm),
+        ("rdf_slab_nm", st.rdf_slab_nm),
+        ("contact_gap_nm", st.contact_gap_nm),
+    ] {
+        write_scalar_attr(g, name, v)?;
+    }
+    if let Some(s) = st.order_parameter {
+        write_scalar_attr(g, "order_parameter", s)?;
+    }
+    let count: Vec<u64> = st.count.iter().map(|&c| c as u64).collect();
+    let clusters: Vec<u64> = st.cluster_sizes.iter().map(|&c| c as u64).collect();
+    g.new_dataset_builder()
+        .with_data(&count[..])
+        .create("count")?;
+    g.new_dataset_builder()
+        .with_data(&clusters[..])
+        .create("cluster_sizes")?;
+    for (name, v) in [
+        ("volume_nm3", &st.volume_nm3),
+        ("pvc", &st.pvc),
+        ("profile_z_nm", &st.profile_z_nm),
+        ("profile_fraction", &st.profile_fraction),
+        ("rdf_r_nm", &st.rdf_r_nm),
+        ("rdf", &st.rdf),
+    ] {
+        g.new_dataset_builder().with_data(&v[..]).create(name)?;
+    }
+    Ok(())
 }
 
 fn write_estimate<D: ndarray::Dimension>(

@@ -114,6 +114,10 @@ enum Command {
         config: PathBuf,
         #[arg(long)]
         profile: Option<String>,
+        /// The study's results are here instead of its [study] output_dir
+        /// (as given to `run --output-dir`).
+        #[arg(long)]
+        output_dir: Option<PathBuf>,
     },
     /// Build the layer only: particle set and statistics to
     /// <dir>/<name>-geometry.h5, a top view and cross-section to <name>-geometry.png.
@@ -241,8 +245,12 @@ fn real_main() -> Result<ExitCode> {
             let study = load_study(&config, None)?;
             slurm_study(&study, profile.as_deref(), shards, cpus, partition, script)?;
         }
-        Command::Merge { config, profile } => {
-            let study = load_study(&config, None)?;
+        Command::Merge {
+            config,
+            profile,
+            output_dir,
+        } => {
+            let study = load_study(&config, output_dir)?;
             let exp = study.expand(profile.as_deref())?;
             let r = inksim::study::merge::merge(&study, &exp)?;
             println!("summary: {}", r.summary_h5.display());

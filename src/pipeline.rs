@@ -9,11 +9,12 @@
 
 use crate::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
 use crate::colour::Observer;
-use crate::config::{GrainOrientation, GrainShape, Incidence, Scene, Substrate};
+use crate::config::{GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Substrate};
 use crate::farfield::table::TableSpec;
 use crate::farfield::{self, Side, SolveEntry};
 use crate::geometry::{
-    self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SpeciesParams,
+    self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SizeDistribution,
+    SpeciesOptions, SpeciesParams, StatsParams,
 };
 use crate::io::{self, GeometrySummary, ResultSet};
 use crate::merl;
@@ -122,6 +123,18 @@ pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
 pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, PipelineError> {
     let l = &scene.layer;
     let size_nm = [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm];
+    let options: Vec<SpeciesOptions> = scene
+        .species
+        .iter()
+        .map(|s| SpeciesOptions {
+            size: match s.size {
+                GrainSize::Fixed => SizeDistribution::Fixed,
+                GrainSize::Normal { sigma } => SizeDistribution::Normal { sigma },
+                GrainSize::LogNormal { sigma } => SizeDistribution::LogNormal { sigma },
+            },
+            cluster_size: s.cluster_size,
+        })
+        .collect();
     if packer_of(scene).0 == "rsa" {
         let params = PackParams {
             size_nm,
@@ -133,6 +146,8 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
                     volume_fraction: s.volume_fraction,
                 })
                 .collect(),
+            options,
+            relief_fraction: l.relief_fraction,
             ..PackParams::default()
         };
         return Ok(geometry::pack_rsa(&params, seed)?);
@@ -156,21 +171,32 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
             field: s.alignment_field,
         })
         .collect();
-    Ok(geometry::pack_dynamics(
-        &DynParams::new(size_nm, species),
-        seed,
-    )?)
+    let params = DynParams {
+        options,
+        relief_fraction: l.relief_fraction,
+        ..DynParams::new(size_nm, species)
+    };
+    Ok(geometry::pack_dynamics(&params, seed)?)
 }
 
-/// The raster grid of a scene.
+/// The raster grid of a scene: the configured cells over the layer, plus,
+/// with surface relief, whole cells above it reaching the highest point a
+/// grain may have (relief fraction × largest possible diameter, +1 % for
+/// the packer's overlap tolerance), the same for every realisation.
 pub fn grid_of(scene: &Scene) -> Grid {
     let l = &scene.layer;
-    Grid {
+    let grid = Grid {
         nx: scene.grid.nx,
         ny: scene.grid.ny,
         nz: scene.grid.nz,
         size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
-    }
+    };
+    let d_max = scene
+        .species
+        .iter()
+        .map(|s| s.size.max_diameter(s.diameter_nm))
+        .fold(0.0, f64::max);
+    grid.with_top_nm(1.01 * l.relief_fraction * d_max)
 }
 
 /// Seed of realisation `r`: the scene's seed for r = 0 (so a
@@ -752,6 +778,7 @@ fn write_result(
     let mut species_of_particle = Vec::new();
     let names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
     let targets: Vec<f64> = scene.species.iter().map(|s| s.volume_fraction).collect();
+    let statistics = layer.map(|(g, _)| geometry::analyse(g, &StatsParams::default()));
     let (achieved, raster_fraction, min_gap, grid) = match layer {
         Some((geometry, raster)) => {
             for (i, p) in geometry.particles.iter().enumerate() {
@@ -796,6 +823,7 @@ fn write_result(
             achieved_fraction: &achieved,
             raster_fraction: &raster_fraction,
             min_gap_nm: min_gap,
+            statistics: statistics.as_ref(),
         },
         grid,
         size_nm: [l.fragment_x_nm, l.fragment_y_nm, l.thickness_nm],
@@ -832,22 +860,16 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
     let s = &geometry.stats;
     let (packer, _) = packer_of(scene);
-    let mut lines = vec![
-        format!(
-            "{} particles by {packer}; PVC {:.4} (target {:.4}; raster {:.4})",
-            geometry.particles.len(),
-            s.achieved_fraction.iter().sum::<f64>(),
-            scene.total_pvc(),
-            raster.mean_fractions().iter().sum::<f64>()
-        ),
-        format!(
-            "worst overlap {:.3} nm; min gap {:.3} nm",
-            s.worst_overlap_nm, s.min_gap_nm
-        ),
-    ];
-    if let Some(o) = s.order_parameter {
-        lines.push(format!("order parameter S = {o:.3}"));
-    }
+    let mut lines = vec![format!(
+        "{} particles by {packer}; PVC {:.4} (target {:.4}; raster {:.4})",
+        geometry.particles.len(),
+        s.achieved_fraction.iter().sum::<f64>(),
+        scene.total_pvc(),
+        raster.mean_fractions().iter().sum::<f64>()
+    )];
+    // Worst overlap, S, relief, clusters (the PVC line is the one above).
+    let stats = geometry::analyse(&geometry, &StatsParams::default());
+    lines.extend(stats.lines().into_iter().skip(1));
     let png = render::geometry_png(&raster, name, &lines)?;
     io::write_atomic(&picture_path, &png)?;
     let pvc = geometry.stats.achieved_fraction.iter().sum();

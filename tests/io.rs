@@ -159,6 +159,7 @@ fn set<'a>(g: &'a Geo, e: &'a [SolveEntry], hash: &'a str, png: Option<&'a [u8]>
             achieved_fraction: &g.achieved,
             raster_fraction: &g.raster,
             min_gap_nm: Some(2.5),
+            statistics: None,
         },
         grid: [64, 48, 20],
         size_nm: [2000.0, 1500.5, 1000.0],

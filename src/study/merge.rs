@@ -88,8 +88,14 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     let mut rows = Vec::with_capacity(exp.variants.len());
     for v in &exp.variants {
         let s = io::read_summary(&run::paths(v).0)?;
-        let n = s.entries.len().max(1) as f64;
-        let mean = |f: fn(&io::EntrySummary) -> f64| s.entries.iter().map(f).sum::<f64>() / n;
+        // Light from above only (solves from below feed the paper term).
+        let above: Vec<&io::EntrySummary> = s
+            .entries
+            .iter()
+            .filter(|e| e.side == crate::farfield::Side::Above)
+            .collect();
+        let n = above.len().max(1) as f64;
+        let mean = |f: fn(&io::EntrySummary) -> f64| above.iter().map(|e| f(e)).sum::<f64>() / n;
         let (r, t, a) = (
             mean(|e| e.total_reflectance),
             mean(|e| e.total_transmittance),
@@ -463,7 +469,7 @@ fn pages(study: &Study, exp: &Expansion, rows: &[Row], grids: &[PathBuf]) -> (St
     let _ = writeln!(
         md,
         "{} variants from `{}`; results in `variants/`, all linked from `summary.h5`. \
-         R, T, A: mean total reflectance, transmittance and absorption over the solves; \
+         R, T, A: mean total reflectance, transmittance and absorption over the solves from above; \
          colour: sRGB and CIELAB under natural light at the first viewing angle (\"—\" \
          where the result has no appearance data).\n",
         rows.len(),

@@ -246,6 +246,26 @@ impl RunPlan {
             let (packer, why) = packer_of(scene);
             lines.push(format!("geometry: {packer} ({why})"));
         }
+        if !analytic {
+            let rf = scene.layer.relief_fraction;
+            lines.push(if rf > 0.0 {
+                format!(
+                    "surface relief: grains may protrude up to {:.0} % of their size through the top; \
+                     the grid extends above the binder (vacuum around the grains, binder surface flat)",
+                    rf * 100.0
+                )
+            } else {
+                "surface relief: none (grains stay inside the binder)".to_string()
+            });
+            for s in &scene.species {
+                if s.cluster_size > 1 {
+                    lines.push(format!(
+                        "agglomeration: `{}` grains seeded in clusters of ~{}",
+                        s.name, s.cluster_size
+                    ));
+                }
+            }
+        }
         let realisations = if analytic { 1 } else { scene.realisations };
         if analytic && scene.realisations > 1 {
             lines.push(format!(

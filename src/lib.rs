@@ -23,6 +23,7 @@ pub mod progress;
 pub mod raster;
 pub mod render;
 pub mod solver;
+pub mod structure;
 pub mod study;
 pub mod substrate;
 

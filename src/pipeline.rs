@@ -9,7 +9,9 @@
 
 use crate::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
 use crate::colour::Observer;
-use crate::config::{GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Substrate};
+use crate::config::{
+    GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Structure, Substrate,
+};
 use crate::farfield::table::TableSpec;
 use crate::farfield::{self, Side, SolveEntry};
 use crate::geometry::{
@@ -22,6 +24,7 @@ use crate::progress::Progress;
 use crate::raster::{self, Grid, Raster};
 use crate::render;
 use crate::solver::{self, airy, Controls, MethodUsed, Problem, SolveRecord};
+use crate::structure::{self, EpsGrid};
 use crate::substrate::Hemisphere;
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
@@ -56,6 +59,10 @@ pub enum PipelineError {
     Appearance(#[from] appearance::AppearanceError),
     #[error("MERL export: {0}")]
     Merl(#[from] merl::MerlError),
+    #[error("structure: {0}")]
+    Structure(#[from] structure::StructureError),
+    #[error("{0}")]
+    NoGrains(String),
 }
 
 /// What a finished run produced.
@@ -236,17 +243,29 @@ impl RunPlan {
         let mut lines = Vec::new();
         let products = scene.appearance.products;
         let analytic = scene.is_molecular();
+        let explicit = scene.structure.is_some();
         if analytic {
             lines.push(
                 "geometry: none — molecular mixture: the homogeneous slab with the \
                  volume-averaged ε, solved in closed form (Airy); no grid, no iteration"
                     .to_string(),
             );
+        } else if let Some(st) = &scene.structure {
+            lines.push(match st {
+                Structure::Primitives(ps) => format!(
+                    "geometry: explicit structure, {} primitive bodies rasterised by volume fraction; no packing",
+                    ps.len()
+                ),
+                Structure::Hdf5(p) => format!(
+                    "geometry: explicit structure, ε grid from {}; no packing, no raster",
+                    p.display()
+                ),
+            });
         } else {
             let (packer, why) = packer_of(scene);
             lines.push(format!("geometry: {packer} ({why})"));
         }
-        if !analytic {
+        if !analytic && !explicit {
             let rf = scene.layer.relief_fraction;
             lines.push(if rf > 0.0 {
                 format!(
@@ -266,11 +285,20 @@ impl RunPlan {
                 }
             }
         }
-        let realisations = if analytic { 1 } else { scene.realisations };
-        if analytic && scene.realisations > 1 {
+        let realisations = if analytic || explicit {
+            1
+        } else {
+            scene.realisations
+        };
+        if (analytic || explicit) && scene.realisations > 1 {
             lines.push(format!(
-                "realisations: 1 of {} requested — a homogeneous layer is deterministic",
-                scene.realisations
+                "realisations: 1 of {} requested — {} is deterministic",
+                scene.realisations,
+                if analytic {
+                    "a homogeneous layer"
+                } else {
+                    "an explicit structure"
+                }
             ));
         } else {
             lines.push(format!(
@@ -472,7 +500,50 @@ pub fn solve_realisation(
     realisation: usize,
     progress: &Progress,
 ) -> Result<Vec<SolveEntry>, PipelineError> {
-    let g = raster.grid;
+    solve_layer(scene, plan, LayerEps::Raster(raster), realisation, progress)
+}
+
+/// Where the permittivity of each wavelength comes from.
+#[derive(Clone, Copy)]
+pub enum LayerEps<'a> {
+    /// Volume fractions (grains or primitives) and the materials' n(λ).
+    Raster(&'a Raster),
+    /// A permittivity grid read from a file.
+    Grid(&'a EpsGrid, Grid),
+}
+
+/// Permittivity of each fraction array of the raster at a wavelength: the
+/// pigments', or the structure primitives' materials.
+fn fraction_eps(scene: &Scene, lambda: f64) -> Result<Vec<C64>, PipelineError> {
+    match &scene.structure {
+        Some(Structure::Primitives(ps)) => {
+            ps.iter()
+                .map(|p| {
+                    p.material.index_at(lambda).map(|n| n * n).ok_or_else(|| {
+                        PipelineError::Material {
+                            material: p.material.name.clone(),
+                            wavelength_nm: lambda,
+                        }
+                    })
+                })
+                .collect()
+        }
+        _ => species_eps(scene, lambda),
+    }
+}
+
+/// Solve every (wavelength, incidence, side) on one layer.
+pub fn solve_layer(
+    scene: &Scene,
+    plan: &RunPlan,
+    layer: LayerEps,
+    realisation: usize,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    let g = match layer {
+        LayerEps::Raster(r) => r.grid,
+        LayerEps::Grid(_, g) => g,
+    };
     let eps_b = scene.layer.binder_index.powi(2);
     let ctl = Controls {
         tolerance: scene.solver.tolerance,
@@ -486,8 +557,13 @@ pub fn solve_realisation(
         .map(|_| Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0)));
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
-        let eps_species = species_eps(scene, lambda)?;
-        raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
+        match layer {
+            LayerEps::Raster(raster) => {
+                let eps_species = fraction_eps(scene, lambda)?;
+                raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
+            }
+            LayerEps::Grid(grid_eps, _) => grid_eps.epsilon_into(lambda, &mut eps),
+        }
         if let Some(f) = flipped.as_mut() {
             f.assign(&eps.slice(s![..;-1, .., ..]));
         }
@@ -608,7 +684,8 @@ pub const PROXY_STEP_NM: f64 = 5.0;
 /// wavelength or when a material lacks data on the grid.
 fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
     let wl = &scene.wavelengths_nm;
-    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
+    // An explicit structure has no pigment mixture to stand in for it.
+    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) || scene.structure.is_some() {
         return None;
     }
     let (lo, hi) = (wl[0], wl[wl.len() - 1]);
@@ -673,9 +750,26 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     let mut entries = Vec::new();
     let mut realisations = Vec::new();
     let mut first: Option<(Geometry, Raster)> = None;
+    let mut explicit_raster: Option<Raster> = None;
     if plan.analytic {
         entries = solve_analytic(scene, &plan, &progress)?;
         realisations.push((scene.seed, scene.total_pvc()));
+    } else if let Some(st) = &scene.structure {
+        let grid = grid_of(scene);
+        match st {
+            Structure::Primitives(ps) => {
+                let raster = structure::rasterize_primitives(ps, &grid);
+                let f: f64 = raster.mean_fractions().iter().sum();
+                entries = solve_layer(scene, &plan, LayerEps::Raster(&raster), 0, &progress)?;
+                realisations.push((scene.seed, f));
+                explicit_raster = Some(raster);
+            }
+            Structure::Hdf5(path) => {
+                let eg = EpsGrid::read(path, &grid, &scene.wavelengths_nm)?;
+                entries = solve_layer(scene, &plan, LayerEps::Grid(&eg, grid), 0, &progress)?;
+                realisations.push((scene.seed, 0.0));
+            }
+        }
     } else {
         let grid = grid_of(scene);
         for (r, &seed) in plan.seeds.iter().enumerate() {
@@ -756,6 +850,7 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     write_result(
         scene,
         first.as_ref(),
+        explicit_raster.as_ref(),
         &entries,
         &realisations,
         &plan_text,
@@ -785,6 +880,7 @@ struct Pictures<'a> {
 fn write_result(
     scene: &Scene,
     layer: Option<&(Geometry, Raster)>,
+    explicit: Option<&Raster>,
     entries: &[SolveEntry],
     realisations: &[(u64, f64)],
     plan: &str,
@@ -796,9 +892,17 @@ fn write_result(
     let mut radii = Vec::new();
     let mut particle_of_sphere = Vec::new();
     let mut species_of_particle = Vec::new();
-    let names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
-    let targets: Vec<f64> = scene.species.iter().map(|s| s.volume_fraction).collect();
+    let mut names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
+    let mut targets: Vec<f64> = scene.species.iter().map(|s| s.volume_fraction).collect();
     let statistics = layer.map(|(g, _)| geometry::analyse(g, &StatsParams::default()));
+    if let Some(Structure::Primitives(ps)) = &scene.structure {
+        names = ps
+            .iter()
+            .enumerate()
+            .map(|(i, p)| format!("primitive[{i}] {}", p.material.name))
+            .collect();
+        targets = explicit.map(|r| r.mean_fractions()).unwrap_or_default();
+    }
     let (achieved, raster_fraction, min_gap, grid) = match layer {
         Some((geometry, raster)) => {
             for (i, p) in geometry.particles.iter().enumerate() {
@@ -816,8 +920,20 @@ fn write_result(
                 [raster.grid.nx, raster.grid.ny, raster.grid.nz],
             )
         }
-        // A molecular mixture is exactly its target composition.
-        None => (targets.clone(), targets.clone(), None, [0, 0, 0]),
+        // An explicit structure is its raster; a molecular mixture is
+        // exactly its target composition (no grid).
+        None => match (&scene.structure, explicit) {
+            (Some(_), r) => {
+                let g = grid_of(scene);
+                (
+                    targets.clone(),
+                    r.map(|r| r.mean_fractions()).unwrap_or_default(),
+                    None,
+                    [g.nx, g.ny, g.nz],
+                )
+            }
+            (None, _) => (targets.clone(), targets.clone(), None, [0, 0, 0]),
+        },
     };
     let created = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -875,6 +991,13 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     let result_path = d.join(format!("{name}-geometry.h5"));
     let picture_path = d.join(format!("{name}-geometry.png"));
     check_output_dir(d)?;
+    if scene.structure.is_some() {
+        return Err(PipelineError::NoGrains(format!(
+            "{}: the layer is given explicitly ([structure]): there are no grains to pack; \
+             use `inksim run`",
+            scene.path().display()
+        )));
+    }
     let geometry = build_geometry(scene)?;
     let grid = grid_of(scene);
     let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
@@ -897,6 +1020,7 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     write_result(
         scene,
         Some(&layer),
+        None,
         &[],
         &[(scene.seed, pvc)],
         &plan_text(&RunPlan::of(scene), &[]),

@@ -199,6 +199,52 @@ pub struct OutputSpec {
     pub name: String,
 }
 
+/// A body of an explicit structure (nm; z = 0 is the top of the layer,
+/// periodic in x and y).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Body {
+    /// The full fragment between two depths.
+    Slab {
+        z_nm: [f64; 2],
+    },
+    /// An axis-aligned box.
+    Box {
+        min_nm: [f64; 3],
+        max_nm: [f64; 3],
+    },
+    Sphere {
+        center_nm: [f64; 3],
+        radius_nm: f64,
+    },
+    /// A circular cylinder along a coordinate axis (0 = x, 1 = y, 2 = z).
+    Cylinder {
+        center_nm: [f64; 3],
+        radius_nm: f64,
+        length_nm: f64,
+        axis: usize,
+    },
+}
+
+/// One body of an explicit structure and its material.
+#[derive(Debug, Clone)]
+pub struct Primitive {
+    pub body: Body,
+    pub material: Material,
+}
+
+/// The layer given explicitly (issue #7): users with measured structures,
+/// and validation.
+#[derive(Debug, Clone)]
+pub enum Structure {
+    /// Bodies in the binder; a later body replaces earlier ones where they
+    /// overlap.
+    Primitives(Vec<Primitive>),
+    /// A permittivity grid from an HDF5 file (resolved path): datasets
+    /// `eps_re`, `eps_im` of shape (nz, ny, nx) for every wavelength, or
+    /// (L, nz, ny, nx) with `wavelengths_nm` (L) covering the scene's.
+    Hdf5(PathBuf),
+}
+
 /// What lies under the layer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Substrate {
@@ -253,6 +299,9 @@ pub struct Scene {
     pub output: OutputSpec,
     pub appearance: Appearance,
     pub substrate: Substrate,
+    /// An explicit structure instead of generated grains (then `species` is
+    /// empty).
+    pub structure: Option<Structure>,
 }
 
 impl Scene {
@@ -263,9 +312,11 @@ impl Scene {
 
     /// Whether the pigments are dissolved (homogeneous layer, no grains).
     pub fn is_molecular(&self) -> bool {
-        self.species
-            .iter()
-            .all(|s| s.shape == GrainShape::Molecular)
+        !self.species.is_empty()
+            && self
+                .species
+                .iter()
+                .all(|s| s.shape == GrainShape::Molecular)
     }
 
     /// File the scene was read from.

@@ -22,6 +22,60 @@ pub struct RawConfig {
     pub output: Option<RawOutput>,
     pub appearance: Option<RawAppearance>,
     pub substrate: Option<RawSubstrate>,
+    pub structure: Option<RawStructure>,
+}
+
+/// `[structure]`: the layer given explicitly instead of generated grains.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawStructure {
+    /// Simple bodies in the binder, rasterised by volume fraction.
+    Primitives {
+        #[serde(default)]
+        primitive: Vec<RawPrimitive>,
+    },
+    /// A complex ε grid from an HDF5 file.
+    Hdf5 { file: String },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPrimitive {
+    pub shape: RawBody,
+    pub material: RawMaterial,
+}
+
+/// `{ kind = "slab", z_nm = [z0, z1] }`, `{ kind = "box", min_nm, max_nm }`,
+/// `{ kind = "sphere", center_nm, radius_nm }`,
+/// `{ kind = "cylinder", center_nm, radius_nm, length_nm, axis }`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawBody {
+    Slab {
+        z_nm: Vec<f64>,
+    },
+    Box {
+        min_nm: Vec<f64>,
+        max_nm: Vec<f64>,
+    },
+    Sphere {
+        center_nm: Vec<f64>,
+        radius_nm: f64,
+    },
+    Cylinder {
+        center_nm: Vec<f64>,
+        radius_nm: f64,
+        length_nm: f64,
+        axis: RawAxis,
+    },
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RawAxis {
+    X,
+    Y,
+    Z,
 }
 
 #[derive(Debug, Deserialize)]
@@ -94,12 +148,14 @@ pub enum RawOrientation {
     Perpendicular,
 }
 
-/// `{ builtin = "red" }` or `{ csv = "path.csv" }`.
+/// `{ builtin = "red" }`, `{ csv = "path.csv" }` or `{ index = [n, k] }`.
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RawMaterial {
     Builtin(String),
     Csv(String),
+    /// Constant `[n, k]` at every wavelength.
+    Index(Vec<f64>),
 }
 
 #[derive(Debug, Deserialize)]

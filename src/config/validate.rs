@@ -25,15 +25,18 @@
 //!   `pigment.agglomeration = { cluster_size }` in `[1, MAX_CLUSTER_SIZE]`;
 //!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`.
 //! - `Provenance::input_hash` is SHA-256 over the config text followed by each
-//!   pigment's table text, in pigment order.
+//!   pigment's table text, in pigment order, then each structure primitive's
+//!   table text or the bytes of the structure's HDF5 file.
+//! - `[structure]` (explicit layer) and `[[pigment]]` exclude each other.
 
-use super::raw::{RawAppearance, RawProduct, RawSubstrate};
+use super::raw::{RawAppearance, RawAxis, RawBody, RawProduct, RawStructure, RawSubstrate};
 use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
 use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSize, RawSolver};
 use super::{
-    Appearance, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence, Layer,
-    Material, Method, OutputSpec, Products, Provenance, Scene, SolverSpec, Species, Substrate,
-    MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA, MAX_PVC, MAX_RELIEF_FRACTION,
+    Appearance, Body, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence,
+    Layer, Material, Method, OutputSpec, Primitive, Products, Provenance, Scene, SolverSpec,
+    Species, Structure, Substrate, MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA,
+    MAX_PVC, MAX_RELIEF_FRACTION,
 };
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
@@ -143,7 +146,21 @@ impl Checker<'_> {
             }
         };
         let layer = self.layer(&raw.layer)?;
-        let species = self.pigments(&raw.pigment, &layer, raw.layer.pvc)?;
+        let structure = match &raw.structure {
+            None => None,
+            Some(st) => Some(self.structure(st, &layer)?),
+        };
+        let species = if structure.is_some() {
+            if !raw.pigment.is_empty() || raw.layer.pvc.is_some() {
+                return Err(self.invalid(
+                    "structure",
+                    "an explicit structure replaces the generated grains: remove [[pigment]] and layer.pvc",
+                ));
+            }
+            Vec::new()
+        } else {
+            self.pigments(&raw.pigment, &layer, raw.layer.pvc)?
+        };
         let grid = self.grid(&raw.grid, &layer)?;
         let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
         let incidence = self.incidence(&raw.illumination)?;
@@ -168,10 +185,43 @@ impl Checker<'_> {
             }
         }
 
+        if let Some(Structure::Primitives(ps)) = &structure {
+            for &wl in &wavelengths_nm {
+                for (i, p) in ps.iter().enumerate() {
+                    if p.material.index_at(wl).is_none() {
+                        let (lo, hi) = p.material.range_nm();
+                        return Err(self.invalid(
+                            wl_key,
+                            format!(
+                                "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
+                                 material {} (structure.primitive[{i}])",
+                                p.material
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
         for s in &species {
             hasher.update(s.material.table_bytes());
+        }
+        match &structure {
+            Some(Structure::Primitives(ps)) => {
+                for p in ps {
+                    hasher.update(p.material.table_bytes());
+                }
+            }
+            Some(Structure::Hdf5(path)) => {
+                let bytes = std::fs::read(path).map_err(|source| ConfigError::Read {
+                    file: path.clone(),
+                    source,
+                })?;
+                hasher.update(&bytes);
+            }
+            None => {}
         }
         let mut input_hash = String::with_capacity(64);
         for b in hasher.finalize() {
@@ -195,7 +245,134 @@ impl Checker<'_> {
             output,
             appearance,
             substrate,
+            structure,
         })
+    }
+
+    fn structure(&self, raw: &RawStructure, layer: &Layer) -> Result<Structure, ConfigError> {
+        match raw {
+            RawStructure::Hdf5 { file } => {
+                if file.trim().is_empty() {
+                    return Err(self.invalid("structure.file", "must not be empty"));
+                }
+                let path = self.file.parent().unwrap_or(Path::new("")).join(file);
+                if !path.is_file() {
+                    return Err(self.invalid(
+                        "structure.file",
+                        format!("{} is not a readable file", path.display()),
+                    ));
+                }
+                Ok(Structure::Hdf5(path))
+            }
+            RawStructure::Primitives { primitive } => {
+                if primitive.is_empty() {
+                    return Err(self.invalid(
+                        "structure.primitive",
+                        "at least one [[structure.primitive]] is required",
+                    ));
+                }
+                let h = layer.thickness_nm;
+                let mut out = Vec::with_capacity(primitive.len());
+                for (i, p) in primitive.iter().enumerate() {
+                    let key = format!("structure.primitive[{i}]");
+                    let material = self.material(&p.material, &format!("{key}.material"))?;
+                    let three = |k: &str, v: &[f64]| -> Result<[f64; 3], ConfigError> {
+                        if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
+                            return Err(self.invalid(
+                                format!("{key}.shape.{k}"),
+                                format!("must be 3 finite values [x, y, z] in nm, got {v:?}"),
+                            ));
+                        }
+                        Ok([v[0], v[1], v[2]])
+                    };
+                    let positive = |k: &str, v: f64| {
+                        self.range(
+                            &format!("{key}.shape.{k}"),
+                            v,
+                            v > 0.0 && v.is_finite(),
+                            "(0, inf) nm",
+                        )
+                    };
+                    let in_layer = |k: &str, z: f64| {
+                        self.range(
+                            &format!("{key}.shape.{k}"),
+                            z,
+                            (0.0..=h).contains(&z),
+                            &format!("z in [0, {h}] nm (inside the layer)"),
+                        )
+                    };
+                    let body = match &p.shape {
+                        RawBody::Slab { z_nm } => {
+                            if z_nm.len() != 2 || z_nm[0] >= z_nm[1] {
+                                return Err(self.invalid(
+                                    format!("{key}.shape.z_nm"),
+                                    format!("must be [z0, z1] with z0 < z1, got {z_nm:?}"),
+                                ));
+                            }
+                            in_layer("z_nm", z_nm[0])?;
+                            in_layer("z_nm", z_nm[1])?;
+                            Body::Slab {
+                                z_nm: [z_nm[0], z_nm[1]],
+                            }
+                        }
+                        RawBody::Box { min_nm, max_nm } => {
+                            let (lo, hi) = (three("min_nm", min_nm)?, three("max_nm", max_nm)?);
+                            if (0..3).any(|a| lo[a] >= hi[a]) {
+                                return Err(self.invalid(
+                                    format!("{key}.shape"),
+                                    "min_nm must be below max_nm on every axis",
+                                ));
+                            }
+                            in_layer("min_nm", lo[2])?;
+                            in_layer("max_nm", hi[2])?;
+                            Body::Box {
+                                min_nm: lo,
+                                max_nm: hi,
+                            }
+                        }
+                        RawBody::Sphere {
+                            center_nm,
+                            radius_nm,
+                        } => {
+                            let c = three("center_nm", center_nm)?;
+                            let r = positive("radius_nm", *radius_nm)?;
+                            in_layer("center_nm", c[2] - r)?;
+                            in_layer("center_nm", c[2] + r)?;
+                            Body::Sphere {
+                                center_nm: c,
+                                radius_nm: r,
+                            }
+                        }
+                        RawBody::Cylinder {
+                            center_nm,
+                            radius_nm,
+                            length_nm,
+                            axis,
+                        } => {
+                            let c = three("center_nm", center_nm)?;
+                            let r = positive("radius_nm", *radius_nm)?;
+                            let l = positive("length_nm", *length_nm)?;
+                            let axis = match axis {
+                                RawAxis::X => 0,
+                                RawAxis::Y => 1,
+                                RawAxis::Z => 2,
+                            };
+                            let half_z = if axis == 2 { l / 2.0 } else { r };
+                            in_layer("center_nm", c[2] - half_z)?;
+                            in_layer("center_nm", c[2] + half_z)?;
+                            Body::Cylinder {
+                                center_nm: c,
+                                radius_nm: r,
+                                length_nm: l,
+                                axis,
+                            }
+                        }
+                    };
+                    out.push(Primitive { body, material });
+                }
+                Ok(Structure::Primitives(out))
+            }
+        }
     }
 
     fn appearance(
@@ -593,6 +770,21 @@ impl Checker<'_> {
                     ),
                 )
             }),
+            RawMaterial::Index(nk) => {
+                let k = format!("{key}.index");
+                if nk.len() != 2 {
+                    return Err(self.invalid(k, format!("must be [n, k], got {} values", nk.len())));
+                }
+                self.range(&k, nk[0], (1.0..=10.0).contains(&nk[0]), "n in [1, 10]")?;
+                self.range(&k, nk[1], (0.0..=10.0).contains(&nk[1]), "k in [0, 10]")?;
+                let text = format!(
+                    "wavelength_nm,n,k\n1,{n},{kk}\n1000000,{n},{kk}\n",
+                    n = nk[0],
+                    kk = nk[1]
+                );
+                let name = format!("n{}+{}i", nk[0], nk[1]);
+                Material::from_csv_text(&name, &text).map_err(|e| self.invalid(k, e.to_string()))
+            }
             RawMaterial::Csv(rel) => {
                 if rel.trim().is_empty() {
                     return Err(self.invalid(format!("{key}.csv"), "must not be empty"));

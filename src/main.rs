@@ -522,12 +522,7 @@ fn plan_study(
     if !others.is_empty() {
         println!("other profiles (same model):");
         for exp in &others {
-            let cal = plan::calibrate(&exp.variants, &exp.variants);
-            let est: Vec<plan::Estimate> = exp
-                .variants
-                .iter()
-                .map(|v| plan::estimate(&v.scene, &cal))
-                .collect();
+            let est = estimates(exp);
             let grids: std::collections::BTreeSet<String> = est
                 .iter()
                 .map(|e| format!("{}×{}×{}", e.grid[0], e.grid[1], e.grid[2]))
@@ -554,6 +549,15 @@ fn plan_study(
     Ok(())
 }
 
+/// Time and memory estimates of every variant, calibrated now.
+fn estimates(exp: &Expansion) -> Vec<plan::Estimate> {
+    let cal = plan::calibrate(&exp.variants, &exp.variants);
+    exp.variants
+        .iter()
+        .map(|v| plan::estimate(&v.scene, &cal))
+        .collect()
+}
+
 fn slurm_study(
     study: &Study,
     profile: Option<&str>,
@@ -567,12 +571,7 @@ fn slurm_study(
     let n = exp.variants.len();
     let shards = shards.unwrap_or(n.min(64));
     anyhow::ensure!(shards >= 1, "--shards must be at least 1");
-    let cal = plan::calibrate(&exp.variants, &exp.variants);
-    let est: Vec<plan::Estimate> = exp
-        .variants
-        .iter()
-        .map(|v| plan::estimate(&v.scene, &cal))
-        .collect();
+    let est = estimates(&exp);
     // Longest shard, at the calibrated speed scaled to the task's CPUs.
     let here = threads(None) as f64;
     let longest = (0..shards)

@@ -50,16 +50,20 @@ fn periodic_overlap(a0: f64, a1: f64, b0: f64, b1: f64, l: f64) -> f64 {
 /// Whether point `p` lies in a curved body, periodic in x and y.
 fn inside(body: &Body, p: [f64; 3], size: [f64; 3]) -> bool {
     let wrap = |d: f64, l: f64| d - l * (d / l).round();
+    // Offset from the body's centre, nearest periodic image in x and y.
+    let offset = |c: [f64; 3]| {
+        [
+            wrap(p[0] - c[0], size[0]),
+            wrap(p[1] - c[1], size[1]),
+            p[2] - c[2],
+        ]
+    };
     match *body {
         Body::Sphere {
             center_nm: c,
             radius_nm: r,
         } => {
-            let d = [
-                wrap(p[0] - c[0], size[0]),
-                wrap(p[1] - c[1], size[1]),
-                p[2] - c[2],
-            ];
+            let d = offset(c);
             d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= r * r
         }
         Body::Cylinder {
@@ -68,14 +72,9 @@ fn inside(body: &Body, p: [f64; 3], size: [f64; 3]) -> bool {
             length_nm: len,
             axis,
         } => {
-            let d = [
-                wrap(p[0] - c[0], size[0]),
-                wrap(p[1] - c[1], size[1]),
-                p[2] - c[2],
-            ];
-            let along = d[axis];
+            let d = offset(c);
             let radial2: f64 = (0..3).filter(|&a| a != axis).map(|a| d[a] * d[a]).sum();
-            along.abs() <= len / 2.0 && radial2 <= r * r
+            d[axis].abs() <= len / 2.0 && radial2 <= r * r
         }
         _ => false,
     }

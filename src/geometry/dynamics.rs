@@ -62,8 +62,8 @@
 use super::cells::{min_image, near_image};
 use super::shapes::{axis_from_uniforms, order_parameter, Orientation, Shape, ShapeTemplate};
 use super::{
-    check_relief, draw_diameters, min_gap_nm, options_of, size_rng, Geometry, GeometryError,
-    GeometryStats, Particle, SpeciesOptions, Sphere, MAX_PARTICLES,
+    check_relief, draw_all_diameters, min_gap_nm, options_of, Geometry, GeometryError,
+    GeometryStats, Particle, SpeciesOptions, Sphere,
 };
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -270,27 +270,12 @@ fn validate(p: &DynParams, seed: u64) -> Result<(Vec<Spec>, Vec<Vec<f64>>), Geom
             "total volume fraction {total} beyond reach; allowed < 0.74"
         )));
     }
-    let mut rng = size_rng(seed);
-    let mut diameters = Vec::with_capacity(p.species.len());
-    let mut n = 0;
-    for (i, s) in p.species.iter().enumerate() {
-        let ds = draw_diameters(
-            i,
-            s.effective_diameter_nm,
-            s.volume_fraction,
-            volume,
-            options[i].size,
-            &mut rng,
-        )?;
-        n += ds.len();
-        diameters.push(ds);
-    }
-    if n > MAX_PARTICLES {
-        return Err(GeometryError::Invalid(format!(
-            "{n} particles in total; at most {MAX_PARTICLES} allowed"
-        )));
-    }
-    Ok((out, diameters))
+    let species: Vec<(f64, f64)> = p
+        .species
+        .iter()
+        .map(|s| (s.effective_diameter_nm, s.volume_fraction))
+        .collect();
+    Ok((out, draw_all_diameters(&species, &options, volume, seed)?))
 }
 /// Grid of particle centres with doubly linked lists per cell.
 #[derive(Debug, Clone)]

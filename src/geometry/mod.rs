@@ -162,6 +162,32 @@ pub(crate) fn size_rng(seed: u64) -> Xoshiro256PlusPlus {
     Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x5157_e5d1_a7b3_c0de)
 }
 
+/// Diameters of every species, `(effective diameter, volume fraction)` each,
+/// drawn from one generator seeded by `seed` in species order (so the draw
+/// does not depend on the packer), with the total bounded by
+/// [`MAX_PARTICLES`].
+pub(crate) fn draw_all_diameters(
+    species: &[(f64, f64)],
+    options: &[SpeciesOptions],
+    box_volume: f64,
+    seed: u64,
+) -> Result<Vec<Vec<f64>>, GeometryError> {
+    let mut rng = size_rng(seed);
+    let mut out = Vec::with_capacity(species.len());
+    let mut n = 0usize;
+    for (i, &(d, f)) in species.iter().enumerate() {
+        let ds = draw_diameters(i, d, f, box_volume, options[i].size, &mut rng)?;
+        n += ds.len();
+        out.push(ds);
+    }
+    if n > MAX_PARTICLES {
+        return Err(GeometryError::Invalid(format!(
+            "{n} particles in total; at most {MAX_PARTICLES} allowed"
+        )));
+    }
+    Ok(out)
+}
+
 /// Most particles one fragment may hold (guards memory against tiny grains).
 pub const MAX_PARTICLES: usize = 50_000_000;
 
@@ -378,27 +404,12 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
             "total volume fraction {total_fraction} must be < 1"
         )));
     }
-    let mut rng = size_rng(seed);
-    let mut out = Vec::with_capacity(params.species.len());
-    let mut n = 0usize;
-    for (i, s) in params.species.iter().enumerate() {
-        let ds = draw_diameters(
-            i,
-            s.diameter_nm,
-            s.volume_fraction,
-            volume,
-            options[i].size,
-            &mut rng,
-        )?;
-        n += ds.len();
-        out.push(ds);
-    }
-    if n > MAX_PARTICLES {
-        return Err(GeometryError::Invalid(format!(
-            "{n} particles in total; at most {MAX_PARTICLES} allowed"
-        )));
-    }
-    Ok(out)
+    let species: Vec<(f64, f64)> = params
+        .species
+        .iter()
+        .map(|s| (s.diameter_nm, s.volume_fraction))
+        .collect();
+    draw_all_diameters(&species, &options, volume, seed)
 }
 
 /// Packs one fragment by random sequential addition (see the module docs).

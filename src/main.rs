@@ -13,7 +13,11 @@ use std::process::ExitCode;
 /// inksim builds a random layer of pigment grains in a binder (geometry),
 /// rasterises its complex refractive index, solves the scalar Helmholtz
 /// equation in Fourier/Bloch form for every wavelength and angle of
-/// incidence, turns the diffraction orders into BRDF/BTDF, combines them with a Lambertian paper and renders the colour tile (white-sky strip and BRDF square), and writes everything (config, plan, geometry statistics, every solve, ensemble means with standard errors) to an HDF5 file plus PNG pictures. A scene may also give the layer explicitly ([structure]).
+/// incidence, turns the diffraction orders into BRDF/BTDF, combines them
+/// with a Lambertian paper and renders the colour tile (white-sky strip and
+/// BRDF square), and writes everything (config, plan, geometry statistics,
+/// every solve, ensemble means with standard errors) to an HDF5 file plus
+/// PNG pictures. A scene may also give the layer explicitly ([structure]).
 ///
 /// A study (a TOML file with a [study] table: a base scene, profiles and
 /// axes; see docs/STUDY.md) runs many such scenes: `plan` shows its cost,

@@ -977,7 +977,8 @@ fn write_result(
 pub struct GeometryReport {
     pub result_path: PathBuf,
     pub picture_path: PathBuf,
-    pub geometry: Geometry,
+    /// The particle set (None for an explicit structure).
+    pub geometry: Option<Geometry>,
     /// Human-readable statistics (also drawn under the picture).
     pub lines: Vec<String>,
 }
@@ -991,12 +992,57 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     let result_path = d.join(format!("{name}-geometry.h5"));
     let picture_path = d.join(format!("{name}-geometry.png"));
     check_output_dir(d)?;
-    if scene.structure.is_some() {
-        return Err(PipelineError::NoGrains(format!(
-            "{}: the layer is given explicitly ([structure]): there are no grains to pack; \
-             use `inksim run`",
-            scene.path().display()
-        )));
+    match &scene.structure {
+        Some(Structure::Primitives(ps)) => {
+            // Draw the explicit layer's raster: what the solver will see.
+            let raster = structure::rasterize_primitives(ps, &grid_of(scene));
+            let fr = raster.mean_fractions();
+            let mut lines = vec![format!(
+                "explicit structure: {} bodies; volume fraction {:.4} in all",
+                ps.len(),
+                fr.iter().sum::<f64>()
+            )];
+            for (i, (p, f)) in ps.iter().zip(&fr).enumerate() {
+                lines.push(format!("body {i}: {} fraction {f:.4}", p.material.name));
+            }
+            let png = render::geometry_png(&raster, name, &lines)?;
+            io::write_atomic(&picture_path, &png)?;
+            write_result(
+                scene,
+                None,
+                Some(&raster),
+                &[],
+                &[(scene.seed, fr.iter().sum())],
+                &plan_text(&RunPlan::of(scene), &[]),
+                Pictures {
+                    orders: &png,
+                    tile: None,
+                },
+                None,
+                &result_path,
+            )?;
+            return Ok(GeometryReport {
+                result_path,
+                picture_path,
+                geometry: None,
+                lines,
+            });
+        }
+        Some(Structure::Hdf5(p)) => {
+            return Err(PipelineError::NoGrains(format!(
+                "{}: the layer is an ε grid from {}: nothing to build; use `inksim run`",
+                scene.path().display(),
+                p.display()
+            )))
+        }
+        None if scene.is_molecular() => {
+            return Err(PipelineError::NoGrains(format!(
+                "{}: the pigments are dissolved (molecular): the layer is homogeneous, \
+                 there are no grains to build",
+                scene.path().display()
+            )))
+        }
+        None => {}
     }
     let geometry = build_geometry(scene)?;
     let grid = grid_of(scene);
@@ -1031,11 +1077,10 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
         None,
         &result_path,
     )?;
-    let geometry = layer.0;
     Ok(GeometryReport {
         result_path,
         picture_path,
-        geometry,
+        geometry: Some(layer.0),
         lines,
     })
 }

@@ -303,3 +303,21 @@ fn structure_input_errors_name_the_key() {
         assert!(err.contains(key), "{key}: {err}");
     }
 }
+
+#[test]
+fn geometry_command_draws_an_explicit_structure() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = slab_scene(dir.path(), 10.0);
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, &text).unwrap();
+    let rep = pipeline::run_geometry(&parse_scene(&path, &text).unwrap()).unwrap();
+    assert!(rep.geometry.is_none());
+    assert!(
+        rep.lines[0].starts_with("explicit structure: 1 bodies"),
+        "{:?}",
+        rep.lines
+    );
+    // The slab fills 200 of 1000 nm: fraction 0.2 exactly (cell-aligned).
+    assert!(rep.lines[0].ends_with("0.2000 in all"), "{:?}", rep.lines);
+    assert!(rep.picture_path.is_file() && rep.result_path.is_file());
+}

@@ -1,14 +1,22 @@
 //! Batched 2-D FFTs over the z-slices of a field.
 //!
 //! Real-space fields are stored `(nz, ny, nx)`; their spectra `(nz, nx, ny)`
-//! (transposed, so both 1-D passes run over contiguous rows). Plans are made
-//! once; per-slice scratch is owned by the caller's [`FftScratch`].
+//! (transposed, so both 1-D passes run over contiguous rows). Plans come
+//! from one process-wide planner, which caches them by length, so every
+//! solve on a grid (all wavelengths, angles, realisations) reuses the same
+//! plans; per-slice scratch is owned by the caller's [`FftScratch`].
 
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The shared planner (rustfft caches every plan it makes).
+fn planner() -> &'static Mutex<FftPlanner<f64>> {
+    static PLANNER: OnceLock<Mutex<FftPlanner<f64>>> = OnceLock::new();
+    PLANNER.get_or_init(|| Mutex::new(FftPlanner::new()))
+}
 
 /// Planned forward and inverse transforms for one slice size.
 pub struct Fft2 {
@@ -27,7 +35,9 @@ pub struct FftScratch {
 
 impl Fft2 {
     pub fn new(nx: usize, ny: usize) -> Self {
-        let mut p = FftPlanner::new();
+        // A poisoned lock only means another thread panicked while planning;
+        // the planner's cache is still valid.
+        let mut p = planner().lock().unwrap_or_else(|e| e.into_inner());
         Fft2 {
             nx,
             ny,

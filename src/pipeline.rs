@@ -9,6 +9,7 @@
 
 use crate::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
 use crate::colour::Observer;
+use crate::config::Material;
 use crate::config::{
     GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Structure, Substrate,
 };
@@ -426,16 +427,32 @@ fn species_eps(scene: &Scene, lambda: f64) -> Result<Vec<C64>, PipelineError> {
     scene
         .species
         .iter()
-        .map(|s| {
-            s.material
-                .index_at(lambda)
-                .map(|n| n * n)
-                .ok_or_else(|| PipelineError::Material {
-                    material: s.material.name.clone(),
-                    wavelength_nm: lambda,
-                })
-        })
+        .map(|s| material_eps(&s.material, lambda))
         .collect()
+}
+
+/// ε = n² of a material at a wavelength.
+fn material_eps(m: &Material, lambda: f64) -> Result<C64, PipelineError> {
+    m.index_at(lambda)
+        .map(|n| n * n)
+        .ok_or_else(|| PipelineError::Material {
+            material: m.name.clone(),
+            wavelength_nm: lambda,
+        })
+}
+
+/// The volume-averaged permittivity of the layer, `Σ f ε_s + (1 − Σ f) ε_b`
+/// (the molecular-mixture slab).
+fn mean_eps(scene: &Scene, lambda: f64) -> Result<C64, PipelineError> {
+    let eps_b = C64::new(scene.layer.binder_index.powi(2), 0.0);
+    let eps_s = species_eps(scene, lambda)?;
+    Ok(scene
+        .species
+        .iter()
+        .zip(&eps_s)
+        .fold(eps_b * (1.0 - scene.total_pvc()), |acc, (s, e)| {
+            acc + e * s.volume_fraction
+        }))
 }
 
 /// The polar angles and sides solved per wavelength, in solve order.
@@ -613,19 +630,10 @@ pub fn solve_analytic(
     plan: &RunPlan,
     progress: &Progress,
 ) -> Result<Vec<SolveEntry>, PipelineError> {
-    let eps_b = C64::new(scene.layer.binder_index.powi(2), 0.0);
-    let total: f64 = scene.total_pvc();
     let incs = incidences(scene, plan);
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
-        let eps_s = species_eps(scene, lambda)?;
-        let mean = scene
-            .species
-            .iter()
-            .zip(&eps_s)
-            .fold(eps_b * (1.0 - total), |acc, (s, e)| {
-                acc + e * s.volume_fraction
-            });
+        let mean = mean_eps(scene, lambda)?;
         for (side, inc) in &incs {
             let start = std::time::Instant::now();
             // A homogeneous slab is symmetric: from below = from above.
@@ -698,22 +706,9 @@ fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
         x += PROXY_STEP_NM;
     }
     fine.sort_by(f64::total_cmp);
-    let eps_b = C64::new(scene.layer.binder_index.powi(2), 0.0);
-    let total = scene.total_pvc();
     let eps = fine
         .iter()
-        .map(|&l| {
-            let es = species_eps(scene, l).ok()?;
-            Some(
-                scene
-                    .species
-                    .iter()
-                    .zip(&es)
-                    .fold(eps_b * (1.0 - total), |acc, (s, e)| {
-                        acc + e * s.volume_fraction
-                    }),
-            )
-        })
+        .map(|&l| mean_eps(scene, l).ok())
         .collect::<Option<Vec<_>>>()?;
     Some(SpectralProxy {
         wavelengths_nm: fine,
@@ -825,14 +820,18 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     } else {
         None
     };
-    let tile_png = match appearance.as_ref().and_then(|a| a.colours.as_ref()) {
-        Some(c) => Some(render::tile::tile_png(
+    let tile_png = match appearance.as_ref() {
+        Some(
+            a @ Appearance {
+                colours: Some(c), ..
+            },
+        ) => Some(render::tile::tile_png(
             &c.tile_srgb8,
-            &scene.appearance.viewing_deg,
-            &appearance_spec(scene, &plan).illumination_deg,
+            &a.spec.viewing_deg,
+            &a.spec.illumination_deg,
             &scene.output.name,
         )?),
-        None => None,
+        _ => None,
     };
     if let (Some(a), true) = (appearance.as_ref(), products.merl) {
         let merl = merl::encode(a)?;

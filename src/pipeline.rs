@@ -848,8 +848,8 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     let plan_text = plan_text(&plan, &entries);
     write_result(
         scene,
-        first.as_ref(),
-        explicit_raster.as_ref(),
+        first.as_ref().map(|f| &f.0),
+        first.as_ref().map(|f| &f.1).or(explicit_raster.as_ref()),
         &entries,
         &realisations,
         &plan_text,
@@ -878,8 +878,8 @@ struct Pictures<'a> {
 #[allow(clippy::too_many_arguments)]
 fn write_result(
     scene: &Scene,
-    layer: Option<&(Geometry, Raster)>,
-    explicit: Option<&Raster>,
+    geometry: Option<&Geometry>,
+    raster: Option<&Raster>,
     entries: &[SolveEntry],
     realisations: &[(u64, f64)],
     plan: &str,
@@ -893,46 +893,42 @@ fn write_result(
     let mut species_of_particle = Vec::new();
     let mut names: Vec<String> = scene.species.iter().map(|s| s.name.clone()).collect();
     let mut targets: Vec<f64> = scene.species.iter().map(|s| s.volume_fraction).collect();
-    let statistics = layer.map(|(g, _)| geometry::analyse(g, &StatsParams::default()));
     if let Some(Structure::Primitives(ps)) = &scene.structure {
         names = ps
             .iter()
             .enumerate()
             .map(|(i, p)| format!("primitive[{i}] {}", p.material.name))
             .collect();
-        targets = explicit.map(|r| r.mean_fractions()).unwrap_or_default();
+        targets = raster.map(|r| r.mean_fractions()).unwrap_or_default();
     }
-    let (achieved, raster_fraction, min_gap, grid) = match layer {
-        Some((geometry, raster)) => {
-            for (i, p) in geometry.particles.iter().enumerate() {
-                species_of_particle.push(p.species as u32);
-                for s in &p.spheres {
-                    centers.push(s.center);
-                    radii.push(s.radius);
-                    particle_of_sphere.push(i as u32);
-                }
+    if let Some(g) = geometry {
+        for (i, p) in g.particles.iter().enumerate() {
+            species_of_particle.push(p.species as u32);
+            for s in &p.spheres {
+                centers.push(s.center);
+                radii.push(s.radius);
+                particle_of_sphere.push(i as u32);
             }
-            (
-                geometry.stats.achieved_fraction.clone(),
-                raster.mean_fractions(),
-                Some(geometry.stats.min_gap_nm),
-                [raster.grid.nx, raster.grid.ny, raster.grid.nz],
-            )
         }
-        // An explicit structure is its raster; a molecular mixture is
-        // exactly its target composition (no grid).
-        None => match (&scene.structure, explicit) {
-            (Some(_), r) => {
-                let g = grid_of(scene);
-                (
-                    targets.clone(),
-                    r.map(|r| r.mean_fractions()).unwrap_or_default(),
-                    None,
-                    [g.nx, g.ny, g.nz],
-                )
-            }
-            (None, _) => (targets.clone(), targets.clone(), None, [0, 0, 0]),
-        },
+    }
+    let statistics = geometry.map(|g| geometry::analyse(g, &StatsParams::default()));
+    // Grains: what the packer achieved; an explicit structure is its raster
+    // (an ε grid has no fractions); a molecular mixture is exactly its
+    // target composition, without a grid.
+    let achieved = geometry.map_or_else(|| targets.clone(), |g| g.stats.achieved_fraction.clone());
+    let raster_fraction = match raster {
+        Some(r) => r.mean_fractions(),
+        None if scene.structure.is_some() => Vec::new(),
+        None => targets.clone(),
+    };
+    let min_gap = geometry.map(|g| g.stats.min_gap_nm);
+    let grid = match raster {
+        Some(r) => [r.grid.nx, r.grid.ny, r.grid.nz],
+        None if scene.structure.is_some() => {
+            let g = grid_of(scene);
+            [g.nx, g.ny, g.nz]
+        }
+        None => [0, 0, 0],
     };
     let created = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -1004,21 +1000,13 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
             for (i, (p, f)) in ps.iter().zip(&fr).enumerate() {
                 lines.push(format!("body {i}: {} fraction {f:.4}", p.material.name));
             }
-            let png = render::geometry_png(&raster, name, &lines)?;
-            io::write_atomic(&picture_path, &png)?;
-            write_result(
+            write_geometry_only(
                 scene,
                 None,
-                Some(&raster),
-                &[],
-                &[(scene.seed, fr.iter().sum())],
-                &plan_text(&RunPlan::of(scene), &[]),
-                Pictures {
-                    orders: &png,
-                    tile: None,
-                },
-                None,
-                &result_path,
+                &raster,
+                fr.iter().sum(),
+                &lines,
+                (&result_path, &picture_path),
             )?;
             return Ok(GeometryReport {
                 result_path,
@@ -1058,14 +1046,40 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
     // Worst overlap, S, relief, clusters (the PVC line is the one above).
     let stats = geometry::analyse(&geometry, &StatsParams::default());
     lines.extend(stats.lines().into_iter().skip(1));
-    let png = render::geometry_png(&raster, name, &lines)?;
-    io::write_atomic(&picture_path, &png)?;
     let pvc = geometry.stats.achieved_fraction.iter().sum();
     let layer = (geometry, raster);
+    write_geometry_only(
+        scene,
+        Some(&layer.0),
+        &layer.1,
+        pvc,
+        &lines,
+        (&result_path, &picture_path),
+    )?;
+    Ok(GeometryReport {
+        result_path,
+        picture_path,
+        geometry: Some(layer.0),
+        lines,
+    })
+}
+
+/// The picture and the result file of `inksim geometry`: the raster drawn
+/// with `lines` under it, and a result set without solves.
+fn write_geometry_only(
+    scene: &Scene,
+    geometry: Option<&Geometry>,
+    raster: &Raster,
+    pvc: f64,
+    lines: &[String],
+    (result_path, picture_path): (&Path, &Path),
+) -> Result<(), PipelineError> {
+    let png = render::geometry_png(raster, &scene.output.name, lines)?;
+    io::write_atomic(picture_path, &png)?;
     write_result(
         scene,
-        Some(&layer),
-        None,
+        geometry,
+        Some(raster),
         &[],
         &[(scene.seed, pvc)],
         &plan_text(&RunPlan::of(scene), &[]),
@@ -1074,14 +1088,8 @@ pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
             tile: None,
         },
         None,
-        &result_path,
-    )?;
-    Ok(GeometryReport {
         result_path,
-        picture_path,
-        geometry: Some(layer.0),
-        lines,
-    })
+    )
 }
 
 /// The run's plan as stored with the results: one line per decision, then

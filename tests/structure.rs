@@ -143,6 +143,19 @@ name = "slab"
     )
 }
 
+/// The slab scene with its primitive replaced by an ε grid file.
+fn with_hdf5(slab_scene: &str, file: &str) -> String {
+    let text = slab_scene.replace(
+        "kind = \"primitives\"\n[[structure.primitive]]\nshape = { kind = \"slab\", z_nm = [300.0, 500.0] }\nmaterial = { index = [2.0, 0.1] }",
+        &format!("kind = \"hdf5\"\nfile = \"{file}\""),
+    );
+    assert!(
+        text.contains("kind = \"hdf5\""),
+        "the primitive block was not found"
+    );
+    text
+}
+
 fn run(dir: &Path, text: &str) -> pipeline::RunReport {
     let path = dir.join("scene.toml");
     std::fs::write(&path, text).unwrap();
@@ -220,30 +233,8 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
             .create("wavelengths_nm")
             .unwrap();
     }
-    let file_text = format!(
-        r#"
-[layer]
-thickness_nm = 1000.0
-fragment_nm = [200.0, 200.0]
-[structure]
-kind = "hdf5"
-file = "eps.h5"
-[grid]
-cell_nm = 50.0
-z_cell_nm = 10.0
-[illumination]
-wavelengths_nm = [450.0, 600.0]
-polar_deg = [0.0, 40.0]
-[appearance]
-outputs = []
-[solver]
-tolerance = 1e-10
-[output]
-dir = "{}"
-name = "file"
-"#,
-        dir.path().display()
-    );
+    let file_text = with_hdf5(&slab_scene(dir.path(), 10.0), "eps.h5")
+        .replace("name = \"slab\"", "name = \"file\"");
     let from_file = run(dir.path(), &file_text);
     for (a, b) in prim.entries.iter().zip(&from_file.entries) {
         assert_eq!(
@@ -288,13 +279,7 @@ fn structure_input_errors_name_the_key() {
         ),
         (base.replace("z_nm = [300.0, 500.0]", "z_nm = [300.0, 1500.0]"), "z_nm"),
         (base.replace("index = [2.0, 0.1]", "index = [2.0]"), "index"),
-        (
-            base.replace(
-                "kind = \"primitives\"\n[[structure.primitive]]\nshape = { kind = \"slab\", z_nm = [300.0, 500.0] }\nmaterial = { index = [2.0, 0.1] }",
-                "kind = \"hdf5\"\nfile = \"none.h5\"",
-            ),
-            "structure.file",
-        ),
+        (with_hdf5(&base, "none.h5"), "structure.file"),
     ] {
         let err = match parse_scene(&p, &text) {
             Ok(_) => panic!("{key}: accepted"),

@@ -28,6 +28,7 @@ fn main() -> anyhow::Result<()> {
     let ctl = Controls {
         tolerance,
         max_iterations: 20_000,
+        precision: inksim::config::Precision::F64,
     };
     println!(
         "{}: grid {}×{}×{}, tolerance {tolerance:.0e}",

@@ -75,6 +75,7 @@ fn main() {
             &Controls {
                 tolerance: 1e-6,
                 max_iterations: 50_000,
+                precision: inksim::config::Precision::F64,
             },
         ) {
             Ok(s) => {
@@ -95,7 +96,7 @@ fn main() {
     }
     // Unrestarted GMRES (restart longer than the iteration count).
     let mut sys = solver::System::new(&p).expect("system");
-    let mut u = Array3::zeros(eps.dim());
+    let mut u = Array3::<C64>::zeros(eps.dim());
     sys.set_background(&mut u);
     let t = std::time::Instant::now();
     let g = solver::gmres::Gmres { restart: 80 };
@@ -106,6 +107,7 @@ fn main() {
         &Controls {
             tolerance: 1e-6,
             max_iterations: 50_000,
+            precision: inksim::config::Precision::F64,
         },
     ) {
         Ok(o) => println!(

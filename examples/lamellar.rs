@@ -119,6 +119,7 @@ fn run(a: &Args) -> Result<(), String> {
     let ctl = Controls {
         tolerance: a.tolerance,
         max_iterations: 20_000,
+        precision: inksim::config::Precision::F64,
     };
     for &cell in &a.cells {
         let nx = cells_in(PERIOD, cell, "lateral")?;

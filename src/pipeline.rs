@@ -565,6 +565,7 @@ pub fn solve_layer(
     let ctl = Controls {
         tolerance: scene.solver.tolerance,
         max_iterations: scene.solver.max_iterations,
+        precision: scene.solver.precision,
     };
     let incs = incidences(scene, plan);
     let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));

@@ -144,6 +144,23 @@ fn solver_methods_parse() {
 }
 
 #[test]
+fn solver_precision_parses_and_limits_the_tolerance() {
+    assert_eq!(parse(BASE).unwrap().solver.precision, Precision::F64);
+    for (word, want) in [("f64", Precision::F64), ("f32", Precision::F32)] {
+        let s = parse(&format!("{BASE}\n[solver]\nprecision = \"{word}\"\n")).unwrap();
+        assert_eq!(s.solver.precision, want);
+    }
+    // f32 fields cannot hold a residual below 1e-6; f64 can.
+    let tight = "[solver]\nprecision = \"{p}\"\ntolerance = 1e-9\n";
+    assert!(parse(&format!("{BASE}\n{}", tight.replace("{p}", "f64"))).is_ok());
+    let (key, msg) = invalid(&format!("{BASE}\n{}", tight.replace("{p}", "f32")));
+    assert_eq!(key, "solver.tolerance");
+    assert!(msg.contains("f32") && msg.contains("1e-6"), "{msg}");
+    let err = parse(&format!("{BASE}\n[solver]\nprecision = \"f16\"\n")).unwrap_err();
+    assert!(err.to_string().contains("f16"), "{err}");
+}
+
+#[test]
 fn unknown_key_is_named_on_one_line() {
     let text = edit(
         "thickness_nm = 1000.0",

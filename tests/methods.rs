@@ -2,8 +2,8 @@
 //! helper (the macro at the bottom instantiates it per method). A method
 //! either reproduces the reference or — only where it declares itself not
 //! valid (Born on strong scattering) — fails loudly; it never returns a wrong
-//! answer.
-use inksim::config::Method;
+//! answer. Each case runs with f64 and with f32 field storage.
+use inksim::config::{Method, Precision};
 use inksim::farfield::efficiencies;
 use inksim::solver::{
     self, born::Born, green, Controls, IterativeMethod, Problem, SolveError, System, Validity,
@@ -16,7 +16,23 @@ use common::{layer_eps, packed_rsa, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-9,
     max_iterations: 20000,
+    precision: Precision::F64,
 };
+/// f32 field storage: the tolerance it can reach (config enforces ≥ 1e-6).
+const CTL32: Controls = Controls {
+    tolerance: 1e-6,
+    max_iterations: 20000,
+    precision: Precision::F32,
+};
+
+/// What a solve at `ctl` must reproduce: (energy balance, agreement with
+/// the f64 reference at 1e-9).
+fn bounds(ctl: &Controls) -> (f64, f64) {
+    match ctl.precision {
+        Precision::F64 => (1e-8, 1e-6),
+        Precision::F32 => (1e-6, 1e-6),
+    }
+}
 
 /// Exact Airy |r|², |t|² for a slab of permittivity `eps` in vacuum.
 fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
@@ -32,11 +48,15 @@ fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
 }
 
 /// Solve, or check that a failure is one the method announced.
-fn solve_or_declared_failure(p: &Problem, method: Method) -> Option<solver::Solution> {
-    match solver::solve(p, method, &CTL) {
+fn solve_or_declared_failure(
+    p: &Problem,
+    method: Method,
+    ctl: &Controls,
+) -> Option<solver::Solution> {
+    match solver::solve(p, method, ctl) {
         Ok(s) => {
             assert!(
-                s.record.residual <= CTL.tolerance,
+                s.record.residual <= ctl.tolerance,
                 "{method:?}: residual {}",
                 s.record.residual
             );
@@ -53,7 +73,10 @@ fn solve_or_declared_failure(p: &Problem, method: Method) -> Option<solver::Solu
             );
             let mut sys = System::new(p).unwrap();
             assert!(
-                matches!(Born.validity(&mut sys), Validity::Unlikely(_)),
+                matches!(
+                    IterativeMethod::<C64>::validity(&Born, &mut sys),
+                    Validity::Unlikely(_)
+                ),
                 "Born failed where it claimed validity: {e}"
             );
             None
@@ -67,7 +90,8 @@ fn solve_or_declared_failure(p: &Problem, method: Method) -> Option<solver::Solu
 /// the slab is, so the grazing real slab needs finer cells than the default
 /// 10 nm — see tests/solver_slab.rs for the convergence order), exact energy
 /// balance.
-fn check_airy(method: Method) {
+fn check_airy(method: Method, ctl: &Controls) {
+    let (balance, _) = bounds(ctl);
     let h = 1000.0;
     let cases = [
         (C64::new(2.3, 0.0), 0.0),
@@ -85,7 +109,7 @@ fn check_airy(method: Method) {
             eps: &grid,
             eps_binder: EPS_B,
         };
-        let Some(sol) = solve_or_declared_failure(&p, method) else {
+        let Some(sol) = solve_or_declared_failure(&p, method, ctl) else {
             continue;
         };
         let ff = efficiencies(&sol);
@@ -98,7 +122,7 @@ fn check_airy(method: Method) {
             "{method:?} eps {eps} polar {polar}: error {err}"
         );
         assert!(
-            ff.energy_balance.abs() < 1e-8,
+            ff.energy_balance.abs() < balance,
             "{method:?}: balance {}",
             ff.energy_balance
         );
@@ -109,7 +133,8 @@ fn check_airy(method: Method) {
 
 /// A random absorbing grain layer: energy balance to 1e-4 and agreement
 /// between methods (all solve the same discrete equation).
-fn check_layer(method: Method) {
+fn check_layer(method: Method, ctl: &Controls) {
+    let (balance, agree) = bounds(ctl);
     let size = [800.0, 800.0, 500.0];
     let geom = packed_rsa(size, 160.0, 0.25, 21);
     let (eps, _) = layer_eps(&geom, [32, 32, 50], C64::new(1.4, 0.6));
@@ -120,22 +145,28 @@ fn check_layer(method: Method) {
         eps_binder: EPS_B,
     };
     let reference = solver::solve(&p, Method::TimeMarching, &CTL).unwrap();
-    let Some(sol) = solve_or_declared_failure(&p, method) else {
+    let Some(sol) = solve_or_declared_failure(&p, method, ctl) else {
         return;
     };
     let (a, b) = (efficiencies(&sol), efficiencies(&reference));
     assert!(
-        a.energy_balance.abs() < 1e-4,
+        a.energy_balance.abs() < balance.max(1e-4),
         "{method:?}: balance {}",
         a.energy_balance
     );
     assert!(
-        (a.total_reflectance - b.total_reflectance).abs() < 1e-6,
-        "{method:?} vs time-marching"
+        (a.total_reflectance - b.total_reflectance).abs() < agree,
+        "{method:?} {}: R {} vs time-marching {}",
+        ctl.precision,
+        a.total_reflectance,
+        b.total_reflectance
     );
     assert!(
-        (a.absorption - b.absorption).abs() < 1e-6,
-        "{method:?} vs time-marching"
+        (a.absorption - b.absorption).abs() < agree,
+        "{method:?} {}: A {} vs time-marching {}",
+        ctl.precision,
+        a.absorption,
+        b.absorption
     );
 }
 
@@ -145,11 +176,19 @@ macro_rules! every_method {
             use super::*;
             #[test]
             fn airy_slabs() {
-                check_airy($method);
+                check_airy($method, &CTL);
             }
             #[test]
             fn grain_layer() {
-                check_layer($method);
+                check_layer($method, &CTL);
+            }
+            #[test]
+            fn airy_slabs_f32() {
+                check_airy($method, &CTL32);
+            }
+            #[test]
+            fn grain_layer_f32() {
+                check_layer($method, &CTL32);
             }
         }
     )*};

@@ -16,6 +16,7 @@ use num_complex::Complex64 as C64;
 const CTL: Controls = Controls {
     tolerance: 1e-10,
     max_iterations: 20000,
+    precision: inksim::config::Precision::F64,
 };
 
 /// Minimal JSON value: enough to read the fixture without a JSON crate.

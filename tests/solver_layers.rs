@@ -11,6 +11,7 @@ use common::{layer_eps, packed_rsa as packed, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
+    precision: inksim::config::Precision::F64,
 };
 
 #[test]

@@ -40,6 +40,7 @@ fn slab_solve(
         &Controls {
             tolerance: 1e-11,
             max_iterations: 20000,
+            precision: inksim::config::Precision::F64,
         },
     )
     .expect("solve");

@@ -2,8 +2,8 @@
 //! finish with no inf/NaN, the residual at tolerance and the energy balance
 //! within 1e-4, with `auto` (which may fall back and says so). The grazing
 //! order, the guided resonance and the 3 µm layer live in tests/traps.rs and
-//! tests/solver_layers.rs.
-use inksim::config::Method;
+//! tests/solver_layers.rs. f32 field storage runs the hardest case.
+use inksim::config::{Method, Precision};
 use inksim::farfield::efficiencies;
 use inksim::geometry::{
     pack_dynamics, DynParams, DynSpecies, Geometry, GeometryStats, Orientation, Particle, Shape,
@@ -17,9 +17,22 @@ use common::{layer_eps, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20_000,
+    precision: Precision::F64,
 };
 
 fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, polar: f64) {
+    check_with(name, geom, cells, n, lambda, polar, &CTL);
+}
+
+fn check_with(
+    name: &str,
+    geom: &Geometry,
+    cells: [usize; 3],
+    n: C64,
+    lambda: f64,
+    polar: f64,
+    ctl: &Controls,
+) -> solver::Solution {
     let (eps, _) = layer_eps(geom, cells, n);
     let lat = Problem::lattice(cells, geom.size_nm, lambda, polar, 0.0);
     let sol = solver::solve(
@@ -29,7 +42,7 @@ fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, po
             eps_binder: EPS_B,
         },
         Method::Auto,
-        &CTL,
+        ctl,
     )
     .unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(
@@ -39,7 +52,7 @@ fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, po
         "{name}: non-finite field"
     );
     assert!(
-        sol.record.residual <= CTL.tolerance,
+        sol.record.residual <= ctl.tolerance,
         "{name}: residual {}",
         sol.record.residual
     );
@@ -58,6 +71,7 @@ fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, po
         "{name}: balance {}",
         ff.energy_balance
     );
+    sol
 }
 
 fn packed(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {
@@ -138,4 +152,31 @@ fn a_single_huge_grain() {
         600.0,
         10.0,
     );
+}
+
+/// f32 field storage on the hardest case: same checks, and the answer of
+/// the f64 solve to the solver tolerance.
+#[test]
+fn f32_storage_on_fifty_percent_pvc() {
+    let g = packed([600.0, 600.0, 500.0], 150.0, 0.5, 1);
+    let run = |precision| {
+        check_with(
+            &format!("50 % PVC, n = 1.4+0.8i, {precision}"),
+            &g,
+            [32, 32, 50],
+            C64::new(1.4, 0.8),
+            450.0,
+            20.0,
+            &Controls { precision, ..CTL },
+        )
+    };
+    let (a, b) = (run(Precision::F32), run(Precision::F64));
+    assert!(a.record.note.contains("f32"), "{}", a.record.note);
+    let (fa, fb) = (efficiencies(&a), efficiencies(&b));
+    for (x, y, what) in [
+        (fa.total_reflectance, fb.total_reflectance, "R"),
+        (fa.absorption, fb.absorption, "A"),
+    ] {
+        assert!((x - y).abs() < 1e-5, "{what}: f32 {x} vs f64 {y}");
+    }
 }

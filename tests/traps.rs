@@ -78,6 +78,7 @@ fn order_on_a_guided_resonance_stays_finite() {
             &Controls {
                 tolerance: 1e-8,
                 max_iterations: 20000,
+                precision: inksim::config::Precision::F64,
             },
         ) {
             Ok(sol) => {
@@ -130,6 +131,7 @@ fn strongly_evanescent_harmonics_in_a_thick_layer_stay_finite() {
         &Controls {
             tolerance: 1e-8,
             max_iterations: 20000,
+            precision: inksim::config::Precision::F64,
         },
     )
     .expect("converges");

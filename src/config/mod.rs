@@ -175,6 +175,26 @@ pub enum Method {
     Auto,
 }
 
+/// How the solver stores its fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Precision {
+    /// Complex f64 everywhere (default).
+    #[default]
+    F64,
+    /// Fields stored as complex f32 (half the memory); every operator
+    /// application, inner product and norm runs in f64.
+    F32,
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        })
+    }
+}
+
 /// Solver settings.
 #[derive(Debug, Clone, Copy)]
 pub struct SolverSpec {
@@ -182,6 +202,8 @@ pub struct SolverSpec {
     /// Target relative residual.
     pub tolerance: f64,
     pub max_iterations: usize,
+    /// Field storage.
+    pub precision: Precision,
 }
 
 /// One direction of incidence (from above, in vacuum).

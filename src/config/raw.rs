@@ -192,6 +192,14 @@ pub struct RawSolver {
     pub method: Option<RawMethod>,
     pub tolerance: Option<f64>,
     pub max_iterations: Option<i64>,
+    pub precision: Option<RawPrecision>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawPrecision {
+    F64,
+    F32,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

@@ -30,13 +30,15 @@
 //! - `[structure]` (explicit layer) and `[[pigment]]` exclude each other.
 
 use super::raw::{RawAppearance, RawAxis, RawBody, RawProduct, RawStructure, RawSubstrate};
-use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
+use super::raw::{
+    RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod, RawPrecision,
+};
 use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSize, RawSolver};
 use super::{
     Appearance, Body, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence,
-    Layer, Material, Method, OutputSpec, Primitive, Products, Provenance, Scene, SolverSpec,
-    Species, Structure, Substrate, MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA,
-    MAX_PVC, MAX_RELIEF_FRACTION,
+    Layer, Material, Method, OutputSpec, Precision, Primitive, Products, Provenance, Scene,
+    SolverSpec, Species, Structure, Substrate, MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA,
+    MAX_NORMAL_SIGMA, MAX_PVC, MAX_RELIEF_FRACTION,
 };
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
@@ -60,6 +62,8 @@ pub const DEFAULT_PAPER_ALBEDO: f64 = 0.9;
 const DEFAULT_QUADRATURE_POINTS: i64 = 6;
 const DEFAULT_TOLERANCE: f64 = 1e-6;
 const DEFAULT_MAX_ITERATIONS: usize = 5000;
+/// Smallest relative residual f32 field storage reaches reliably.
+pub const F32_MIN_TOLERANCE: f64 = 1e-6;
 const MAX_ITERATIONS: i64 = 10_000_000;
 /// Relative slack for ceilings and for landing on `stop` in a range.
 const REL_EPS: f64 = 1e-9;
@@ -1033,10 +1037,24 @@ impl Checker<'_> {
                 ))
             }
         };
+        let precision = match raw.and_then(|s| s.precision) {
+            Some(RawPrecision::F32) => Precision::F32,
+            Some(RawPrecision::F64) | None => Precision::F64,
+        };
+        if precision == Precision::F32 && tolerance < F32_MIN_TOLERANCE {
+            return Err(self.invalid(
+                "solver.tolerance",
+                format!(
+                    "must be in [{F32_MIN_TOLERANCE:e}, 1e-1] with precision = \"f32\" \
+                     (f32 fields cannot hold a smaller residual), got {tolerance:e}"
+                ),
+            ));
+        }
         Ok(SolverSpec {
             method,
             tolerance,
             max_iterations,
+            precision,
         })
     }
 

@@ -6,9 +6,10 @@
 //! learned, it needs far fewer applications. Breakdowns (⟨r̂, v⟩ ≈ 0) restart
 //! from the current iterate; convergence is confirmed on the true residual.
 
+use super::storage::norm_sqr;
 use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, System,
-    Validity,
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, Storage,
+    System, Validity,
 };
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
@@ -19,13 +20,13 @@ pub struct BiCgStab {}
 
 impl BiCgStab {
     /// `out ← P A x`.
-    fn op(sys: &mut System, x: &Array3<C64>, out: &mut Array3<C64>) {
+    fn op<S: Storage>(sys: &mut System, x: &Array3<S>, out: &mut Array3<S>) {
         sys.apply_a_shifted(x, out);
         sys.precondition(out);
     }
 }
 
-impl IterativeMethod for BiCgStab {
+impl<S: Storage> IterativeMethod<S> for BiCgStab {
     fn kind(&self) -> MethodUsed {
         MethodUsed::BiCgStab
     }
@@ -39,11 +40,11 @@ impl IterativeMethod for BiCgStab {
     fn run(
         &self,
         sys: &mut System,
-        u: &mut Array3<C64>,
+        u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
         let dim = u.dim();
-        let z = || Array3::<C64>::zeros(dim);
+        let z = || Array3::<S>::default(dim);
         let (mut r, mut rh, mut p, mut v, mut s, mut t) = (z(), z(), z(), z(), z(), z());
         let mut iterations = 0;
         let mut applications = 0;
@@ -67,8 +68,8 @@ impl IterativeMethod for BiCgStab {
                 Restart::Go { norm, target } => (norm, target),
             };
             rh.assign(&r);
-            p.fill(C64::new(0.0, 0.0));
-            v.fill(C64::new(0.0, 0.0));
+            p.fill(S::default());
+            v.fill(S::default());
             let (mut rho, mut alpha, mut omega) = (one, one, one);
             while iterations < ctl.max_iterations {
                 iterations += 1;
@@ -78,10 +79,9 @@ impl IterativeMethod for BiCgStab {
                 }
                 let beta = (rho_new / rho) * (alpha / omega);
                 rho = rho_new;
-                Zip::from(&mut p)
-                    .and(&r)
-                    .and(&v)
-                    .par_for_each(|p, r, v| *p = r + beta * (*p - omega * v));
+                Zip::from(&mut p).and(&r).and(&v).par_for_each(|p, r, v| {
+                    *p = S::store(r.load() + beta * (p.load() - omega * v.load()))
+                });
                 Self::op(sys, &p, &mut v);
                 let rv = dot(&rh, &v);
                 if rv.norm() < 1e-30 * r0 * r0 {
@@ -91,24 +91,23 @@ impl IterativeMethod for BiCgStab {
                 Zip::from(&mut s)
                     .and(&r)
                     .and(&v)
-                    .par_for_each(|s, r, v| *s = r - alpha * v);
+                    .par_for_each(|s, r, v| *s = S::store(r.load() - alpha * v.load()));
                 Self::op(sys, &s, &mut t);
                 applications += 2;
-                let tt = dot(&t, &t).re;
+                let tt = norm_sqr(&t);
                 omega = if tt > 0.0 {
                     dot(&t, &s) / tt
                 } else {
                     C64::new(0.0, 0.0)
                 };
-                Zip::from(&mut *u)
-                    .and(&p)
-                    .and(&s)
-                    .par_for_each(|u, p, s| *u += alpha * p + omega * s);
+                Zip::from(&mut *u).and(&p).and(&s).par_for_each(|u, p, s| {
+                    *u = S::store(u.load() + alpha * p.load() + omega * s.load())
+                });
                 Zip::from(&mut r)
                     .and(&s)
                     .and(&t)
-                    .par_for_each(|r, s, t| *r = s - omega * t);
-                let rn = dot(&r, &r).re.sqrt();
+                    .par_for_each(|r, s, t| *r = S::store(s.load() - omega * t.load()));
+                let rn = norm_sqr(&r).sqrt();
                 if !rn.is_finite() || rn <= target || omega.norm() == 0.0 {
                     break;
                 }

@@ -5,9 +5,10 @@
 //! detected from residual growth and reported as an error, never returned as
 //! a result. [`Born::validity`] estimates the contraction from a few steps.
 
-use super::{Controls, IterativeMethod, MethodUsed, Outcome, SolveError, System, Validity};
+use super::{
+    Controls, IterativeMethod, MethodUsed, Outcome, SolveError, Storage, System, Validity,
+};
 use ndarray::{Array3, Zip};
-use num_complex::Complex64 as C64;
 
 /// Steps spent on the a-priori contraction estimate.
 pub const ESTIMATE_STEPS: usize = 4;
@@ -17,14 +18,14 @@ pub const MAX_CONTRACTION: f64 = 0.8;
 /// The Born series.
 pub struct Born;
 
-impl IterativeMethod for Born {
+impl<S: Storage> IterativeMethod<S> for Born {
     fn kind(&self) -> MethodUsed {
         MethodUsed::Born
     }
 
     fn validity(&self, sys: &mut System) -> Validity {
-        let mut u = Array3::zeros(sys.v.dim());
-        let mut r = Array3::zeros(sys.v.dim());
+        let dim = sys.eps.dim();
+        let (mut u, mut r) = (Array3::<S>::default(dim), Array3::<S>::default(dim));
         sys.set_background(&mut u);
         let mut prev = f64::NAN;
         let mut ratio = 0.0;
@@ -37,7 +38,9 @@ impl IterativeMethod for Born {
                 ratio = res / prev;
             }
             prev = res;
-            Zip::from(&mut u).and(&r).par_for_each(|u, r| *u += r);
+            Zip::from(&mut u)
+                .and(&r)
+                .par_for_each(|u, r| *u = S::store(u.load() + r.load()));
         }
         if ratio.is_finite() && ratio < MAX_CONTRACTION {
             Validity::Likely(format!(
@@ -53,10 +56,10 @@ impl IterativeMethod for Born {
     fn run(
         &self,
         sys: &mut System,
-        u: &mut Array3<C64>,
+        u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
-        let mut r = Array3::zeros(u.dim());
+        let mut r = Array3::<S>::default(u.dim());
         let mut best = f64::INFINITY;
         let mut growing = 0;
         for it in 0..=ctl.max_iterations {
@@ -87,7 +90,9 @@ impl IterativeMethod for Born {
                     tolerance: ctl.tolerance,
                 });
             }
-            Zip::from(&mut *u).and(&r).par_for_each(|u, r| *u += r);
+            Zip::from(&mut *u)
+                .and(&r)
+                .par_for_each(|u, r| *u = S::store(u.load() + r.load()));
         }
         unreachable!("loop returns")
     }

@@ -10,9 +10,10 @@
 //! `‖u_s + G_s V' u − u‖ / ‖u_s‖`, evaluated at every restart. Inner products are
 //! summed in a fixed order, so results do not depend on the thread count.
 
+use super::storage::norm_sqr;
 use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, System,
-    Validity,
+    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, Storage,
+    System, Validity,
 };
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
@@ -30,7 +31,7 @@ impl Default for Gmres {
     }
 }
 
-impl IterativeMethod for Gmres {
+impl<S: Storage> IterativeMethod<S> for Gmres {
     fn kind(&self) -> MethodUsed {
         MethodUsed::Gmres
     }
@@ -42,13 +43,13 @@ impl IterativeMethod for Gmres {
     fn run(
         &self,
         sys: &mut System,
-        u: &mut Array3<C64>,
+        u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
         let m = self.restart.max(1);
         let dim = u.dim();
-        let mut basis: Vec<Array3<C64>> = (0..=m).map(|_| Array3::zeros(dim)).collect();
-        let mut r = Array3::zeros(dim);
+        let mut basis: Vec<Array3<S>> = (0..=m).map(|_| Array3::default(dim)).collect();
+        let mut r = Array3::<S>::default(dim);
         let mut h = vec![C64::new(0.0, 0.0); (m + 1) * m];
         let (mut cs, mut sn) = (vec![C64::new(0.0, 0.0); m], vec![C64::new(0.0, 0.0); m]);
         let mut g = vec![C64::new(0.0, 0.0); m + 1];
@@ -74,7 +75,7 @@ impl IterativeMethod for Gmres {
             };
             Zip::from(&mut basis[0])
                 .and(&r)
-                .par_for_each(|v, r| *v = r / beta);
+                .par_for_each(|v, r| *v = S::store(r.load() / beta));
             g.fill(C64::new(0.0, 0.0));
             g[0] = C64::new(beta, 0.0);
             let mut k_used = 0;
@@ -90,12 +91,12 @@ impl IterativeMethod for Gmres {
                     h[i * m + k] = hik;
                     Zip::from(&mut *w)
                         .and(vi)
-                        .par_for_each(|w, v| *w -= hik * v);
+                        .par_for_each(|w, v| *w = S::store(w.load() - hik * v.load()));
                 }
-                let hn = dot(w, w).re.sqrt();
+                let hn = norm_sqr(w).sqrt();
                 h[(k + 1) * m + k] = C64::new(hn, 0.0);
                 if hn > 0.0 {
-                    w.mapv_inplace(|x| x / hn);
+                    w.mapv_inplace(|x| S::store(x.load() / hn));
                 }
                 for i in 0..k {
                     let (a, b) = (h[i * m + k], h[(i + 1) * m + k]);
@@ -132,7 +133,7 @@ impl IterativeMethod for Gmres {
             for (i, yi) in y.iter().enumerate() {
                 Zip::from(&mut *u)
                     .and(&basis[i])
-                    .par_for_each(|u, v| *u += yi * v);
+                    .par_for_each(|u, v| *u = S::store(u.load() + yi * v.load()));
             }
         }
     }

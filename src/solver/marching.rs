@@ -20,7 +20,7 @@
 //! and an inverse 2-D FFT.
 
 use super::{
-    Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, System, Validity,
+    Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, Storage, System, Validity,
 };
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
@@ -52,7 +52,7 @@ pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
     (er, rad)
 }
 
-impl IterativeMethod for TimeMarching {
+impl<S: Storage> IterativeMethod<S> for TimeMarching {
     fn kind(&self) -> MethodUsed {
         MethodUsed::TimeMarching
     }
@@ -64,11 +64,11 @@ impl IterativeMethod for TimeMarching {
     fn run(
         &self,
         sys: &mut System,
-        u: &mut Array3<C64>,
+        u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
         let (er, es) = (sys.shift.er, sys.shift.es);
-        let mut r = Array3::zeros(u.dim());
+        let mut r = Array3::<S>::default(u.dim());
         let step = self.step;
         let mut monitor = Monitor::new(MethodUsed::TimeMarching);
         for it in 0..=ctl.max_iterations {
@@ -85,7 +85,7 @@ impl IterativeMethod for TimeMarching {
             sys.precondition(&mut r);
             Zip::from(&mut *u)
                 .and(&r)
-                .par_for_each(|u, w| *u += step * w);
+                .par_for_each(|u, w| *u = S::store(u.load() + step * w.load()));
         }
         unreachable!("loop returns")
     }

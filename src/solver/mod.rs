@@ -24,14 +24,17 @@ pub mod green;
 pub mod marching;
 pub mod operator;
 pub mod shift;
+pub mod storage;
 
-use crate::config::Method;
+use crate::config::{Method, Precision};
 use ndarray::{Array2, Array3, Zip};
-use num_complex::Complex64 as C64;
+use num_complex::{Complex32 as C32, Complex64 as C64};
 use operator::{GreenTable, Lattice, Operator, Workspace};
 use shift::{BandScratch, ShiftTable};
 use std::fmt;
 use std::time::Instant;
+pub use storage::{dot, Storage};
+use storage::{norm_sqr, sum_slices};
 
 /// Which method produced a solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -149,6 +152,8 @@ impl Problem<'_> {
 pub struct Controls {
     pub tolerance: f64,
     pub max_iterations: usize,
+    /// Field storage of the iterative methods ([`storage`]).
+    pub precision: Precision,
 }
 
 /// How far a method can be trusted on a problem, before running it.
@@ -229,10 +234,10 @@ pub enum Restart {
 
 impl System<'_> {
     /// Shared start of a GMRES cycle or a BiCGStab run.
-    pub fn restart(
+    pub fn restart<S: Storage>(
         &mut self,
-        u: &Array3<C64>,
-        r: &mut Array3<C64>,
+        u: &Array3<S>,
+        r: &mut Array3<S>,
         monitor: &mut Monitor,
         iterations: usize,
         ctl: &Controls,
@@ -242,7 +247,7 @@ impl System<'_> {
             return Ok(Restart::Converged(res));
         }
         self.precondition(r);
-        let norm = dot(r, r).re.sqrt();
+        let norm = norm_sqr(r).sqrt();
         Ok(Restart::Go {
             norm,
             target: 0.5 * norm * ctl.tolerance / res,
@@ -250,8 +255,9 @@ impl System<'_> {
     }
 }
 
-/// An iterative method for the shared discrete equation.
-pub trait IterativeMethod {
+/// An iterative method for the shared discrete equation, with its fields
+/// stored as `S` ([`storage`]).
+pub trait IterativeMethod<S: Storage> {
     fn kind(&self) -> MethodUsed;
     /// A cheap a-priori statement of where the method is valid.
     fn validity(&self, sys: &mut System) -> Validity;
@@ -259,7 +265,7 @@ pub trait IterativeMethod {
     fn run(
         &self,
         sys: &mut System,
-        u: &mut Array3<C64>,
+        u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError>;
 }
@@ -267,11 +273,13 @@ pub trait IterativeMethod {
 /// The discrete equation `u = u_bg + G_b V u` and the scratch to work on it.
 pub struct System<'a> {
     pub op: Operator,
-    pub binder: GreenTable,
+    /// `G_b`'s tables, built on the first plain residual (Born) and
+    /// released by [`System::release_binder`] when Born is not used.
+    binder: Option<GreenTable>,
     pub eps: &'a Array3<C64>,
     pub eps_binder: f64,
-    /// V = k0² (ε − ε_b).
-    pub v: Array3<C64>,
+    /// k0².
+    k2: f64,
     /// Cell averages of u_bg per z (constant in x, y).
     pub ubg: Vec<C64>,
     pub r_bg: C64,
@@ -280,8 +288,6 @@ pub struct System<'a> {
     /// CBS shift: real centre ε_r, ε_s, c = k0²(ε_r + iε_s − ε_b), and the
     /// exact per-harmonic shifted operators.
     pub shift: Shift,
-    /// V' = k0² (ε − ε_r − iε_s) = V − c.
-    pub v_shift: Array3<C64>,
     /// u_s = (I − c G_b)⁻¹ u_bg per z cell (harmonic 00 only).
     pub us: Vec<C64>,
     us_norm: f64,
@@ -289,7 +295,8 @@ pub struct System<'a> {
     top00: Vec<C64>,
     bottom00: Vec<C64>,
     pub ws: Workspace,
-    /// Scratch field.
+    /// The f64 field every operator application works on (V u or V' u in,
+    /// G of it out); the methods' own fields may be f32.
     pub tmp: Array3<C64>,
 }
 
@@ -323,9 +330,7 @@ impl<'a> System<'a> {
             ));
         }
         let op = Operator::new(lat);
-        let binder = GreenTable::new(&lat, C64::new(p.eps_binder, 0.0));
         let k2 = lat.k0 * lat.k0;
-        let v = p.eps.mapv(|e| k2 * (e - p.eps_binder));
         let mut ubg = vec![C64::new(0.0, 0.0); lat.nz];
         let g2 = C64::new(k2 * p.eps_binder - lat.q[0].powi(2) - lat.q[1].powi(2), 0.0);
         let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
@@ -335,7 +340,6 @@ impl<'a> System<'a> {
         let es = (SHIFT_MARGIN * rad).max(1e-9);
         let c = k2 * (C64::new(er, es) - p.eps_binder);
         let table = ShiftTable::new(&lat, p.eps_binder, c);
-        let v_shift = v.mapv(|v| v - c);
         let mut scr = BandScratch::new(lat.nz);
         scr.column().copy_from_slice(&ubg);
         table.solve_column(0, &mut scr);
@@ -350,16 +354,15 @@ impl<'a> System<'a> {
         let tmp = Array3::zeros(p.eps.dim());
         Ok(System {
             shift,
-            v_shift,
+            k2,
             us,
             us_norm,
             top00,
             bottom00,
             op,
-            binder,
+            binder: None,
             eps: p.eps,
             eps_binder: p.eps_binder,
-            v,
             ubg,
             r_bg,
             t_bg,
@@ -370,122 +373,118 @@ impl<'a> System<'a> {
     }
 
     /// Fill `u` with the background field.
-    pub fn set_background(&self, u: &mut Array3<C64>) {
+    pub fn set_background<S: Storage>(&self, u: &mut Array3<S>) {
         for (j, mut slice) in u.outer_iter_mut().enumerate() {
-            slice.fill(self.ubg[j]);
+            slice.fill(S::store(self.ubg[j]));
         }
     }
 
+    /// `tmp ← (V − shift) x` with `V = k0²(ε − ε_b)`.
+    fn load_scaled<S: Storage>(&mut self, x: &Array3<S>, shift: C64) {
+        let (k2, eb) = (self.k2, self.eps_binder);
+        Zip::from(&mut self.tmp)
+            .and(x)
+            .and(self.eps)
+            .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
+    }
+
+    /// `out ← base_j + tmp − u` per z-slice j.
+    fn finish_residual<S: Storage>(&self, base: &[C64], u: &Array3<S>, out: &mut Array3<S>) {
+        use rayon::prelude::*;
+        out.outer_iter_mut()
+            .into_par_iter()
+            .zip(u.outer_iter().into_par_iter())
+            .zip(self.tmp.outer_iter().into_par_iter())
+            .zip(base.par_iter())
+            .for_each(|(((mut o, u), t), b)| {
+                Zip::from(&mut o)
+                    .and(&u)
+                    .and(&t)
+                    .for_each(|o, u, t| *o = S::store(b + t - u.load()));
+            });
+    }
+
     /// `out ← u_bg + G V u − u` (the residual); returns ‖out‖ / ‖u_bg‖.
-    pub fn residual(&mut self, u: &Array3<C64>, out: &mut Array3<C64>) -> f64 {
-        Zip::from(&mut *out)
-            .and(u)
-            .and(&self.v)
-            .par_for_each(|o, u, v| *o = v * u);
-        self.op.apply(&self.binder, out, &mut self.ws);
-        let ubg = &self.ubg;
-        for (j, (mut o, uu)) in out.outer_iter_mut().zip(u.outer_iter()).enumerate() {
-            Zip::from(&mut o).and(&uu).for_each(|o, u| *o += ubg[j] - u);
-        }
+    pub fn residual<S: Storage>(&mut self, u: &Array3<S>, out: &mut Array3<S>) -> f64 {
+        self.load_scaled(u, C64::new(0.0, 0.0));
+        let lat = self.op.lat;
+        let binder = self
+            .binder
+            .get_or_insert_with(|| GreenTable::new(&lat, C64::new(self.eps_binder, 0.0)));
+        self.op.apply(binder, &mut self.tmp, &mut self.ws);
+        self.finish_residual(&self.ubg, u, out);
         self.norm(out)
+    }
+
+    /// Drop `G_b`'s tables (as large as a field) once Born is ruled out.
+    pub fn release_binder(&mut self) {
+        self.binder = None;
     }
 
     /// `out ← u_s + G_s V' u − u`, the residual of the same equation in its
     /// shifted form (`= (I − c G_b)⁻¹ × the plain residual`); returns
     /// ‖out‖ / ‖u_s‖. Never applies `G_b`, so guided-mode poles of the binder
     /// slab cannot enter.
-    pub fn residual_shifted(&mut self, u: &Array3<C64>, out: &mut Array3<C64>) -> f64 {
-        Zip::from(&mut *out)
-            .and(u)
-            .and(&self.v_shift)
-            .par_for_each(|o, u, v| *o = v * u);
+    pub fn residual_shifted<S: Storage>(&mut self, u: &Array3<S>, out: &mut Array3<S>) -> f64 {
+        self.load_scaled(u, self.shift.c);
         self.op
-            .apply_shifted_green(&self.shift.table, out, &mut self.ws);
-        let us = &self.us;
-        for (j, (mut o, uu)) in out.outer_iter_mut().zip(u.outer_iter()).enumerate() {
-            Zip::from(&mut o).and(&uu).for_each(|o, u| *o += us[j] - u);
-        }
+            .apply_shifted_green(&self.shift.table, &mut self.tmp, &mut self.ws);
+        self.finish_residual(&self.us, u, out);
         self.norm(out) * self.ubg_norm / self.us_norm
     }
 
     /// `out ← x − G_s V' x` (the shifted operator, without u_s).
-    pub fn apply_a_shifted(&mut self, x: &Array3<C64>, out: &mut Array3<C64>) {
+    pub fn apply_a_shifted<S: Storage>(&mut self, x: &Array3<S>, out: &mut Array3<S>) {
+        self.load_scaled(x, self.shift.c);
+        self.op
+            .apply_shifted_green(&self.shift.table, &mut self.tmp, &mut self.ws);
         Zip::from(&mut *out)
             .and(x)
-            .and(&self.v_shift)
-            .par_for_each(|o, x, v| *o = v * x);
-        self.op
-            .apply_shifted_green(&self.shift.table, out, &mut self.ws);
-        Zip::from(&mut *out).and(x).par_for_each(|o, x| *o = x - *o);
+            .and(&self.tmp)
+            .par_for_each(|o, x, t| *o = S::store(x.load() - t));
     }
 
     /// `x ← γ x`, γ = 1 + i(ε − ε_r)/ε_s: the CBS preconditioner of the
     /// shifted form.
-    pub fn precondition(&self, x: &mut Array3<C64>) {
+    pub fn precondition<S: Storage>(&self, x: &mut Array3<S>) {
         let (er, es) = (self.shift.er, self.shift.es);
         Zip::from(x)
             .and(self.eps)
-            .par_for_each(|x, e| *x *= 1.0 + C64::i() * (e - er) / es);
+            .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)));
     }
 
     /// ‖x‖ / ‖u_bg‖.
-    pub fn norm(&self, x: &Array3<C64>) -> f64 {
-        sum_slices(x, |c, _| c.norm_sqr(), x).sqrt() / self.ubg_norm
+    pub fn norm<S: Storage>(&self, x: &Array3<S>) -> f64 {
+        norm_sqr(x).sqrt() / self.ubg_norm
     }
 
     /// Far-field amplitudes and absorption of a field.
-    fn outputs(&mut self, u: &Array3<C64>) -> (Array2<C64>, Array2<C64>, f64) {
+    fn outputs<S: Storage>(&mut self, u: &Array3<S>) -> (Array2<C64>, Array2<C64>, f64) {
         let lat = self.op.lat;
-        let mut src = std::mem::replace(&mut self.tmp, Array3::zeros((0, 0, 0)));
         let mut r = Array2::zeros((lat.nx, lat.ny));
         let mut t = Array2::zeros((lat.nx, lat.ny));
         // G_b V u = G_b(V' u + c u) = w + c G_b(u − G_s V' u), and at the
         // solution u − G_s V' u = u_s (harmonic 00 only): boundary values of
         // w from the shifted sweep, of G_b u_s from the 00 functionals.
-        Zip::from(&mut src)
-            .and(u)
-            .and(&self.v_shift)
-            .par_for_each(|o, u, v| *o = v * u);
-        self.op
-            .shifted_boundary(&self.shift.table, &mut src, &mut self.ws, &mut r, &mut t);
-        self.tmp = src;
+        self.load_scaled(u, self.shift.c);
+        self.op.shifted_boundary(
+            &self.shift.table,
+            &mut self.tmp,
+            &mut self.ws,
+            &mut r,
+            &mut t,
+        );
         let c = self.shift.c;
         let us_top: C64 = self.top00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
         let us_bottom: C64 = self.bottom00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
         r[[0, 0]] += self.r_bg + c * us_top;
         t[[0, 0]] += self.t_bg + c * us_bottom;
         let dz = lat.size_nm[2] / lat.nz as f64;
-        let s = sum_slices(u, |u, e| e.im * u.norm_sqr(), self.eps);
+        let s = sum_slices(u, |u: &S, e: &C64| e.im * u.load().norm_sqr(), self.eps);
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
     }
-}
-
-/// Σ f(a, b) over all voxels, parallel over z-slices but summed in a fixed
-/// order, so the result is bit-identical for any thread count.
-fn sum_slices(a: &Array3<C64>, f: impl Fn(&C64, &C64) -> f64 + Sync, b: &Array3<C64>) -> f64 {
-    use rayon::prelude::*;
-    let parts: Vec<f64> = a
-        .outer_iter()
-        .into_par_iter()
-        .zip(b.outer_iter().into_par_iter())
-        .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| f(x, y)).sum())
-        .collect();
-    parts.iter().sum()
-}
-
-/// ⟨a, b⟩ = Σ conj(a) b, summed per z-slice in parallel and then in a fixed
-/// order (thread-count independent).
-pub fn dot(a: &Array3<C64>, b: &Array3<C64>) -> C64 {
-    use rayon::prelude::*;
-    let parts: Vec<C64> = a
-        .outer_iter()
-        .into_par_iter()
-        .zip(b.outer_iter().into_par_iter())
-        .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| x.conj() * y).sum())
-        .collect();
-    parts.iter().sum()
 }
 
 /// A solved problem: the field and what the far field needs.
@@ -502,11 +501,23 @@ pub struct Solution {
     pub record: SolveRecord,
 }
 
-/// Solve one problem with the requested method (`Auto` picks and falls back).
+/// Solve one problem with the requested method (`Auto` picks and falls
+/// back) and the field storage of `ctl.precision`.
 pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, SolveError> {
+    match ctl.precision {
+        Precision::F64 => solve_stored::<C64>(p, method, ctl),
+        Precision::F32 => solve_stored::<C32>(p, method, ctl),
+    }
+}
+
+fn solve_stored<S: Storage>(
+    p: &Problem,
+    method: Method,
+    ctl: &Controls,
+) -> Result<Solution, SolveError> {
     let start = Instant::now();
     let mut sys = System::new(p)?;
-    let mut u = Array3::zeros(p.eps.dim());
+    let mut u = Array3::<S>::default(p.eps.dim());
     sys.set_background(&mut u);
     let born = born::Born;
     let gm = gmres::Gmres::default();
@@ -521,11 +532,14 @@ pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, So
             // Born only where its contraction estimate is good; then BiCGStab;
             // time-marching (always convergent) as the last resort. Each
             // failure is recorded.
-            let mut chain: Vec<&dyn IterativeMethod> = vec![&bi, &tm];
+            let mut chain: Vec<&dyn IterativeMethod<S>> = vec![&bi, &tm];
             let mut notes = vec![];
             let mut spent = 0;
-            match born.validity(&mut sys) {
-                Validity::Unlikely(why) => notes.push(format!("skipped Born: {why}")),
+            match IterativeMethod::<S>::validity(&born, &mut sys) {
+                Validity::Unlikely(why) => {
+                    notes.push(format!("skipped Born: {why}"));
+                    sys.release_binder();
+                }
                 Validity::Likely(why) => {
                     notes.push(format!("chose Born: {why}"));
                     chain.insert(0, &born);
@@ -562,17 +576,22 @@ pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, So
         }
     };
     let (r, t, absorption) = sys.outputs(&u);
+    let mut note = out.note;
+    if ctl.precision == Precision::F32 {
+        note.push_str("; f32 field storage");
+    }
     let record = SolveRecord {
         method: used,
         iterations: out.iterations,
         operator_applications: out.applications,
         residual: out.residual,
         seconds: start.elapsed().as_secs_f64(),
-        note: out.note,
+        note,
     };
+    drop(sys);
     Ok(Solution {
         lattice: p.lattice,
-        field: u,
+        field: u.mapv(S::load),
         r,
         t,
         absorption,

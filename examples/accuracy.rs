@@ -62,6 +62,19 @@ fn knobs() -> Vec<(&'static str, Vec<Value>)> {
             .collect::<Vec<_>>()
     };
     let i = |v: &[i64]| v.iter().map(|&x| Value::Integer(x)).collect::<Vec<_>>();
+    // Spheres per particle: rice grains (aspect 3) of the case's effective
+    // diameter, built of n spheres.
+    let rice = |v: &[i64]| {
+        v.iter()
+            .map(|&n| {
+                let mut t = toml::map::Map::new();
+                t.insert("kind".into(), Value::String("rice".into()));
+                t.insert("aspect".into(), Value::Float(3.0));
+                t.insert("spheres".into(), Value::Integer(n));
+                Value::Table(t)
+            })
+            .collect::<Vec<_>>()
+    };
     vec![
         ("grid.cell_nm", f(&[50.0, 33.4, 25.0, 20.0, 16.7])),
         ("grid.z_cell_nm", f(&[25.0, 20.0, 10.0, 5.0])),
@@ -74,6 +87,8 @@ fn knobs() -> Vec<(&'static str, Vec<Value>)> {
         ("realisations", i(&[1, 2, 4, 8])),
         ("layer.fragment_nm", frag(&[700.0, 1000.0, 1500.0, 2000.0])),
         ("solver.method", s(&["time-marching", "gmres", "bicgstab"])),
+        ("solver.precision", s(&["f32", "f64"])),
+        ("pigment.0.shape", rice(&[3, 5, 7, 11])),
     ]
 }
 
@@ -114,11 +129,16 @@ name = "x"
     toml::from_str(&text).expect("valid base scene")
 }
 
+/// Set a dotted key; a numeric part indexes an array (`pigment.0.shape`).
 fn set(v: &mut Value, key: &str, value: Value) {
     let mut cur = v;
     let parts: Vec<&str> = key.split('.').collect();
     for p in &parts[..parts.len() - 1] {
-        cur = cur.get_mut(*p).expect("key exists in the base scene");
+        cur = match p.parse::<usize>() {
+            Ok(i) => cur.get_mut(i),
+            Err(_) => cur.get_mut(*p),
+        }
+        .expect("key exists in the base scene");
     }
     cur.as_table_mut()
         .expect("table")
@@ -263,6 +283,10 @@ fn compare(a: &AppearanceArrays, r: &AppearanceArrays, obs: &Observer) -> Errors
 fn show(v: &Value) -> String {
     match v {
         Value::Array(a) => show(&a[0]),
+        Value::Table(t) => match t.get("spheres") {
+            Some(n) => format!("rice, {n} spheres"),
+            None => v.to_string(),
+        },
         Value::String(s) => s.clone(),
         other => other.to_string(),
     }

@@ -314,6 +314,17 @@ pub const SHIFT_MARGIN: f64 = 1.05;
 
 impl<'a> System<'a> {
     pub fn new(p: &Problem<'a>) -> Result<Self, SolveError> {
+        Self::with_margin(p, SHIFT_MARGIN)
+    }
+
+    /// As [`System::new`] with the CBS shift `ε_s = margin · max|ε − ε_r|`
+    /// (margin ≥ 1; Osnabrugge et al. take 1, [`SHIFT_MARGIN`] is the default).
+    pub fn with_margin(p: &Problem<'a>, margin: f64) -> Result<Self, SolveError> {
+        if !(1.0..=100.0).contains(&margin) {
+            return Err(SolveError::Invalid(format!(
+                "CBS shift margin must be in [1, 100], got {margin}"
+            )));
+        }
         let lat = p.lattice;
         if p.eps.dim() != (lat.nz, lat.ny, lat.nx) {
             return Err(SolveError::Invalid(format!(
@@ -337,7 +348,7 @@ impl<'a> System<'a> {
         let ubg_norm =
             (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
         let (er, rad) = marching::shift_of(p.eps, p.eps_binder);
-        let es = (SHIFT_MARGIN * rad).max(1e-9);
+        let es = (margin * rad).max(1e-9);
         let c = k2 * (C64::new(er, es) - p.eps_binder);
         let table = ShiftTable::new(&lat, p.eps_binder, c);
         let mut scr = BandScratch::new(lat.nz);
@@ -458,6 +469,21 @@ impl<'a> System<'a> {
         norm_sqr(x).sqrt() / self.ubg_norm
     }
 
+    /// The solved field with its far-field amplitudes and absorption.
+    pub fn into_solution<S: Storage>(mut self, u: Array3<S>, record: SolveRecord) -> Solution {
+        let (r, t, absorption) = self.outputs(&u);
+        let lattice = self.op.lat;
+        drop(self);
+        Solution {
+            lattice,
+            field: u.mapv(S::load),
+            r,
+            t,
+            absorption,
+            record,
+        }
+    }
+
     /// Far-field amplitudes and absorption of a field.
     fn outputs<S: Storage>(&mut self, u: &Array3<S>) -> (Array2<C64>, Array2<C64>, f64) {
         let lat = self.op.lat;
@@ -575,7 +601,6 @@ fn solve_stored<S: Storage>(
             }
         }
     };
-    let (r, t, absorption) = sys.outputs(&u);
     let mut note = out.note;
     if ctl.precision == Precision::F32 {
         note.push_str("; f32 field storage");
@@ -588,13 +613,5 @@ fn solve_stored<S: Storage>(
         seconds: start.elapsed().as_secs_f64(),
         note,
     };
-    drop(sys);
-    Ok(Solution {
-        lattice: p.lattice,
-        field: u.mapv(S::load),
-        r,
-        t,
-        absorption,
-        record,
-    })
+    Ok(sys.into_solution(u, record))
 }

@@ -52,7 +52,10 @@ fn main() {
         "f32" => Precision::F32,
         p => panic!("unknown precision {p}"),
     };
-    let n: Vec<usize> = args[2..5].iter().map(|a| a.parse().expect("size")).collect();
+    let n: Vec<usize> = args[2..5]
+        .iter()
+        .map(|a| a.parse().expect("size"))
+        .collect();
     let iterations: usize = args.get(5).map_or(3, |a| a.parse().expect("iterations"));
     let (nx, ny, nz) = (n[0], n[1], n[2]);
     let voxels = (nx * ny * nz) as f64;

@@ -101,6 +101,9 @@ fn main() {
         max_iterations: 20_000,
         precision: Precision::F64,
     };
+    // Per layer and grid: worst k0·d, error, diffuse power, error / coherent
+    // term, diffuse / incoherent term, and the smallest estimate / error.
+    let mut summary: Vec<(String, [f64; 6])> = Vec::new();
     println!(
         "material,d_nm,pvc,H_nm,cell_nm,cell_z_nm,wl_nm,polar_deg,achieved_pvc,\
          dR,dT,dA,err,diffuse,balance,coherent_term,incoherent_term,estimate"
@@ -117,6 +120,7 @@ fn main() {
         );
         let geom = pack_rsa(&params, 7).expect("packing");
         for &(cl, cz) in &grids {
+            let mut worst = [0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY];
             let grid = Grid {
                 nx: (FRAGMENT_NM / cl).round() as usize,
                 ny: (FRAGMENT_NM / cl).round() as usize,
@@ -164,6 +168,13 @@ fn main() {
                         airy::effective_medium_terms(&[term], eps_b, c.thickness_nm, wl, polar);
                     let est =
                         airy::effective_medium_error(&[term], eps_b, c.thickness_nm, wl, polar);
+                    let k0d = 2.0 * std::f64::consts::PI / wl * c.diameter_nm;
+                    worst[0] = f64::max(worst[0], k0d);
+                    worst[1] = worst[1].max(err);
+                    worst[2] = worst[2].max(diffuse);
+                    worst[3] = worst[3].max(err / coh);
+                    worst[4] = worst[4].max(diffuse / inc);
+                    worst[5] = worst[5].min(est / err);
                     println!(
                         "{},{},{},{},{},{},{},{},{:.4},{:.3e},{:.3e},{:.3e},{:.3e},{:.3e},{:.1e},{:.3e},{:.3e},{:.3e}",
                         c.material,
@@ -187,6 +198,30 @@ fn main() {
                     );
                 }
             }
+            summary.push((
+                format!(
+                    "| {} | {} | {} | {} | {}/{} ",
+                    c.material, c.diameter_nm, c.pvc, c.thickness_nm, cl, cz
+                ),
+                worst,
+            ));
         }
     }
+    eprintln!(
+        "| grains | d nm | PVC | H nm | cells nm | max k0·d | max err R/T/A | max diffuse | \
+         max err / coherent | max diffuse / incoherent | min estimate / err |"
+    );
+    eprintln!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for (head, w) in &summary {
+        eprintln!(
+            "{head}| {:.3} | {:.2e} | {:.2e} | {:.3} | {:.3} | {:.2} |",
+            w[0], w[1], w[2], w[3], w[4], w[5]
+        );
+    }
+    let all = |i: usize| summary.iter().map(|(_, w)| w[i]).fold(0.0, f64::max);
+    eprintln!(
+        "all: max err / coherent {:.3}, max diffuse / incoherent {:.3}",
+        all(3),
+        all(4)
+    );
 }

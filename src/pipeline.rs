@@ -470,6 +470,23 @@ fn effective_medium_shortcut(scene: &Scene, polar_deg: &[f64]) -> Result<String,
             scene.total_pvc()
         ));
     }
+    let d_max = scene
+        .species
+        .iter()
+        .map(|s| s.size.max_diameter(s.diameter_nm))
+        .fold(0.0, f64::max);
+    let lambda_min = scene
+        .wavelengths_nm
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let x = 2.0 * std::f64::consts::PI / lambda_min * d_max;
+    if x > airy::EFFECTIVE_MAX_SIZE_PARAMETER {
+        return Err(format!(
+            "grains up to {d_max:.3} nm are beyond λ/20 at {lambda_min} nm (k0 d = {x:.3}), \
+             outside the range where the effective-medium error was measured"
+        ));
+    }
     let eps_b = scene.layer.binder_index.powi(2);
     let mut worst = (0.0, 0.0, 0.0);
     for &lambda in &scene.wavelengths_nm {
@@ -493,11 +510,6 @@ fn effective_medium_shortcut(scene: &Scene, polar_deg: &[f64]) -> Result<String,
         }
     }
     let (est, lambda, p) = worst;
-    let d_max = scene
-        .species
-        .iter()
-        .map(|s| s.size.max_diameter(s.diameter_nm))
-        .fold(0.0, f64::max);
     let at = format!(
         "estimated error in R/T/A {est:.1e} (grains ≤ {d_max:.3} nm, worst at {lambda} nm, \
          {}°)",

@@ -174,8 +174,8 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
 #[test]
 fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
     let dir = tempfile::tempdir().unwrap();
-    // 150 nm grains: the estimate is far above the tolerance.
-    let text = scene_text(dir.path(), 150.0, "effective_medium_tolerance = 1e-2")
+    // 15 nm grains (λ/30): the estimate is above the default tolerance.
+    let text = scene_text(dir.path(), 15.0, "")
         .replace("[450.0, 550.0, 650.0]", "[550.0]")
         .replace("polar_deg = [0.0, 40.0]", "polar_deg = [0.0]")
         .replace("kind = \"paper\"\nalbedo = 0.9", "kind = \"none\"");
@@ -188,10 +188,10 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
         .find(|l| l.starts_with("effective-medium shortcut: refused"))
         .unwrap();
     assert!(
-        line.contains("> solver.effective_medium_tolerance 1.0e-2"),
+        line.contains("> solver.effective_medium_tolerance 1.0e-3"),
         "{line}"
     );
-    assert!(planned_estimate(&plan) > 1e-2);
+    assert!(planned_estimate(&plan) > 1e-3);
     let rep = run(dir.path(), &text);
     assert!(rep.geometry.is_some());
     assert_eq!(rep.entries.len(), 1);
@@ -205,6 +205,10 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
         (
             fine.replace("outputs = [\"tile\"]", "outputs = [\"brdf\", \"tile\"]"),
             "the BRDF table is the grains' diffuse scattering",
+        ),
+        (
+            scene_text(dir.path(), 30.0, "effective_medium_tolerance = 0.1"),
+            "beyond λ/20 at 450 nm",
         ),
         (
             fine.replace("pvc = 0.1", "pvc = 0.1\nrelief_fraction = 0.3"),
@@ -294,7 +298,7 @@ fn the_estimate_bounds_measured_errors_and_is_not_vacuous() {
         (&strong, 10.0, 0.1, 400.0, 60.0),
         (&red, 20.0, 0.3, 450.0, 0.0),
         (&white, 10.0, 0.1, 400.0, 60.0),
-        (&white, 40.0, 0.3, 550.0, 0.0),
+        (&white, 20.0, 0.3, 550.0, 0.0),
     ] {
         let (err, est) = measured(m, d, pvc, wl, polar);
         assert!(

@@ -72,10 +72,15 @@ pub struct GrainTerm {
     pub delta_eps: C64,
 }
 
+/// Largest grain size parameter `k0 d` (d = λ/20) at which the estimate was
+/// measured to hold: beyond it single grains scatter strongly (lossless
+/// high-index grains broke the linear law at `k0 d` = 0.63), so the shortcut
+/// is not offered there whatever the tolerance.
+pub const EFFECTIVE_MAX_SIZE_PARAMETER: f64 = std::f64::consts::PI / 10.0;
 /// Measured constant of the coherent term (docs/ACCURACY.md).
 pub const EFFECTIVE_COHERENT: f64 = 0.5;
 /// Measured constant of the incoherent (diffuse) term (docs/ACCURACY.md).
-pub const EFFECTIVE_INCOHERENT: f64 = 0.2;
+pub const EFFECTIVE_INCOHERENT: f64 = 0.25;
 
 /// The two terms of the effective-medium error, without their constants,
 /// at one wavelength and incidence (`k0 = 2π/λ`, `θ_t` the refracted angle
@@ -112,7 +117,9 @@ pub fn effective_medium_terms(
 /// Conservative estimate of the largest absolute error in R, T or A when a
 /// layer of grains is replaced by the homogeneous slab of the volume-averaged
 /// ε: `C_coh · coherent + C_inc · incoherent` ([`effective_medium_terms`])
-/// with the measured constants [`EFFECTIVE_COHERENT`], [`EFFECTIVE_INCOHERENT`].
+/// with the measured constants [`EFFECTIVE_COHERENT`], [`EFFECTIVE_INCOHERENT`];
+/// measured to hold for `k0 d ≤` [`EFFECTIVE_MAX_SIZE_PARAMETER`], PVC ≤ 0.3,
+/// spheres dispersed by random sequential addition inside a flat binder.
 pub fn effective_medium_error(
     grains: &[GrainTerm],
     eps_binder: f64,

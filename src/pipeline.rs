@@ -243,14 +243,30 @@ impl RunPlan {
     pub fn of(scene: &Scene) -> RunPlan {
         let mut lines = Vec::new();
         let products = scene.appearance.products;
-        let analytic = scene.is_molecular();
         let explicit = scene.structure.is_some();
-        if analytic {
+        let (above, extra) = above_angles(scene);
+        let paper = matches!(scene.substrate, Substrate::Paper { .. });
+        let below =
+            (products.tile && paper).then(|| Hemisphere::new(scene.appearance.quadrature_points));
+        let shortcut = if scene.is_molecular() || explicit {
+            None
+        } else {
+            let mut angles = above.clone();
+            angles.extend(below.iter().flat_map(|h| h.polar_deg()));
+            Some(effective_medium_shortcut(scene, &angles))
+        };
+        let analytic = scene.is_molecular() || matches!(shortcut, Some(Ok(_)));
+        if scene.is_molecular() {
             lines.push(
                 "geometry: none — molecular mixture: the homogeneous slab with the \
                  volume-averaged ε, solved in closed form (Airy); no grid, no iteration"
                     .to_string(),
             );
+        } else if let Some(Ok(why)) = &shortcut {
+            lines.push(format!(
+                "geometry: none — effective-medium shortcut: {why}; the homogeneous slab with \
+                 the volume-averaged ε, solved in closed form (Airy); no packing, no grid, no iteration"
+            ));
         } else if let Some(st) = &scene.structure {
             lines.push(match st {
                 Structure::Primitives(ps) => format!(
@@ -265,6 +281,9 @@ impl RunPlan {
         } else {
             let (packer, why) = packer_of(scene);
             lines.push(format!("geometry: {packer} ({why})"));
+            if let Some(Err(why)) = &shortcut {
+                lines.push(format!("effective-medium shortcut: refused — {why}"));
+            }
         }
         if !analytic && !explicit {
             let rf = scene.layer.relief_fraction;
@@ -314,17 +333,6 @@ impl RunPlan {
         let seeds = (0..realisations)
             .map(|r| realisation_seed(scene.seed, r))
             .collect();
-        let illum: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
-        let mut above = illum.clone();
-        if products.tile {
-            for &v in &scene.appearance.viewing_deg {
-                if !above.contains(&v) {
-                    above.push(v);
-                }
-            }
-            above.sort_by(f64::total_cmp);
-        }
-        let extra = above.len() - illum.len();
         lines.push(format!(
             "solves from above at {} polar angles {}{}",
             above.len(),
@@ -335,25 +343,20 @@ impl RunPlan {
                 String::new()
             }
         ));
-        let paper = matches!(scene.substrate, Substrate::Paper { .. });
-        let below = if products.tile && paper {
-            let h = Hemisphere::new(scene.appearance.quadrature_points);
+        if let Some(h) = &below {
             lines.push(format!(
                 "solves from below (layer flipped) at {} Gauss–Legendre nodes {}: the paper term needs R_dd↑ and T_d",
                 h.mu.len(),
                 fmt_list(&h.polar_deg())
             ));
-            Some(h)
         } else if !paper {
             lines.push("solves from below: skipped — no substrate".to_string());
-            None
         } else {
             lines.push(
                 "solves from below: skipped — no tile requested, nothing uses the paper term"
                     .to_string(),
             );
-            None
-        };
+        }
         let max_wl = scene.wavelengths_nm.iter().copied().fold(0.0, f64::max);
         let l = &scene.layer;
         let cell = scene
@@ -405,6 +408,119 @@ impl RunPlan {
     /// Total solves of a run.
     pub fn solves(&self, scene: &Scene) -> usize {
         self.realisations * scene.wavelengths_nm.len() * self.solves_per_wavelength()
+    }
+}
+
+/// Polar angles solved from above (the illumination angles, plus the
+/// viewing angles when the tile needs R and T there), and how many of them
+/// are viewing-only.
+fn above_angles(scene: &Scene) -> (Vec<f64>, usize) {
+    let illum: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
+    let mut above = illum.clone();
+    if scene.appearance.products.tile {
+        for &v in &scene.appearance.viewing_deg {
+            if !above.contains(&v) {
+                above.push(v);
+            }
+        }
+        above.sort_by(f64::total_cmp);
+    }
+    let extra = above.len() - illum.len();
+    (above, extra)
+}
+
+/// Whether a layer of generated grains may be replaced by the homogeneous
+/// slab of the volume-averaged ε: `Ok(why)` when the measured estimate
+/// ([`airy::effective_medium_error`]) at the scene's worst wavelength and
+/// angle is within `[solver] effective_medium_tolerance`, `Err(why not)`
+/// otherwise, or when the layer has something the slab cannot represent.
+fn effective_medium_shortcut(scene: &Scene, polar_deg: &[f64]) -> Result<String, String> {
+    let tol = scene.solver.effective_medium_tolerance;
+    if tol <= 0.0 {
+        return Err("solver.effective_medium_tolerance = 0".to_string());
+    }
+    let products = scene.appearance.products;
+    if products.brdf || products.btdf {
+        return Err(format!(
+            "the {} table is the grains' diffuse scattering, which a homogeneous slab does not have \
+             (outputs = [\"tile\"] allows the shortcut)",
+            if products.brdf { "BRDF" } else { "BTDF" }
+        ));
+    }
+    if scene.layer.relief_fraction > 0.0 {
+        return Err("surface relief: grains protruding through the top are not a flat slab".into());
+    }
+    if let Some(s) = scene.species.iter().find(|s| s.shape != GrainShape::Sphere) {
+        return Err(format!(
+            "`{}` grains are not spheres; the estimate was measured on sphere layers",
+            s.name
+        ));
+    }
+    if let Some(s) = scene.species.iter().find(|s| s.cluster_size > 1) {
+        return Err(format!(
+            "`{}` grains agglomerate (clusters scatter as larger grains); the estimate was \
+             measured on dispersed grains",
+            s.name
+        ));
+    }
+    if scene.total_pvc() > RSA_MAX_PVC {
+        return Err(format!(
+            "PVC {:.3} > {RSA_MAX_PVC}: the estimate was measured on random-sequential-addition \
+             layers up to PVC {RSA_MAX_PVC}",
+            scene.total_pvc()
+        ));
+    }
+    let d_max = scene
+        .species
+        .iter()
+        .map(|s| s.size.max_diameter(s.diameter_nm))
+        .fold(0.0, f64::max);
+    let lambda_min = scene
+        .wavelengths_nm
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let x = 2.0 * std::f64::consts::PI / lambda_min * d_max;
+    if x > airy::EFFECTIVE_MAX_SIZE_PARAMETER {
+        return Err(format!(
+            "grains up to {d_max:.3} nm are beyond λ/20 at {lambda_min} nm (k0 d = {x:.3}), \
+             outside the range where the effective-medium error was measured"
+        ));
+    }
+    let eps_b = scene.layer.binder_index.powi(2);
+    let mut worst = (0.0, 0.0, 0.0);
+    for &lambda in &scene.wavelengths_nm {
+        let eps = species_eps(scene, lambda).map_err(|e| e.to_string())?;
+        let grains: Vec<airy::GrainTerm> = scene
+            .species
+            .iter()
+            .zip(&eps)
+            .map(|(s, e)| airy::GrainTerm {
+                volume_fraction: s.volume_fraction,
+                diameter_nm: s.size.max_diameter(s.diameter_nm),
+                delta_eps: e - eps_b,
+            })
+            .collect();
+        for &p in polar_deg {
+            let est =
+                airy::effective_medium_error(&grains, eps_b, scene.layer.thickness_nm, lambda, p);
+            if est >= worst.0 {
+                worst = (est, lambda, p);
+            }
+        }
+    }
+    let (est, lambda, p) = worst;
+    let at = format!(
+        "estimated error in R/T/A {est:.1e} (grains ≤ {d_max:.3} nm, worst at {lambda} nm, \
+         {}°)",
+        (p * 100.0).round() / 100.0
+    );
+    if est <= tol {
+        Ok(format!("{at} ≤ tolerance {tol:.1e}"))
+    } else {
+        Err(format!(
+            "{at} > solver.effective_medium_tolerance {tol:.1e}: full solve"
+        ))
     }
 }
 
@@ -624,8 +740,9 @@ pub fn solve_layer(
     Ok(entries)
 }
 
-/// The homogeneous slab of a molecular mixture, `⟨ε⟩ = Σ f ε_s + (1 − Σ f) ε_b`,
-/// in closed form for every (wavelength, incidence, side).
+/// The homogeneous slab of a molecular mixture (or of grains fine enough for
+/// the effective-medium shortcut), `⟨ε⟩ = Σ f ε_s + (1 − Σ f) ε_b`, in closed
+/// form for every (wavelength, incidence, side).
 pub fn solve_analytic(
     scene: &Scene,
     plan: &RunPlan,
@@ -652,8 +769,14 @@ pub fn solve_analytic(
                     residual: 0.0,
                     seconds: start.elapsed().as_secs_f64(),
                     note: format!(
-                        "molecular mixture: homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form",
-                        mean.re, mean.im
+                        "{}: homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form",
+                        if scene.is_molecular() {
+                            "molecular mixture"
+                        } else {
+                            "effective-medium shortcut (grains fine against λ)"
+                        },
+                        mean.re,
+                        mean.im
                     ),
                 },
             };

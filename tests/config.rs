@@ -161,6 +161,28 @@ fn solver_precision_parses_and_limits_the_tolerance() {
 }
 
 #[test]
+fn effective_medium_tolerance_defaults_and_is_limited() {
+    assert_eq!(parse(BASE).unwrap().solver.effective_medium_tolerance, 1e-3);
+    for v in ["0.0", "0.02", "0.1"] {
+        let s = parse(&format!(
+            "{BASE}\n[solver]\neffective_medium_tolerance = {v}\n"
+        ))
+        .unwrap();
+        assert_eq!(
+            s.solver.effective_medium_tolerance,
+            v.parse::<f64>().unwrap()
+        );
+    }
+    for v in ["-1e-3", "0.2", "nan"] {
+        let (key, msg) = invalid(&format!(
+            "{BASE}\n[solver]\neffective_medium_tolerance = {v}\n"
+        ));
+        assert_eq!(key, "solver.effective_medium_tolerance");
+        assert!(msg.contains("[0, 0.1]"), "{msg}");
+    }
+}
+
+#[test]
 fn unknown_key_is_named_on_one_line() {
     let text = edit(
         "thickness_nm = 1000.0",

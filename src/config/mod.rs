@@ -204,6 +204,10 @@ pub struct SolverSpec {
     pub max_iterations: usize,
     /// Field storage.
     pub precision: Precision,
+    /// Largest absolute error in R, T or A accepted from replacing a grain
+    /// layer by the homogeneous slab of the volume-averaged ε (closed form,
+    /// no solve) when the measured estimate allows it; 0 never does.
+    pub effective_medium_tolerance: f64,
 }
 
 /// One direction of incidence (from above, in vacuum).

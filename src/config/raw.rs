@@ -193,6 +193,7 @@ pub struct RawSolver {
     pub tolerance: Option<f64>,
     pub max_iterations: Option<i64>,
     pub precision: Option<RawPrecision>,
+    pub effective_medium_tolerance: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

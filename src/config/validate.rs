@@ -65,6 +65,12 @@ const DEFAULT_MAX_ITERATIONS: usize = 5000;
 /// Smallest relative residual f32 field storage reaches reliably.
 pub const F32_MIN_TOLERANCE: f64 = 1e-6;
 const MAX_ITERATIONS: i64 = 10_000_000;
+/// Default accepted error of the effective-medium shortcut: the R/T/A error
+/// of the recommended 25 nm grid (docs/ACCURACY.md), so the shortcut costs
+/// no more accuracy than the discretisation it replaces.
+pub const DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 1e-3;
+/// Largest accepted error of the effective-medium shortcut.
+pub const MAX_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 0.1;
 /// Relative slack for ceilings and for landing on `stop` in a range.
 const REL_EPS: f64 = 1e-9;
 
@@ -1050,11 +1056,21 @@ impl Checker<'_> {
                 ),
             ));
         }
+        let e = raw
+            .and_then(|s| s.effective_medium_tolerance)
+            .unwrap_or(DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE);
+        let effective_medium_tolerance = self.range(
+            "solver.effective_medium_tolerance",
+            e,
+            (0.0..=MAX_EFFECTIVE_MEDIUM_TOLERANCE).contains(&e),
+            "[0, 0.1] (absolute error in R, T, A; 0 never takes the shortcut)",
+        )?;
         Ok(SolverSpec {
             method,
             tolerance,
             max_iterations,
             precision,
+            effective_medium_tolerance,
         })
     }
 

@@ -9,6 +9,10 @@
 //! The absorption is integrated from that field in closed form
 //! (`A = k0² Im ε ∫|u|² dz / β`), independently of `r` and `t`, so the energy
 //! balance `|r|² + |t|² + A − 1` stays a real check.
+//!
+//! [`effective_medium_error`] bounds how far a layer of fine grains is from
+//! this slab with the volume-averaged ε: the shortcut's error, measured
+//! against full solves (docs/ACCURACY.md, examples/effective_medium.rs).
 
 use super::green::{phi1, sqrt_branch};
 use num_complex::Complex64 as C64;
@@ -55,6 +59,76 @@ pub fn slab(eps: C64, thickness_nm: f64, wavelength_nm: f64, polar_deg: f64) -> 
     let integral = (a.norm_sqr() + b.norm_sqr()) * decay + 2.0 * cross.re;
     let absorption = k0 * k0 * eps.im * integral / beta.re;
     SlabResponse { r, t, absorption }
+}
+
+/// One grain species as [`effective_medium_error`] sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct GrainTerm {
+    /// Volume fraction of the species in the layer.
+    pub volume_fraction: f64,
+    /// Largest grain diameter of the species, nm.
+    pub diameter_nm: f64,
+    /// `ε_grain − ε_binder` at the wavelength.
+    pub delta_eps: C64,
+}
+
+/// Largest grain size parameter `k0 d` (d = λ/20) at which the estimate was
+/// measured to hold: beyond it single grains scatter strongly (lossless
+/// high-index grains broke the linear law at `k0 d` = 0.63), so the shortcut
+/// is not offered there whatever the tolerance.
+pub const EFFECTIVE_MAX_SIZE_PARAMETER: f64 = std::f64::consts::PI / 10.0;
+/// Measured constant of the coherent term (docs/ACCURACY.md).
+pub const EFFECTIVE_COHERENT: f64 = 0.5;
+/// Measured constant of the incoherent (diffuse) term (docs/ACCURACY.md).
+pub const EFFECTIVE_INCOHERENT: f64 = 0.25;
+
+/// The two terms of the effective-medium error, without their constants,
+/// at one wavelength and incidence (`k0 = 2π/λ`, `θ_t` the refracted angle
+/// in the binder):
+///
+/// * coherent, `Σ f |Δε| k0 d`: grains confined to the binder leave a
+///   depleted skin ~d/2 at each face and a denser interior, a first-order
+///   change of the mean profile (plus the `(k0 d)²` corrections of ⟨ε⟩);
+/// * incoherent, `Σ f |Δε|² (k0 d)³ k0 H / (24 cos θ_t)`: the power the
+///   grains scatter out of the specular order (Rayleigh cross-section of a
+///   scalar sphere, `k0⁴ |Δε|² V² / 4π`, times the number along the path),
+///   which the slab cannot carry.
+pub fn effective_medium_terms(
+    grains: &[GrainTerm],
+    eps_binder: f64,
+    thickness_nm: f64,
+    wavelength_nm: f64,
+    polar_deg: f64,
+) -> (f64, f64) {
+    let k0 = 2.0 * std::f64::consts::PI / wavelength_nm;
+    let s = polar_deg.to_radians().sin();
+    let cos_t = (1.0 - s * s / eps_binder.max(1.0)).max(1e-6).sqrt();
+    let mut coherent = 0.0;
+    let mut incoherent = 0.0;
+    for g in grains {
+        let x = k0 * g.diameter_nm;
+        let de = g.delta_eps.norm();
+        coherent += g.volume_fraction * de * x;
+        incoherent += g.volume_fraction * de * de * x.powi(3) * k0 * thickness_nm / (24.0 * cos_t);
+    }
+    (coherent, incoherent)
+}
+
+/// Conservative estimate of the largest absolute error in R, T or A when a
+/// layer of grains is replaced by the homogeneous slab of the volume-averaged
+/// ε: `C_coh · coherent + C_inc · incoherent` ([`effective_medium_terms`])
+/// with the measured constants [`EFFECTIVE_COHERENT`], [`EFFECTIVE_INCOHERENT`];
+/// measured to hold for `k0 d ≤` [`EFFECTIVE_MAX_SIZE_PARAMETER`], PVC ≤ 0.3,
+/// spheres dispersed by random sequential addition inside a flat binder.
+pub fn effective_medium_error(
+    grains: &[GrainTerm],
+    eps_binder: f64,
+    thickness_nm: f64,
+    wavelength_nm: f64,
+    polar_deg: f64,
+) -> f64 {
+    let (c, i) = effective_medium_terms(grains, eps_binder, thickness_nm, wavelength_nm, polar_deg);
+    EFFECTIVE_COHERENT * c + EFFECTIVE_INCOHERENT * i
 }
 
 /// Gaussian elimination with partial pivoting on a 4×5 augmented matrix.

@@ -171,6 +171,38 @@ fn run_writes_results_identical_for_one_and_two_threads() {
     );
 }
 
+/// A grain longer than half the fragment fails at the geometry stage (the
+/// config alone cannot know the grain's length): one error line, its cause
+/// said once, no result written.
+#[test]
+fn grain_longer_than_half_the_fragment_is_named_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = TINY.replace(
+        "diameter_nm = 150.0",
+        "diameter_nm = 200.0\nshape = { kind = \"rice\", aspect = 3.0, spheres = 3 }",
+    );
+    let cfg = write_config(dir.path(), &text);
+    let out = dir.path().join("out");
+    let (ok, _, err) = inksim(&[
+        "run",
+        cfg.to_str().unwrap(),
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
+    assert_eq!(errors.len(), 1, "{err}");
+    assert!(errors[0].contains("half the lateral period"), "{err}");
+    assert_eq!(
+        errors[0].matches("exceeds").count(),
+        1,
+        "repeated: {}",
+        errors[0]
+    );
+    assert!(!out.join("tiny.h5").exists());
+}
+
 #[test]
 fn dense_rice_layer_uses_dynamics_and_runs() {
     let dir = tempfile::tempdir().unwrap();

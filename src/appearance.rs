@@ -110,8 +110,17 @@ impl SpectralProxy {
     }
 }
 
+/// Largest factor by which the ratio layer / proxy may change across one
+/// interval between solved wavelengths for the proxy to be trusted there.
+pub const PROXY_RATIO_SPREAD: f64 = 2.0;
+
 /// Spectrum on the proxy's fine grid: `ratio(λ) · proxy(λ)` with the ratio
 /// interpolated linearly between the solved wavelengths (held at the ends).
+/// Where the ratio changes by more than [`PROXY_RATIO_SPREAD`] across an
+/// interval, the proxy does not describe the layer there (e.g. a strongly
+/// absorbing layer seen by its surface scattering, while the slab's double
+/// pass through the band is orders of magnitude darker): that interval falls
+/// back to linear interpolation of the layer's own values.
 fn through_proxy(wl: &[f64], values: &[f64], fine: &[f64], proxy_fine: &[f64]) -> Vec<f64> {
     let at = |x: f64| fine.iter().position(|&f| f == x);
     let ratio: Vec<f64> = wl
@@ -122,23 +131,42 @@ fn through_proxy(wl: &[f64], values: &[f64], fine: &[f64], proxy_fine: &[f64]) -
             if p > 0.0 {
                 v / p
             } else {
-                1.0
+                f64::INFINITY
             }
         })
         .collect();
+    let trusted = |k: usize| {
+        let (a, b) = (ratio[k], ratio[k + 1]);
+        a.is_finite()
+            && b.is_finite()
+            && a > 0.0
+            && b > 0.0
+            && a.max(b) <= PROXY_RATIO_SPREAD * a.min(b)
+    };
+    let n = wl.len();
+    let held = |k: usize, p: f64| {
+        if ratio[k].is_finite() {
+            ratio[k] * p
+        } else {
+            values[k]
+        }
+    };
     fine.iter()
         .zip(proxy_fine)
         .map(|(&x, &p)| {
-            let r = if x <= wl[0] {
-                ratio[0]
-            } else if x >= wl[wl.len() - 1] {
-                ratio[wl.len() - 1]
+            if x <= wl[0] || n == 1 {
+                return held(0, p);
+            }
+            if x >= wl[n - 1] {
+                return held(n - 1, p);
+            }
+            let k = wl.windows(2).position(|w| x < w[1]).unwrap_or(0);
+            let t = (x - wl[k]) / (wl[k + 1] - wl[k]);
+            if trusted(k) {
+                (ratio[k] * (1.0 - t) + ratio[k + 1] * t) * p
             } else {
-                let k = wl.windows(2).position(|w| x < w[1]).unwrap_or(0);
-                let t = (x - wl[k]) / (wl[k + 1] - wl[k]);
-                ratio[k] * (1.0 - t) + ratio[k + 1] * t
-            };
-            r * p
+                values[k] * (1.0 - t) + values[k + 1] * t
+            }
         })
         .collect()
 }
@@ -496,4 +524,38 @@ fn colours_of(
         natural_srgb8,
         natural_lab,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn proxy_shapes_between_solves_and_falls_back_where_it_does_not_fit() {
+        let fine: Vec<f64> = (0..=20).map(|i| 400.0 + 10.0 * i as f64).collect();
+        let wl = [400.0, 500.0, 600.0];
+        // A proxy with a band at 450 nm and a deep one at 560 nm.
+        let proxy: Vec<f64> = fine
+            .iter()
+            .map(|&x| {
+                0.5 - 0.3 * (-((x - 450.0) / 20.0).powi(2)).exp()
+                    - 0.4999 * (-((x - 580.0) / 20.0).powi(2)).exp()
+            })
+            .collect();
+        let p_at = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
+        // Layer = 0.8 × proxy at 400 and 500 nm (the proxy fits there), but
+        // a flat 0.1 at 600 nm where the proxy's band darkens it ~50-fold.
+        let values = [0.8 * p_at(400.0), 0.8 * p_at(500.0), 0.1];
+        let out = through_proxy(&wl, &values, &fine, &proxy);
+        let at = |x: f64| out[fine.iter().position(|&f| f == x).unwrap()];
+        for (w, v) in wl.iter().zip(values) {
+            assert!((at(*w) - v).abs() < 1e-15, "solved wavelengths are exact");
+        }
+        // 400–500 nm: constant ratio, so the band at 450 nm is reproduced.
+        assert!((at(450.0) - 0.8 * p_at(450.0)).abs() < 1e-12);
+        assert!(at(450.0) < 0.8 * 0.21, "the band is there");
+        // 500–600 nm: the ratio jumps far beyond the spread; linear values.
+        let lin = 0.5 * (values[1] + values[2]);
+        assert!((at(550.0) - lin).abs() < 1e-12, "{} vs {lin}", at(550.0));
+    }
 }

@@ -112,7 +112,7 @@ impl SpectralProxy {
 
 /// Largest factor by which the ratio layer / proxy may change across one
 /// interval between solved wavelengths for the proxy to be trusted there.
-pub const PROXY_RATIO_SPREAD: f64 = 2.0;
+pub const PROXY_RATIO_SPREAD: f64 = 10.0;
 
 /// Spectrum on the proxy's fine grid: `ratio(λ) · proxy(λ)` with the ratio
 /// interpolated linearly between the solved wavelengths (held at the ends).
@@ -534,17 +534,17 @@ mod tests {
     fn proxy_shapes_between_solves_and_falls_back_where_it_does_not_fit() {
         let fine: Vec<f64> = (0..=20).map(|i| 400.0 + 10.0 * i as f64).collect();
         let wl = [400.0, 500.0, 600.0];
-        // A proxy with a band at 450 nm and a deep one at 560 nm.
+        // A proxy with a band at 450 nm and a deep one at 600 nm.
         let proxy: Vec<f64> = fine
             .iter()
             .map(|&x| {
                 0.5 - 0.3 * (-((x - 450.0) / 20.0).powi(2)).exp()
-                    - 0.4999 * (-((x - 580.0) / 20.0).powi(2)).exp()
+                    - 0.4999 * (-((x - 600.0) / 20.0).powi(2)).exp()
             })
             .collect();
         let p_at = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
         // Layer = 0.8 × proxy at 400 and 500 nm (the proxy fits there), but
-        // a flat 0.1 at 600 nm where the proxy's band darkens it ~50-fold.
+        // a flat 0.1 at 600 nm where the proxy's band darkens it 5000-fold.
         let values = [0.8 * p_at(400.0), 0.8 * p_at(500.0), 0.1];
         let out = through_proxy(&wl, &values, &fine, &proxy);
         let at = |x: f64| out[fine.iter().position(|&f| f == x).unwrap()];

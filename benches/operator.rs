@@ -3,7 +3,8 @@
 //! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
 //! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
 //!
-//! `cargo bench --bench operator`
+//! `cargo bench --bench operator` (256 × 256 × 64 and 512 × 512 × 96; the
+//! larger grid needs about 3 GB).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use inksim::solver::fft::Fft2;
@@ -22,7 +23,7 @@ fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("operator");
     g.sample_size(10);
-    for &(n, nz) in &[(128usize, 64usize), (256, 64)] {
+    for &(n, nz) in &[(256usize, 64usize), (512, 96)] {
         let lat = Problem::lattice(
             [n, n, nz],
             [2560.0 * n as f64 / 256.0, 2560.0 * n as f64 / 256.0, 1000.0],

@@ -232,8 +232,7 @@ impl Operator {
             .enumerate()
             .for_each(|(chunk, (mut block, scr))| {
                 for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
-                    table.shifted_green_row(chunk * rows_per + k, &mut row, scr);
-                    row.mapv_inplace(|v| v * norm);
+                    table.shifted_green_row(chunk * rows_per + k, &mut row, scr, true);
                 }
             });
         for (k, h) in table.dense_indices().enumerate() {

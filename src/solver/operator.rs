@@ -13,9 +13,10 @@
 //! [`Workspace`], owned by the caller, so applications never allocate.
 
 use super::fft::{Fft2, FftScratch};
-use super::green::{self, Coef, Slab};
+use super::green::{self, Slab};
+use super::shift::simd::{self, Cx, W};
 use super::shift::{BandScratch, RowScratch, ShiftTable};
-use ndarray::{Array3, Axis};
+use ndarray::{Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
@@ -83,17 +84,37 @@ struct Special {
 /// Per-harmonic data of the Green's operator for one background permittivity.
 pub struct GreenTable {
     pub eps_bg: C64,
-    coef: Vec<Coef>,
-    /// q^j for every harmonic, layout (nz, nx, ny).
-    pow: Array3<C64>,
+    /// Sweep coefficients, layout (ix, block of [`W`] harmonics).
+    blocks: Vec<GreenBlock>,
     special: Vec<Special>,
+}
+
+/// The sweep coefficients of [`W`] harmonics: `q` and the Galerkin weights
+/// `f2, r2n, diag, rf` of [`Coef`], each times `K dz/(nx ny)` (the overall
+/// factor and the inverse FFT's normalisation). Grazing harmonics have zeros.
+#[derive(Debug, Clone, Copy)]
+struct GreenBlock {
+    q: Cx,
+    f2: Cx,
+    r2n: Cx,
+    diag: Cx,
+    rf: Cx,
 }
 
 impl GreenTable {
     pub fn new(lat: &Lattice, eps_bg: C64) -> Self {
         let slab = lat.slab();
-        let (nx, ny, nz) = (lat.nx, lat.ny, lat.nz);
-        let mut coef = Vec::with_capacity(nx * ny);
+        let (nx, ny) = (lat.nx, lat.ny);
+        let nb = ny.div_ceil(W);
+        let norm = 1.0 / (nx * ny) as f64;
+        let zero = GreenBlock {
+            q: Cx::ZERO,
+            f2: Cx::ZERO,
+            r2n: Cx::ZERO,
+            diag: Cx::ZERO,
+            rf: Cx::ZERO,
+        };
+        let mut blocks = vec![zero; nx * nb];
         let mut special = Vec::new();
         for ix in 0..nx {
             for iy in 0..ny {
@@ -106,25 +127,21 @@ impl GreenTable {
                         index: ix * ny + iy,
                         matrix,
                     });
-                    coef.push(zero_coef(beta));
-                } else {
-                    coef.push(green::coef_from(&slab, g2, beta));
+                    continue;
                 }
-            }
-        }
-        let mut pow = Array3::from_elem((nz, nx, ny), ZERO);
-        for (h, c) in coef.iter().enumerate() {
-            let (ix, iy) = (h / ny, h % ny);
-            let mut p = C64::new(1.0, 0.0);
-            for j in 0..nz {
-                pow[[j, ix, iy]] = p;
-                p *= c.q;
+                let c = green::coef_from(&slab, g2, beta);
+                let k = c.kdz * norm;
+                let (b, l) = (&mut blocks[ix * nb + iy / W], iy % W);
+                b.q.set(l, c.q);
+                b.f2.set(l, k * c.f2);
+                b.r2n.set(l, k * c.r2n);
+                b.diag.set(l, k * c.diag);
+                b.rf.set(l, k * c.rf);
             }
         }
         GreenTable {
             eps_bg,
-            coef,
-            pow,
+            blocks,
             special,
         }
     }
@@ -133,36 +150,89 @@ impl GreenTable {
     pub fn special_count(&self) -> usize {
         self.special.len()
     }
+
+    /// `row ← G_b row / (nx ny)` for the non-grazing harmonics of spectral
+    /// row `ix` (`row` is (N, ny)), [`W`] harmonics per operation.
+    ///
+    /// With `s_k` the cell sources and `p_m = q^m` (one running product per
+    /// application, kept in scratch): down sweep `A_j = Σ_{k<j} q^{j−1−k} s_k`,
+    /// `C_j = Σ_{k<j} q^k s_k`, `Sh = Σ q^{N−1−k} s_k`, storing
+    /// `f2 A_j + r2n p_{N−1−j} C_j`; up sweep `B_j = Σ_{k>j} q^{k−j−1} s_k`,
+    /// `D_j = Σ_{k>j} q^{N−1−k} s_k` and the result
+    /// `stored + f2 B_j + r2n p_j D_j + diag s_j + rf (p_j Se + p_{N−1−j} Sh)`,
+    /// `Se = C_N` (the Galerkin matrix of [`Coef::entry`] applied in O(N)).
+    #[inline(always)]
+    fn row_kernel(&self, ix: usize, row: &mut ArrayViewMut2<C64>, scr: &mut GreenScratch) {
+        let (n, ny) = row.dim();
+        let nb = ny.div_ceil(W);
+        let blocks = &self.blocks[ix * nb..(ix + 1) * nb];
+        let one = {
+            let mut o = Cx::ZERO;
+            o.re = [1.0; W];
+            o
+        };
+        for (b, k) in blocks.iter().enumerate() {
+            let lanes = b * W..ny.min((b + 1) * W);
+            let (p, acc) = (&mut scr.pow, &mut scr.acc);
+            p[0] = one;
+            for m in 1..n {
+                p[m] = p[m - 1] * k.q;
+            }
+            let (mut a, mut c, mut sh) = (Cx::ZERO, Cx::ZERO, Cx::ZERO);
+            for j in 0..n {
+                let s = load_at(row, j, &lanes);
+                let pm = p[n - 1 - j];
+                acc[j] = k.f2 * a + k.r2n * (pm * c);
+                a = k.q * a + s;
+                c = c + p[j] * s;
+                sh = sh + pm * s;
+            }
+            let (mut bb, mut d) = (Cx::ZERO, Cx::ZERO);
+            for j in (0..n).rev() {
+                let s = load_at(row, j, &lanes);
+                let (pj, pm) = (p[j], p[n - 1 - j]);
+                let out = acc[j]
+                    + (k.f2 * bb + k.r2n * (pj * d))
+                    + k.diag * s
+                    + k.rf * (pj * c + pm * sh);
+                bb = k.q * bb + s;
+                d = d + pm * s;
+                store_at(out, row, j, &lanes);
+            }
+        }
+    }
 }
 
-fn zero_coef(beta: C64) -> Coef {
-    Coef {
-        q: ZERO,
-        kdz: ZERO,
-        f2: ZERO,
-        rf: ZERO,
-        r2n: ZERO,
-        diag: ZERO,
-        phi1: ZERO,
-        rho: ZERO,
-        qn: ZERO,
-        gamma: ZERO,
-        beta,
-    }
+/// Cells `lanes` of spectral row cell `j`.
+#[inline(always)]
+fn load_at(row: &ArrayViewMut2<C64>, j: usize, lanes: &std::ops::Range<usize>) -> Cx {
+    let r = row.row(j);
+    Cx::load(&r.as_slice().expect("contiguous spectral row")[lanes.clone()])
+}
+
+#[inline(always)]
+fn store_at(x: Cx, row: &mut ArrayViewMut2<C64>, j: usize, lanes: &std::ops::Range<usize>) {
+    let mut r = row.row_mut(j);
+    x.store(&mut r.as_slice_mut().expect("contiguous spectral row")[lanes.clone()]);
+}
+
+/// Per-task scratch of the `G_b` row sweeps: `q^m` and the down sweep's
+/// partial results for one block of harmonics.
+struct GreenScratch {
+    pow: Vec<Cx>,
+    acc: Vec<Cx>,
 }
 
 /// Scratch buffers for operator applications, sized for one lattice.
 pub struct Workspace {
     spec: Array3<C64>,
-    acc: Array3<C64>,
-    /// Running sums per row: (nx, 3, ny).
-    rows: Array3<C64>,
     fft: FftScratch,
     special_in: Vec<C64>,
     /// One banded-solve scratch per spectral row (ix).
     bands: Vec<BandScratch>,
     /// Row-sweep scratch, one per parallel chunk of spectral rows.
     row_scratch: Vec<RowScratch>,
+    green_scratch: Vec<GreenScratch>,
 }
 
 /// FFT plans plus the lattice: what every application shares.
@@ -183,13 +253,17 @@ impl Operator {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         Workspace {
             spec: Array3::from_elem((nz, nx, ny), ZERO),
-            acc: Array3::from_elem((nz, nx, ny), ZERO),
-            rows: Array3::from_elem((nx, 3, ny), ZERO),
             fft: self.fft.scratch(nz),
             special_in: Vec::new(),
             bands: (0..nx).map(|_| BandScratch::new(nz)).collect(),
             row_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
                 .map(|_| RowScratch::new(nz, ny))
+                .collect(),
+            green_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
+                .map(|_| GreenScratch {
+                    pow: vec![Cx::ZERO; nz],
+                    acc: vec![Cx::ZERO; nz],
+                })
                 .collect(),
         }
     }
@@ -282,59 +356,18 @@ impl Operator {
                 ws.special_in.push(ws.spec[[j, ix, iy]]);
             }
         }
-        let coef = &table.coef;
+        let rows_per = nx.div_ceil(ws.green_scratch.len());
         ws.spec
-            .axis_iter_mut(Axis(1))
+            .axis_chunks_iter_mut(Axis(1), rows_per)
             .into_par_iter()
-            .zip(ws.acc.axis_iter_mut(Axis(1)).into_par_iter())
-            .zip(table.pow.axis_iter(Axis(1)).into_par_iter())
-            .zip(ws.rows.axis_iter_mut(Axis(0)).into_par_iter())
+            .zip(ws.green_scratch.par_iter_mut())
             .enumerate()
-            .for_each(|(ix, (((mut s, mut acc), pow), mut rows))| {
-                let cs = &coef[ix * ny..(ix + 1) * ny];
-                let rows = rows.as_slice_mut().expect("contiguous rows");
-                let (a, rest) = rows.split_at_mut(ny);
-                let (c, d) = rest.split_at_mut(ny);
-                a.fill(ZERO);
-                c.fill(ZERO);
-                d.fill(ZERO);
-                // Down: a_j = Σ_{k<j} q^{j−1−k} s_k, c_j = Σ_{k<j} q^k s_k.
-                for j in 0..nz {
-                    let sj = s.row(j);
-                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
-                    let mut out = acc.row_mut(j);
-                    for iy in 0..ny {
-                        let k = &cs[iy];
-                        out[iy] = k.f2 * a[iy] + k.r2n * pm[iy] * c[iy];
-                        a[iy] = k.q * a[iy] + sj[iy];
-                        c[iy] += pj[iy] * sj[iy];
-                    }
-                }
-                // c = Se = Σ q^k s_k. Up: b_j (reusing a), d_j = Σ_{k>j} q^{N−1−k} s_k.
-                a.fill(ZERO);
-                for j in (0..nz).rev() {
-                    let sj = s.row(j);
-                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
-                    let mut out = acc.row_mut(j);
-                    for iy in 0..ny {
-                        let k = &cs[iy];
-                        out[iy] += k.f2 * a[iy] + k.r2n * pj[iy] * d[iy];
-                        a[iy] = k.q * a[iy] + sj[iy];
-                        d[iy] += pm[iy] * sj[iy];
-                    }
-                }
-                // d = Sh = Σ q^{N−1−k} s_k. Assemble in place.
-                for j in 0..nz {
-                    let (pj, pm) = (pow.row(j), pow.row(nz - 1 - j));
-                    let out = acc.row(j);
-                    let mut sj = s.row_mut(j);
-                    for iy in 0..ny {
-                        let k = &cs[iy];
-                        sj[iy] = (k.kdz * norm)
-                            * (out[iy]
-                                + k.diag * sj[iy]
-                                + k.rf * (pj[iy] * c[iy] + pm[iy] * d[iy]));
-                    }
+            .for_each(|(chunk, (mut block, scr))| {
+                for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
+                    simd::dispatch(
+                        #[inline(always)]
+                        || table.row_kernel(chunk * rows_per + k, &mut row, scr),
+                    );
                 }
             });
         for (n, sp) in table.special.iter().enumerate() {

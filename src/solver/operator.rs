@@ -171,8 +171,20 @@ impl GreenTable {
             o.re = [1.0; W];
             o
         };
-        for (b, k) in blocks.iter().enumerate() {
-            let lanes = b * W..ny.min((b + 1) * W);
+        // The row's cells lie a power of two apart: copy them once to
+        // contiguous scratch, layout (block, cell), and back at the end.
+        let cells = &mut scr.cells[..nb * n];
+        for j in 0..n {
+            if j + 1 < n {
+                simd::prefetch(row.row(j + 1).as_slice().expect("contiguous spectral row"));
+            }
+            let r = row.row(j);
+            let r = r.as_slice().expect("contiguous spectral row");
+            for b in 0..nb {
+                cells[b * n + j] = Cx::load(&r[b * W..ny.min((b + 1) * W)]);
+            }
+        }
+        for (k, s) in blocks.iter().zip(cells.chunks_exact_mut(n)) {
             let (p, acc) = (&mut scr.pow, &mut scr.acc);
             p[0] = one;
             for m in 1..n {
@@ -180,45 +192,37 @@ impl GreenTable {
             }
             let (mut a, mut c, mut sh) = (Cx::ZERO, Cx::ZERO, Cx::ZERO);
             for j in 0..n {
-                let s = load_at(row, j, &lanes);
                 let pm = p[n - 1 - j];
                 acc[j] = k.f2 * a + k.r2n * (pm * c);
-                a = k.q * a + s;
-                c = c + p[j] * s;
-                sh = sh + pm * s;
+                a = k.q * a + s[j];
+                c = c + p[j] * s[j];
+                sh = sh + pm * s[j];
             }
             let (mut bb, mut d) = (Cx::ZERO, Cx::ZERO);
             for j in (0..n).rev() {
-                let s = load_at(row, j, &lanes);
-                let (pj, pm) = (p[j], p[n - 1 - j]);
-                let out = acc[j]
+                let (sj, pj, pm) = (s[j], p[j], p[n - 1 - j]);
+                s[j] = acc[j]
                     + (k.f2 * bb + k.r2n * (pj * d))
-                    + k.diag * s
+                    + k.diag * sj
                     + k.rf * (pj * c + pm * sh);
-                bb = k.q * bb + s;
-                d = d + pm * s;
-                store_at(out, row, j, &lanes);
+                bb = k.q * bb + sj;
+                d = d + pm * sj;
+            }
+        }
+        for j in 0..n {
+            let mut r = row.row_mut(j);
+            let r = r.as_slice_mut().expect("contiguous spectral row");
+            for b in 0..nb {
+                cells[b * n + j].store(&mut r[b * W..ny.min((b + 1) * W)]);
             }
         }
     }
 }
 
-/// Cells `lanes` of spectral row cell `j`.
-#[inline(always)]
-fn load_at(row: &ArrayViewMut2<C64>, j: usize, lanes: &std::ops::Range<usize>) -> Cx {
-    let r = row.row(j);
-    Cx::load(&r.as_slice().expect("contiguous spectral row")[lanes.clone()])
-}
-
-#[inline(always)]
-fn store_at(x: Cx, row: &mut ArrayViewMut2<C64>, j: usize, lanes: &std::ops::Range<usize>) {
-    let mut r = row.row_mut(j);
-    x.store(&mut r.as_slice_mut().expect("contiguous spectral row")[lanes.clone()]);
-}
-
-/// Per-task scratch of the `G_b` row sweeps: `q^m` and the down sweep's
-/// partial results for one block of harmonics.
+/// Per-task scratch of the `G_b` row sweeps: a spectral row and, for one
+/// block of harmonics, `q^m` and the down sweep's partial results.
 struct GreenScratch {
+    cells: Vec<Cx>,
     pow: Vec<Cx>,
     acc: Vec<Cx>,
 }
@@ -261,6 +265,7 @@ impl Operator {
                 .collect(),
             green_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
                 .map(|_| GreenScratch {
+                    cells: vec![Cx::ZERO; nz * ny.div_ceil(W)],
                     pow: vec![Cx::ZERO; nz],
                     acc: vec![Cx::ZERO; nz],
                 })

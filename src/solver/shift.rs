@@ -101,12 +101,23 @@ pub struct ShiftTable {
     ny: usize,
     /// Blocks of [`W`] harmonics per spectral row.
     nb: usize,
-    /// Per row: index of its first [`StepBlock`] and number of stored cells
-    /// (layout (cell, block) within a row).
-    row_off: Vec<usize>,
-    row_cells: Vec<usize>,
+    /// Per spectral row, its blocks of [`W`] harmonics ordered by stored
+    /// cells, most first: `order[ix·nb + i]` is the block at position i,
+    /// `pos[ix·nb + b]` the position of block b. Everything below that is
+    /// per block is laid out (ix, position).
+    order: Vec<u32>,
+    pos: Vec<u32>,
+    /// Stored cells per block.
+    cells: Vec<usize>,
+    /// Stored cells, layout (ix, cell, position): cell j of a row holds the
+    /// blocks still settling, a prefix of the order, so a sweep reads the
+    /// table front to back. `cell_start[row_cs[ix] + j]` is where cell j of
+    /// row ix starts (one more entry marks the end).
     steps: Vec<StepBlock>,
-    /// Layout (ix, block).
+    row_cs: Vec<usize>,
+    cell_start: Vec<usize>,
+    /// The last stored cell of every block, used for the cells after it.
+    settled: Vec<StepBlock>,
     harm: Vec<HarmBlock>,
 }
 
@@ -200,14 +211,28 @@ impl ShiftTable {
         }
         let cells = n - 1;
         let mut ends = vec![[ZERO; 3]; h.len()];
-        let mut harm = vec![HarmBlock::ZERO; nx * nb];
-        let mut row_off = Vec::with_capacity(nx);
-        let mut row_cells = Vec::with_capacity(nx);
+        let mut harm = Vec::with_capacity(nx * nb);
+        let mut order = Vec::with_capacity(nx * nb);
+        let mut pos = vec![0; nx * nb];
+        let mut cells_of = Vec::with_capacity(nx * nb);
+        let mut row_cs = Vec::with_capacity(nx);
+        let mut cell_start = Vec::new();
+        let mut settled = Vec::with_capacity(nx * nb);
         let mut steps = Vec::new();
         // One row's full columns, layout (iy, j).
         let mut full = vec![Step::ZERO; ny * cells];
+        let mut keep = vec![0; nb];
+        let mut row_harm = vec![HarmBlock::ZERO; nb];
+        let block_step = |full: &[Step], b: usize, j: usize| {
+            let mut sb = StepBlock::ZERO;
+            for k in 0..W.min(ny - b * W) {
+                sb.set(k, &full[(b * W + k) * cells + j]);
+            }
+            sb
+        };
         for ix in 0..nx {
-            let mut keep = 0;
+            keep.fill(0);
+            row_harm.fill(HarmBlock::ZERO);
             for iy in 0..ny {
                 let i = ix * ny + iy;
                 let col = &mut full[iy * cells..(iy + 1) * cells];
@@ -217,28 +242,39 @@ impl ShiftTable {
                 };
                 let (e, hb) = sweep_coefficients(hs, col);
                 ends[i] = e;
-                let blk = &mut harm[ix * nb + iy / W];
-                blk.set(iy % W, &hb, norm);
-                // Cells from `settle` on equal the cell `settle` to rounding.
+                row_harm[iy / W].set(iy % W, &hb, norm);
+                // Cells from `settle` on equal the last cell to rounding.
                 let mut settle = cells;
                 while settle > 0 && col[settle - 1].settled(&col[cells - 1]) {
                     settle -= 1;
                 }
-                let settle = settle.min(cells.saturating_sub(1));
-                keep = keep.max(settle + 1);
+                let k = &mut keep[iy / W];
+                *k = (*k).max(settle + 1).min(cells);
             }
-            let keep = keep.min(cells);
-            row_off.push(steps.len());
-            row_cells.push(keep);
-            for j in 0..keep {
-                for b in 0..nb {
-                    let mut sb = StepBlock::ZERO;
-                    for k in 0..W.min(ny - b * W) {
-                        sb.set(k, &full[(b * W + k) * cells + j]);
+            let first = order.len();
+            order.extend(0..nb as u32);
+            order[first..].sort_by_key(|&b| std::cmp::Reverse(keep[b as usize]));
+            for (i, &b) in order[first..].iter().enumerate() {
+                let b = b as usize;
+                pos[ix * nb + b] = i as u32;
+                cells_of.push(keep[b]);
+                harm.push(row_harm[b]);
+                settled.push(match keep[b] {
+                    0 => StepBlock::ZERO,
+                    k => block_step(&full, b, k - 1),
+                });
+            }
+            row_cs.push(cell_start.len());
+            for j in 0..keep.iter().copied().max().unwrap_or(0) {
+                cell_start.push(steps.len());
+                for &b in order[first..].iter() {
+                    if keep[b as usize] <= j {
+                        break;
                     }
-                    steps.push(sb);
+                    steps.push(block_step(&full, b as usize, j));
                 }
             }
+            cell_start.push(steps.len());
         }
         ShiftTable {
             c,
@@ -248,9 +284,13 @@ impl ShiftTable {
             n,
             ny,
             nb,
-            row_off,
-            row_cells,
+            order,
+            pos,
+            cells: cells_of,
             steps,
+            row_cs,
+            cell_start,
+            settled,
             harm,
         }
     }
@@ -262,16 +302,20 @@ impl ShiftTable {
             .expect("dense harmonic")
     }
 
-    /// Number of cells stored for spectral row `ix` (at most N − 1).
-    pub fn stored_cells(&self, ix: usize) -> usize {
-        self.row_cells[ix]
+    /// Down-sweep cells stored, summed over all harmonics (at most
+    /// (N − 1) per harmonic; the rest are reused).
+    pub fn stored_cells(&self) -> usize {
+        self.cells.iter().sum::<usize>() * W
     }
 
-    /// Step block of row `ix`, cell `j`, block `b`.
+    /// Step block of row `ix`, cell `j`, block at position `i`.
     #[inline(always)]
-    fn step(&self, ix: usize, j: usize, b: usize) -> &StepBlock {
-        let j = j.min(self.row_cells[ix].saturating_sub(1));
-        &self.steps[self.row_off[ix] + j * self.nb + b]
+    fn step(&self, ix: usize, j: usize, i: usize) -> &StepBlock {
+        if j < self.cells[ix * self.nb + i] {
+            &self.steps[self.cell_start[self.row_cs[ix] + j] + i]
+        } else {
+            &self.settled[ix * self.nb + i]
+        }
     }
 }
 
@@ -400,7 +444,7 @@ impl ShiftTable {
         };
         let n = self.n;
         let (ix, iy) = (index / self.ny, index % self.ny);
-        let (b, k) = (iy / W, iy % W);
+        let (b, k) = (self.pos[ix * self.nb + iy / W] as usize, iy % W);
         let hb = &self.harm[ix * self.nb + b];
         let (s, top, eb, eu, g, gtl) = (
             hb.s.lane(k),
@@ -496,53 +540,70 @@ impl ShiftTable {
     ) {
         let (n, ny, nb) = (self.n, self.ny, self.nb);
         let hbs = &self.harm[ix * nb..(ix + 1) * nb];
-        let (bp, u, d, w) = (&mut scr.bp, &mut scr.u, &mut scr.d, &mut scr.w);
-        let scale = |hb: &HarmBlock| if normalised { hb.sn } else { hb.s };
-        {
-            let r0 = row.row(0);
-            let r0 = r0.as_slice().expect("contiguous spectral row");
-            for (b, hb) in hbs.iter().enumerate() {
-                bp[b] = Cx::load(&r0[b * W..ny.min((b + 1) * W)]) * scale(hb);
-                u[b] = hb.top * bp[b];
-            }
+        let (bp, u, d, wy, xr) = (
+            &mut scr.bp,
+            &mut scr.u,
+            &mut scr.d,
+            &mut scr.wy,
+            &mut scr.xr,
+        );
+        let order = &self.order[ix * nb..(ix + 1) * nb];
+        let cells = &self.cells[ix * nb..(ix + 1) * nb];
+        let settled = &self.settled[ix * nb..(ix + 1) * nb];
+        let cs = &self.cell_start[self.row_cs[ix]..];
+        // Blocks in the row's order (position i is block order[i]).
+        for (i, hb) in hbs.iter().enumerate() {
+            bp[i] = load(row, 0, order[i] as usize, ny) * scale(hb, normalised);
+            u[i] = hb.top * bp[i];
         }
-        // Down sweep: row j ← g u_j − x'_j, w_j to scratch.
+        // Down sweep: (w_j, g u_j − x'_j) to scratch (the spectral row's cells
+        // lie a power of two apart, so it is read once and written once).
         for j in 0..n - 1 {
-            let st = &self.steps[self.row_off[ix] + j.min(self.row_cells[ix] - 1) * nb..][..nb];
-            let wj = &mut w[j * nb..(j + 1) * nb];
-            let (mut rj, rn) = row.multi_slice_mut((ndarray::s![j, ..], ndarray::s![j + 1, ..]));
-            let rj = rj.as_slice_mut().expect("contiguous spectral row");
-            let rn = rn.as_slice().expect("contiguous spectral row");
-            for b in 0..nb {
-                let (hb, st) = (&hbs[b], &st[b]);
-                let lanes = b * W..ny.min((b + 1) * W);
-                let bn = Cx::load(&rn[lanes.clone()]) * scale(hb);
-                let delta = bp[b] - bn;
-                (hb.g * u[b] - bp[b]).store(&mut rj[lanes]);
-                wj[b] = st.wa * delta + st.wb * u[b];
-                u[b] = st.ua * delta + st.ub * u[b];
-                bp[b] = bn;
+            let wyj = &mut wy[j * nb..(j + 1) * nb];
+            let fresh = if j < cells[0] {
+                &self.steps[cs[j]..cs[j + 1]]
+            } else {
+                &[]
+            };
+            // The next cell's row in its natural order first (one
+            // sequential read), then the blocks in the row's order.
+            for (b, x) in xr.iter_mut().enumerate() {
+                *x = load(row, j + 1, b, ny);
+            }
+            if j + 2 < n {
+                simd::prefetch(row.row(j + 2).as_slice().expect("contiguous spectral row"));
+            }
+            for i in 0..nb {
+                let hb = &hbs[i];
+                let st = fresh.get(i).unwrap_or(&settled[i]);
+                let bn = xr[order[i] as usize] * scale(hb, normalised);
+                let delta = bp[i] - bn;
+                wyj[i] = [st.wa * delta + st.wb * u[i], hb.g * u[i] - bp[i]];
+                u[i] = st.ua * delta + st.ub * u[i];
+                bp[i] = bn;
             }
         }
         // Bottom closure, then the up sweep adding gt_j d_j.
-        {
-            let mut rl = row.row_mut(n - 1);
-            let rl = rl.as_slice_mut().expect("contiguous spectral row");
-            for (b, hb) in hbs.iter().enumerate() {
-                d[b] = hb.eb * bp[b] + hb.eu * u[b];
-                (hb.gtl * d[b] + (hb.g * u[b] - bp[b])).store(&mut rl[b * W..ny.min((b + 1) * W)]);
-            }
+        for (i, hb) in hbs.iter().enumerate() {
+            d[i] = hb.eb * bp[i] + hb.eu * u[i];
+            let y = hb.gtl * d[i] + (hb.g * u[i] - bp[i]);
+            store(y, row, n - 1, order[i] as usize, ny);
         }
         for j in (0..n - 1).rev() {
-            let st = &self.steps[self.row_off[ix] + j.min(self.row_cells[ix] - 1) * nb..][..nb];
-            let wj = &w[j * nb..(j + 1) * nb];
-            let mut rj = row.row_mut(j);
-            let rj = rj.as_slice_mut().expect("contiguous spectral row");
-            for b in 0..nb {
-                let st = &st[b];
-                let lanes = b * W..ny.min((b + 1) * W);
-                d[b] = st.v * d[b] + wj[b];
-                (st.gt * d[b] + Cx::load(&rj[lanes.clone()])).store(&mut rj[lanes]);
+            let wyj = &wy[j * nb..(j + 1) * nb];
+            let fresh = if j < cells[0] {
+                &self.steps[cs[j]..cs[j + 1]]
+            } else {
+                &[]
+            };
+            for i in 0..nb {
+                let st = fresh.get(i).unwrap_or(&settled[i]);
+                let [w, y] = wyj[i];
+                d[i] = st.v * d[i] + w;
+                xr[order[i] as usize] = st.gt * d[i] + y;
+            }
+            for (b, x) in xr.iter().enumerate() {
+                store(*x, row, j, b, ny);
             }
         }
     }
@@ -553,23 +614,48 @@ impl ShiftTable {
     }
 }
 
+#[inline(always)]
+fn scale(hb: &HarmBlock, normalised: bool) -> Cx {
+    if normalised {
+        hb.sn
+    } else {
+        hb.s
+    }
+}
+
+/// Block `b` of cell `j` of a spectral row.
+#[inline(always)]
+fn load(row: &ndarray::ArrayViewMut2<C64>, j: usize, b: usize, ny: usize) -> Cx {
+    let r = row.row(j);
+    Cx::load(&r.as_slice().expect("contiguous spectral row")[b * W..ny.min((b + 1) * W)])
+}
+
+#[inline(always)]
+fn store(x: Cx, row: &mut ndarray::ArrayViewMut2<C64>, j: usize, b: usize, ny: usize) {
+    let mut r = row.row_mut(j);
+    x.store(&mut r.as_slice_mut().expect("contiguous spectral row")[b * W..ny.min((b + 1) * W)]);
+}
+
 /// Per-row scratch of [`ShiftTable::shifted_green_row`].
 pub struct RowScratch {
-    /// `w_j` per cell and block.
-    w: Vec<Cx>,
+    /// `w_j` and `g u_j − x'_j` per cell and block.
+    wy: Vec<[Cx; 2]>,
     bp: Vec<Cx>,
     u: Vec<Cx>,
     d: Vec<Cx>,
+    /// One cell of the row, natural order.
+    xr: Vec<Cx>,
 }
 
 impl RowScratch {
     pub fn new(n: usize, ny: usize) -> Self {
         let nb = ny.div_ceil(W);
         RowScratch {
-            w: vec![Cx::ZERO; n * nb],
+            wy: vec![[Cx::ZERO; 2]; n * nb],
             bp: vec![Cx::ZERO; nb],
             u: vec![Cx::ZERO; nb],
             d: vec![Cx::ZERO; nb],
+            xr: vec![Cx::ZERO; nb],
         }
     }
 }
@@ -779,6 +865,24 @@ pub(super) mod simd {
             }
             r
         }
+    }
+
+    /// Ask the cache for `data` ahead of its use. The sweeps read a
+    /// spectral row's cells a power of two apart, one page each, where the
+    /// hardware prefetchers do not reach.
+    #[inline(always)]
+    pub fn prefetch(data: &[C64]) {
+        #[cfg(target_arch = "x86_64")]
+        for line in data.chunks(4) {
+            // SAFETY: a prefetch hint never faults and changes no state the
+            // program can observe; the address lies inside `data`.
+            unsafe {
+                use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+                _mm_prefetch::<_MM_HINT_T0>(line.as_ptr().cast());
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = data;
     }
 
     /// Run `f`, compiled for AVX-512 or AVX2 where the CPU has them (the

@@ -101,23 +101,11 @@ pub struct ShiftTable {
     ny: usize,
     /// Blocks of [`W`] harmonics per spectral row.
     nb: usize,
-    /// Per spectral row, its blocks of [`W`] harmonics ordered by stored
-    /// cells, most first: `order[ix·nb + i]` is the block at position i,
-    /// `pos[ix·nb + b]` the position of block b. Everything below that is
-    /// per block is laid out (ix, position).
-    order: Vec<u32>,
-    pos: Vec<u32>,
-    /// Stored cells per block.
-    cells: Vec<usize>,
-    /// Stored cells, layout (ix, cell, position): cell j of a row holds the
-    /// blocks still settling, a prefix of the order, so a sweep reads the
-    /// table front to back. `cell_start[row_cs[ix] + j]` is where cell j of
-    /// row ix starts (one more entry marks the end).
+    /// Per block of [`W`] harmonics, layout (ix, block): index of its first
+    /// stored cell in `steps` and the number stored (consecutive cells).
+    block_off: Vec<usize>,
+    block_cells: Vec<usize>,
     steps: Vec<StepBlock>,
-    row_cs: Vec<usize>,
-    cell_start: Vec<usize>,
-    /// The last stored cell of every block, used for the cells after it.
-    settled: Vec<StepBlock>,
     harm: Vec<HarmBlock>,
 }
 
@@ -211,28 +199,15 @@ impl ShiftTable {
         }
         let cells = n - 1;
         let mut ends = vec![[ZERO; 3]; h.len()];
-        let mut harm = Vec::with_capacity(nx * nb);
-        let mut order = Vec::with_capacity(nx * nb);
-        let mut pos = vec![0; nx * nb];
-        let mut cells_of = Vec::with_capacity(nx * nb);
-        let mut row_cs = Vec::with_capacity(nx);
-        let mut cell_start = Vec::new();
-        let mut settled = Vec::with_capacity(nx * nb);
+        let mut harm = vec![HarmBlock::ZERO; nx * nb];
+        let mut block_off = Vec::with_capacity(nx * nb);
+        let mut block_cells = Vec::with_capacity(nx * nb);
         let mut steps = Vec::new();
         // One row's full columns, layout (iy, j).
         let mut full = vec![Step::ZERO; ny * cells];
         let mut keep = vec![0; nb];
-        let mut row_harm = vec![HarmBlock::ZERO; nb];
-        let block_step = |full: &[Step], b: usize, j: usize| {
-            let mut sb = StepBlock::ZERO;
-            for k in 0..W.min(ny - b * W) {
-                sb.set(k, &full[(b * W + k) * cells + j]);
-            }
-            sb
-        };
         for ix in 0..nx {
             keep.fill(0);
-            row_harm.fill(HarmBlock::ZERO);
             for iy in 0..ny {
                 let i = ix * ny + iy;
                 let col = &mut full[iy * cells..(iy + 1) * cells];
@@ -242,7 +217,7 @@ impl ShiftTable {
                 };
                 let (e, hb) = sweep_coefficients(hs, col);
                 ends[i] = e;
-                row_harm[iy / W].set(iy % W, &hb, norm);
+                harm[ix * nb + iy / W].set(iy % W, &hb, norm);
                 // Cells from `settle` on equal the last cell to rounding.
                 let mut settle = cells;
                 while settle > 0 && col[settle - 1].settled(&col[cells - 1]) {
@@ -251,30 +226,17 @@ impl ShiftTable {
                 let k = &mut keep[iy / W];
                 *k = (*k).max(settle + 1).min(cells);
             }
-            let first = order.len();
-            order.extend(0..nb as u32);
-            order[first..].sort_by_key(|&b| std::cmp::Reverse(keep[b as usize]));
-            for (i, &b) in order[first..].iter().enumerate() {
-                let b = b as usize;
-                pos[ix * nb + b] = i as u32;
-                cells_of.push(keep[b]);
-                harm.push(row_harm[b]);
-                settled.push(match keep[b] {
-                    0 => StepBlock::ZERO,
-                    k => block_step(&full, b, k - 1),
-                });
-            }
-            row_cs.push(cell_start.len());
-            for j in 0..keep.iter().copied().max().unwrap_or(0) {
-                cell_start.push(steps.len());
-                for &b in order[first..].iter() {
-                    if keep[b as usize] <= j {
-                        break;
+            for (b, &keep) in keep.iter().enumerate() {
+                block_off.push(steps.len());
+                block_cells.push(keep);
+                for j in 0..keep {
+                    let mut sb = StepBlock::ZERO;
+                    for k in 0..W.min(ny - b * W) {
+                        sb.set(k, &full[(b * W + k) * cells + j]);
                     }
-                    steps.push(block_step(&full, b as usize, j));
+                    steps.push(sb);
                 }
             }
-            cell_start.push(steps.len());
         }
         ShiftTable {
             c,
@@ -284,13 +246,9 @@ impl ShiftTable {
             n,
             ny,
             nb,
-            order,
-            pos,
-            cells: cells_of,
+            block_off,
+            block_cells,
             steps,
-            row_cs,
-            cell_start,
-            settled,
             harm,
         }
     }
@@ -305,17 +263,15 @@ impl ShiftTable {
     /// Down-sweep cells stored, summed over all harmonics (at most
     /// (N − 1) per harmonic; the rest are reused).
     pub fn stored_cells(&self) -> usize {
-        self.cells.iter().sum::<usize>() * W
+        self.block_cells.iter().sum::<usize>() * W
     }
 
-    /// Step block of row `ix`, cell `j`, block at position `i`.
+    /// The stored cells of block `b` of row `ix` (the last one stands for
+    /// all later cells).
     #[inline(always)]
-    fn step(&self, ix: usize, j: usize, i: usize) -> &StepBlock {
-        if j < self.cells[ix * self.nb + i] {
-            &self.steps[self.cell_start[self.row_cs[ix] + j] + i]
-        } else {
-            &self.settled[ix * self.nb + i]
-        }
+    fn steps_of(&self, ix: usize, b: usize) -> &[StepBlock] {
+        let i = ix * self.nb + b;
+        &self.steps[self.block_off[i]..][..self.block_cells[i]]
     }
 }
 
@@ -444,7 +400,8 @@ impl ShiftTable {
         };
         let n = self.n;
         let (ix, iy) = (index / self.ny, index % self.ny);
-        let (b, k) = (self.pos[ix * self.nb + iy / W] as usize, iy % W);
+        let (b, k) = (iy / W, iy % W);
+        let steps = self.steps_of(ix, b);
         let hb = &self.harm[ix * self.nb + b];
         let (s, top, eb, eu, g, gtl) = (
             hb.s.lane(k),
@@ -461,7 +418,7 @@ impl ShiftTable {
         let mut u = top * bp;
         let u0 = u;
         for j in 0..n - 1 {
-            let st = self.step(ix, j, b);
+            let st = &steps[j.min(steps.len() - 1)];
             let bn = col[j + 1] * s;
             let delta = bp - bn;
             col[j] = g * u - bp;
@@ -475,7 +432,7 @@ impl ShiftTable {
         let a = t_last * d + u;
         let wh = -bp - hs.kappa * (a + d) + a * hs.q + d;
         for j in (0..n - 1).rev() {
-            let st = self.step(ix, j, b);
+            let st = &steps[j.min(steps.len() - 1)];
             d = st.v.lane(k) * d + scr.w[j];
             col[j] = st.gt.lane(k) * d + col[j];
         }
@@ -540,70 +497,50 @@ impl ShiftTable {
     ) {
         let (n, ny, nb) = (self.n, self.ny, self.nb);
         let hbs = &self.harm[ix * nb..(ix + 1) * nb];
-        let (bp, u, d, wy, xr) = (
-            &mut scr.bp,
-            &mut scr.u,
-            &mut scr.d,
-            &mut scr.wy,
-            &mut scr.xr,
-        );
-        let order = &self.order[ix * nb..(ix + 1) * nb];
-        let cells = &self.cells[ix * nb..(ix + 1) * nb];
-        let settled = &self.settled[ix * nb..(ix + 1) * nb];
-        let cs = &self.cell_start[self.row_cs[ix]..];
-        // Blocks in the row's order (position i is block order[i]).
-        for (i, hb) in hbs.iter().enumerate() {
-            bp[i] = load(row, 0, order[i] as usize, ny) * scale(hb, normalised);
-            u[i] = hb.top * bp[i];
-        }
-        // Down sweep: (w_j, g u_j − x'_j) to scratch (the spectral row's cells
-        // lie a power of two apart, so it is read once and written once).
-        for j in 0..n - 1 {
-            let wyj = &mut wy[j * nb..(j + 1) * nb];
-            let fresh = if j < cells[0] {
-                &self.steps[cs[j]..cs[j + 1]]
-            } else {
-                &[]
-            };
-            // The next cell's row in its natural order first (one
-            // sequential read), then the blocks in the row's order.
-            for (b, x) in xr.iter_mut().enumerate() {
-                *x = load(row, j + 1, b, ny);
+        // The row's cells lie a power of two apart: read them once, scaled,
+        // into contiguous scratch, layout (block, cell), with a prefetch one
+        // cell ahead, and write the result back at the end.
+        let cells = &mut scr.cells[..nb * n];
+        for j in 0..n {
+            if j + 1 < n {
+                simd::prefetch(row.row(j + 1).as_slice().expect("contiguous spectral row"));
             }
-            if j + 2 < n {
-                simd::prefetch(row.row(j + 2).as_slice().expect("contiguous spectral row"));
-            }
-            for i in 0..nb {
-                let hb = &hbs[i];
-                let st = fresh.get(i).unwrap_or(&settled[i]);
-                let bn = xr[order[i] as usize] * scale(hb, normalised);
-                let delta = bp[i] - bn;
-                wyj[i] = [st.wa * delta + st.wb * u[i], hb.g * u[i] - bp[i]];
-                u[i] = st.ua * delta + st.ub * u[i];
-                bp[i] = bn;
+            let r = row.row(j);
+            let r = r.as_slice().expect("contiguous spectral row");
+            for (b, hb) in hbs.iter().enumerate() {
+                cells[b * n + j] = Cx::load(&r[b * W..ny.min((b + 1) * W)]) * scale(hb, normalised);
             }
         }
-        // Bottom closure, then the up sweep adding gt_j d_j.
-        for (i, hb) in hbs.iter().enumerate() {
-            d[i] = hb.eb * bp[i] + hb.eu * u[i];
-            let y = hb.gtl * d[i] + (hb.g * u[i] - bp[i]);
-            store(y, row, n - 1, order[i] as usize, ny);
-        }
-        for j in (0..n - 1).rev() {
-            let wyj = &wy[j * nb..(j + 1) * nb];
-            let fresh = if j < cells[0] {
-                &self.steps[cs[j]..cs[j + 1]]
-            } else {
-                &[]
-            };
-            for i in 0..nb {
-                let st = fresh.get(i).unwrap_or(&settled[i]);
-                let [w, y] = wyj[i];
-                d[i] = st.v * d[i] + w;
-                xr[order[i] as usize] = st.gt * d[i] + y;
+        let w = &mut scr.w;
+        for (b, (hb, x)) in hbs.iter().zip(cells.chunks_exact_mut(n)).enumerate() {
+            let steps = self.steps_of(ix, b);
+            let last = steps.len().saturating_sub(1);
+            // Down sweep: w_j to scratch, g u_j − x'_j in place.
+            let mut bp = x[0];
+            let mut u = hb.top * bp;
+            for j in 0..n - 1 {
+                let st = &steps[j.min(last)];
+                let bn = x[j + 1];
+                let delta = bp - bn;
+                x[j] = hb.g * u - bp;
+                w[j] = st.wa * delta + st.wb * u;
+                u = st.ua * delta + st.ub * u;
+                bp = bn;
             }
-            for (b, x) in xr.iter().enumerate() {
-                store(*x, row, j, b, ny);
+            // Bottom closure, then the up sweep adding gt_j d_j.
+            let mut d = hb.eb * bp + hb.eu * u;
+            x[n - 1] = hb.gtl * d + (hb.g * u - bp);
+            for j in (0..n - 1).rev() {
+                let st = &steps[j.min(last)];
+                d = st.v * d + w[j];
+                x[j] = st.gt * d + x[j];
+            }
+        }
+        for j in 0..n {
+            let mut r = row.row_mut(j);
+            let r = r.as_slice_mut().expect("contiguous spectral row");
+            for b in 0..nb {
+                cells[b * n + j].store(&mut r[b * W..ny.min((b + 1) * W)]);
             }
         }
     }
@@ -623,39 +560,19 @@ fn scale(hb: &HarmBlock, normalised: bool) -> Cx {
     }
 }
 
-/// Block `b` of cell `j` of a spectral row.
-#[inline(always)]
-fn load(row: &ndarray::ArrayViewMut2<C64>, j: usize, b: usize, ny: usize) -> Cx {
-    let r = row.row(j);
-    Cx::load(&r.as_slice().expect("contiguous spectral row")[b * W..ny.min((b + 1) * W)])
-}
-
-#[inline(always)]
-fn store(x: Cx, row: &mut ndarray::ArrayViewMut2<C64>, j: usize, b: usize, ny: usize) {
-    let mut r = row.row_mut(j);
-    x.store(&mut r.as_slice_mut().expect("contiguous spectral row")[b * W..ny.min((b + 1) * W)]);
-}
-
 /// Per-row scratch of [`ShiftTable::shifted_green_row`].
 pub struct RowScratch {
-    /// `w_j` and `g u_j − x'_j` per cell and block.
-    wy: Vec<[Cx; 2]>,
-    bp: Vec<Cx>,
-    u: Vec<Cx>,
-    d: Vec<Cx>,
-    /// One cell of the row, natural order.
-    xr: Vec<Cx>,
+    /// The row's cells, layout (block, cell).
+    cells: Vec<Cx>,
+    /// `w_j` of one block.
+    w: Vec<Cx>,
 }
 
 impl RowScratch {
     pub fn new(n: usize, ny: usize) -> Self {
-        let nb = ny.div_ceil(W);
         RowScratch {
-            wy: vec![[Cx::ZERO; 2]; n * nb],
-            bp: vec![Cx::ZERO; nb],
-            u: vec![Cx::ZERO; nb],
-            d: vec![Cx::ZERO; nb],
-            xr: vec![Cx::ZERO; nb],
+            cells: vec![Cx::ZERO; n * ny.div_ceil(W)],
+            w: vec![Cx::ZERO; n],
         }
     }
 }

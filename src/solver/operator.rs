@@ -15,6 +15,7 @@
 use super::fft::{Fft2, FftScratch};
 use super::green::{self, Slab};
 use super::shift::simd::{self, Cx, W};
+use super::shift::AHEAD;
 use super::shift::{BandScratch, RowScratch, ShiftTable};
 use ndarray::{Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64 as C64;
@@ -175,8 +176,12 @@ impl GreenTable {
         // contiguous scratch, layout (block, cell), and back at the end.
         let cells = &mut scr.cells[..nb * n];
         for j in 0..n {
-            if j + 1 < n {
-                simd::prefetch(row.row(j + 1).as_slice().expect("contiguous spectral row"));
+            if j + AHEAD < n {
+                simd::prefetch(
+                    row.row(j + AHEAD)
+                        .as_slice()
+                        .expect("contiguous spectral row"),
+                );
             }
             let r = row.row(j);
             let r = r.as_slice().expect("contiguous spectral row");

@@ -502,8 +502,12 @@ impl ShiftTable {
         // cell ahead, and write the result back at the end.
         let cells = &mut scr.cells[..nb * n];
         for j in 0..n {
-            if j + 1 < n {
-                simd::prefetch(row.row(j + 1).as_slice().expect("contiguous spectral row"));
+            if j + AHEAD < n {
+                simd::prefetch(
+                    row.row(j + AHEAD)
+                        .as_slice()
+                        .expect("contiguous spectral row"),
+                );
             }
             let r = row.row(j);
             let r = r.as_slice().expect("contiguous spectral row");
@@ -675,6 +679,9 @@ fn dense_inverse_shift(m: &[C64], n: usize, c: C64) -> Vec<C64> {
     inv
 }
 
+/// How many cells ahead the sweeps prefetch a spectral row.
+pub(super) const AHEAD: usize = 3;
+
 /// Complex arithmetic on [`W`] lanes at once (split real and imaginary
 /// parts), written so LLVM vectorises it, and a dispatcher that runs a
 /// kernel compiled for the widest vector unit the CPU has. Each lane does
@@ -715,10 +722,11 @@ pub(super) mod simd {
         #[inline(always)]
         pub fn load(src: &[C64]) -> Cx {
             let mut x = Cx::ZERO;
+            // A full block as an array, so the copy compiles to vector shuffles.
             if let Ok(src) = <&[C64; W]>::try_from(src) {
-                for k in 0..W {
-                    x.re[k] = src[k].re;
-                    x.im[k] = src[k].im;
+                for (k, c) in src.iter().enumerate() {
+                    x.re[k] = c.re;
+                    x.im[k] = c.im;
                 }
             } else {
                 for (k, c) in src.iter().enumerate() {
@@ -733,8 +741,8 @@ pub(super) mod simd {
         #[inline(always)]
         pub fn store(&self, dst: &mut [C64]) {
             if let Ok(dst) = <&mut [C64; W]>::try_from(&mut *dst) {
-                for k in 0..W {
-                    dst[k] = C64::new(self.re[k], self.im[k]);
+                for (k, c) in dst.iter_mut().enumerate() {
+                    *c = C64::new(self.re[k], self.im[k]);
                 }
             } else {
                 for (k, c) in dst.iter_mut().enumerate() {

@@ -263,7 +263,12 @@ impl ShiftTable {
     /// Down-sweep cells stored, summed over all harmonics (at most
     /// (N − 1) per harmonic; the rest are reused).
     pub fn stored_cells(&self) -> usize {
-        self.block_cells.iter().sum::<usize>() * W
+        let (nb, ny) = (self.nb, self.ny);
+        self.block_cells
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| c * W.min(ny - (i % nb) * W))
+            .sum()
     }
 
     /// The stored cells of block `b` of row `ix` (the last one stands for

@@ -2,10 +2,12 @@
 //! by every solver.
 //!
 //! One application = a forward 2-D FFT of every z-slice, per Bloch harmonic
-//! three O(Nz) sweeps (down, up, assemble) that apply the exact Galerkin
-//! matrix of [`green`](super::green), and the inverse 2-D FFT. Fields hold the
-//! periodic part `v` of the Bloch field `u = v e^{iq·ρ}`, as z-cell averages,
-//! stored `(nz, ny, nx)`.
+//! two O(Nz) sweeps (down, then up with the assembly) that apply the exact
+//! Galerkin matrix of [`green`](super::green), and the inverse 2-D FFT. The
+//! sweeps run on blocks of `W` = 8 harmonics of one spectral row at a time
+//! (vectorised, see `shift::simd`), on a contiguous copy of the row. Fields
+//! hold the periodic part `v` of the Bloch field `u = v e^{iq·ρ}`, as z-cell
+//! averages, stored `(nz, ny, nx)`.
 //!
 //! A [`GreenTable`] holds everything that depends on the background
 //! permittivity (binder for the physical problem, binder shifted by `iε_s` for
@@ -85,13 +87,13 @@ struct Special {
 /// Per-harmonic data of the Green's operator for one background permittivity.
 pub struct GreenTable {
     pub eps_bg: C64,
-    /// Sweep coefficients, layout (ix, block of [`W`] harmonics).
+    /// Sweep coefficients, layout (ix, block of `W` harmonics).
     blocks: Vec<GreenBlock>,
     special: Vec<Special>,
 }
 
-/// The sweep coefficients of [`W`] harmonics: `q` and the Galerkin weights
-/// `f2, r2n, diag, rf` of [`Coef`], each times `K dz/(nx ny)` (the overall
+/// The sweep coefficients of `W` harmonics: `q` and the Galerkin weights
+/// `f2, r2n, diag, rf` of [`green::Coef`], each times `K dz/(nx ny)` (the overall
 /// factor and the inverse FFT's normalisation). Grazing harmonics have zeros.
 #[derive(Debug, Clone, Copy)]
 struct GreenBlock {
@@ -153,7 +155,7 @@ impl GreenTable {
     }
 
     /// `row ← G_b row / (nx ny)` for the non-grazing harmonics of spectral
-    /// row `ix` (`row` is (N, ny)), [`W`] harmonics per operation.
+    /// row `ix` (`row` is (N, ny)), `W` harmonics per operation.
     ///
     /// With `s_k` the cell sources and `p_m = q^m` (one running product per
     /// application, kept in scratch): down sweep `A_j = Σ_{k<j} q^{j−1−k} s_k`,
@@ -161,7 +163,7 @@ impl GreenTable {
     /// `f2 A_j + r2n p_{N−1−j} C_j`; up sweep `B_j = Σ_{k>j} q^{k−j−1} s_k`,
     /// `D_j = Σ_{k>j} q^{N−1−k} s_k` and the result
     /// `stored + f2 B_j + r2n p_j D_j + diag s_j + rf (p_j Se + p_{N−1−j} Sh)`,
-    /// `Se = C_N` (the Galerkin matrix of [`Coef::entry`] applied in O(N)).
+    /// `Se = C_N` (the Galerkin matrix of [`green::Coef::entry`] applied in O(N)).
     #[inline(always)]
     fn row_kernel(&self, ix: usize, row: &mut ArrayViewMut2<C64>, scr: &mut GreenScratch) {
         let (n, ny) = row.dim();

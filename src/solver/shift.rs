@@ -50,7 +50,7 @@ struct Dense {
     bottom: Vec<C64>,
 }
 
-/// Down-sweep coefficients of cell j for [`W`] harmonics, independent of
+/// Down-sweep coefficients of cell j for `W` harmonics, independent of
 /// the right-hand side: `u_{j+1} = ua Δ_j + ub u_j`, `w_j = wa Δ_j + wb u_j`,
 /// `d_j = v d_{j+1} + w_j`, and `gt = g (1 + t_j)` the output weight of
 /// `d_j` (`G_s x` at cell j is `g σ_j − x'_j`, `σ_j = (1 + t_j) d_j + u_j`).
@@ -64,7 +64,7 @@ struct StepBlock {
     wb: Cx,
 }
 
-/// Per-harmonic constants of [`W`] harmonics of one spectral row: the input
+/// Per-harmonic constants of `W` harmonics of one spectral row: the input
 /// scale `s = 1/γ_s²` (and `sn = s/(nx ny)`, which also normalises the inverse
 /// FFT), the top relation `u_0 = top x'_0`, the bottom closure
 /// `d_{N−1} = eb x'_{N−1} + eu u_{N−1}`, the output weight `g = γ² φ1 s` and
@@ -86,7 +86,7 @@ struct HarmBlock {
 /// that converges geometrically (the shifted background is lossy), and every
 /// coefficient of cell j is a function of `t_j`. Per spectral row only the
 /// cells until all its harmonics' coefficients have settled to within
-/// [`SETTLED`] (relative, i.e. to rounding) are stored; later cells reuse the
+/// `SETTLED` (relative, i.e. to rounding) are stored; later cells reuse the
 /// last stored one. Rows of evanescent harmonics then need a few cells
 /// instead of N, and the table stays in cache instead of streaming
 /// 96 bytes per voxel on every application.
@@ -99,9 +99,9 @@ pub struct ShiftTable {
     dense: Vec<Dense>,
     n: usize,
     ny: usize,
-    /// Blocks of [`W`] harmonics per spectral row.
+    /// Blocks of `W` harmonics per spectral row.
     nb: usize,
-    /// Per block of [`W`] harmonics, layout (ix, block): index of its first
+    /// Per block of `W` harmonics, layout (ix, block): index of its first
     /// stored cell in `steps` and the number stored (consecutive cells).
     block_off: Vec<usize>,
     block_cells: Vec<usize>,
@@ -138,7 +138,7 @@ impl Step {
         [self.gt, self.v, self.ua, self.ub, self.wa, self.wb]
     }
 
-    /// All fields of `other` within [`SETTLED`] of ours.
+    /// All fields of `other` within `SETTLED` of ours.
     fn settled(&self, other: &Step) -> bool {
         self.fields()
             .iter()
@@ -475,7 +475,7 @@ impl ShiftTable {
 impl ShiftTable {
     /// `row ← G_s row` for every harmonic of spectral row `ix` at once
     /// (`row` is (N, ny), the cell index outermost), the same arithmetic as
-    /// [`Self::shifted_green_column`] on [`W`] harmonics per operation, so
+    /// [`Self::shifted_green_column`] on `W` harmonics per operation, so
     /// the loops vectorise. Near-grazing harmonics come out zero (the caller
     /// applies their dense path). With `normalised`, the result is scaled
     /// by `1/(nx ny)` (the inverse FFT's normalisation) at no extra cost.
@@ -687,7 +687,7 @@ fn dense_inverse_shift(m: &[C64], n: usize, c: C64) -> Vec<C64> {
 /// How many cells ahead the sweeps prefetch a spectral row.
 pub(super) const AHEAD: usize = 3;
 
-/// Complex arithmetic on [`W`] lanes at once (split real and imaginary
+/// Complex arithmetic on `W` lanes at once (split real and imaginary
 /// parts), written so LLVM vectorises it, and a dispatcher that runs a
 /// kernel compiled for the widest vector unit the CPU has. Each lane does
 /// exactly the operations of `num_complex` (no fused multiply-add), so
@@ -723,7 +723,7 @@ pub(super) mod simd {
             self.im[k] = c.im;
         }
 
-        /// Lanes from `src` (at most [`W`] values; the rest zero).
+        /// Lanes from `src` (at most `W` values; the rest zero).
         #[inline(always)]
         pub fn load(src: &[C64]) -> Cx {
             let mut x = Cx::ZERO;
@@ -742,7 +742,7 @@ pub(super) mod simd {
             x
         }
 
-        /// The first `dst.len()` (at most [`W`]) lanes into `dst`.
+        /// The first `dst.len()` (at most `W`) lanes into `dst`.
         #[inline(always)]
         pub fn store(&self, dst: &mut [C64]) {
             if let Ok(dst) = <&mut [C64; W]>::try_from(&mut *dst) {

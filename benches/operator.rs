@@ -3,9 +3,14 @@
 //! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
 //! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
 //!
-//! `cargo bench --bench operator`
+//! `cargo bench --bench operator` (256 × 256 × 64 and 512 × 512 × 96; the
+//! larger grid needs about 3 GB). Each is measured twice: wall time
+//! (`operator`) and the CPU time of all the process's threads together
+//! (`operator_cpu`, Linux), which other processes competing for the cores
+//! disturb much less.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use inksim::solver::fft::Fft2;
 use inksim::solver::operator::{GreenTable, Operator};
 use inksim::solver::shift::ShiftTable;
@@ -19,10 +24,10 @@ fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
     })
 }
 
-fn bench(c: &mut Criterion) {
-    let mut g = c.benchmark_group("operator");
+fn bench<M: Measurement>(c: &mut Criterion<M>, name: &str) {
+    let mut g = c.benchmark_group(name);
     g.sample_size(10);
-    for &(n, nz) in &[(128usize, 64usize), (256, 64)] {
+    for &(n, nz) in &[(256usize, 64usize), (512, 96)] {
         let lat = Problem::lattice(
             [n, n, nz],
             [2560.0 * n as f64 / 256.0, 2560.0 * n as f64 / 256.0, 1000.0],
@@ -39,6 +44,7 @@ fn bench(c: &mut Criterion) {
             &(),
             |b, _| b.iter(|| op.apply(&table, &mut u, &mut ws)),
         );
+        drop(table);
         let c = lat.k0 * lat.k0 * C64::new(2.0 - 1.558f64.powi(2), 0.8);
         let shifted = ShiftTable::new(&lat, 1.558f64.powi(2), c);
         g.bench_with_input(
@@ -46,6 +52,7 @@ fn bench(c: &mut Criterion) {
             &(),
             |b, _| b.iter(|| op.apply_shifted_green(&shifted, &mut u, &mut ws)),
         );
+        drop(shifted);
         let fft = Fft2::new(n, n);
         let mut scr = fft.scratch(nz);
         let mut spec = Array3::zeros((nz, n, n));
@@ -64,5 +71,72 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
-criterion_main!(benches);
+/// CPU time of every thread of this process (ns), from
+/// `/proc/self/task/*/schedstat`; 0 where that is not available.
+fn process_cpu_ns() -> u64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    tasks
+        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum()
+}
+
+/// Criterion measurement: CPU time summed over threads.
+struct CpuTime;
+
+struct CpuFormatter;
+
+impl ValueFormatter for CpuFormatter {
+    fn scale_values(&self, _typical: f64, values: &mut [f64]) -> &'static str {
+        values.iter_mut().for_each(|v| *v *= 1e-6);
+        "ms cpu"
+    }
+    fn scale_throughputs(&self, _t: f64, _tp: &Throughput, values: &mut [f64]) -> &'static str {
+        values.iter_mut().for_each(|v| *v *= 1e-6);
+        "ms cpu"
+    }
+    fn scale_for_machines(&self, _values: &mut [f64]) -> &'static str {
+        "ns"
+    }
+}
+
+impl Measurement for CpuTime {
+    type Intermediate = u64;
+    type Value = u64;
+    fn start(&self) -> u64 {
+        process_cpu_ns()
+    }
+    fn end(&self, i: u64) -> u64 {
+        process_cpu_ns().saturating_sub(i)
+    }
+    fn add(&self, a: &u64, b: &u64) -> u64 {
+        a + b
+    }
+    fn zero(&self) -> u64 {
+        0
+    }
+    fn to_f64(&self, v: &u64) -> f64 {
+        *v as f64
+    }
+    fn formatter(&self) -> &dyn ValueFormatter {
+        &CpuFormatter
+    }
+}
+
+fn wall(c: &mut Criterion<WallTime>) {
+    bench(c, "operator");
+}
+
+fn cpu(c: &mut Criterion<CpuTime>) {
+    bench(c, "operator_cpu");
+}
+
+criterion_group!(walls, wall);
+criterion_group! {
+    name = cpus;
+    config = Criterion::default().with_measurement(CpuTime);
+    targets = cpu
+}
+criterion_main!(walls, cpus);

@@ -25,7 +25,7 @@
 
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Method, Scene};
+use crate::config::{Method, Precision, Scene};
 use crate::pipeline;
 use crate::solver::{MethodUsed, Problem, System};
 use ndarray::Array3;
@@ -46,13 +46,20 @@ pub const DEFAULT_APPLICATIONS: f64 = 200.0;
 /// vector updates and inner products), as a factor.
 pub const KRYLOV_OVERHEAD: f64 = 1.25;
 
-/// Bytes per voxel of a solve (docs/PERFORMANCE.md).
-pub fn bytes_per_voxel(m: Method) -> f64 {
-    match m {
-        Method::TimeMarching | Method::Born => 238.0,
-        Method::BiCgStab | Method::Auto => 318.0,
-        Method::Gmres => 574.0,
-    }
+/// Bytes per voxel of a solve: the solver's own peak measured by
+/// `examples/solver_memory` (docs/PERFORMANCE.md, "Memory") plus the
+/// pipeline's ε grid and its flipped copy for the solves from below
+/// (16 B each).
+pub fn bytes_per_voxel(m: Method, p: Precision) -> f64 {
+    let solver = match (m, p) {
+        (Method::TimeMarching | Method::Born, Precision::F64) => 86.0,
+        (Method::TimeMarching | Method::Born, Precision::F32) => 70.0,
+        (Method::BiCgStab | Method::Auto, Precision::F64) => 165.0,
+        (Method::BiCgStab | Method::Auto, Precision::F32) => 109.0,
+        (Method::Gmres, Precision::F64) => 421.0,
+        (Method::Gmres, Precision::F32) => 237.0,
+    };
+    solver + 32.0
 }
 
 /// Timings of one grid.
@@ -215,7 +222,9 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
         solves as f64 * (t.setup_s + cal.applications * t.apply_s * KRYLOV_OVERHEAD)
     });
     let bytes = BASELINE_BYTES
-        + voxels as f64 * (bytes_per_voxel(scene.solver.method) + 8.0 * scene.species.len() as f64);
+        + voxels as f64
+            * (bytes_per_voxel(scene.solver.method, scene.solver.precision)
+                + 8.0 * scene.species.len() as f64);
     Estimate {
         solves,
         grid,
@@ -254,9 +263,10 @@ mod tests {
 
     #[test]
     fn memory_model_matches_the_documented_rates() {
-        assert_eq!(bytes_per_voxel(Method::TimeMarching), 238.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab), 318.0);
-        assert_eq!(bytes_per_voxel(Method::Gmres), 574.0);
+        assert_eq!(bytes_per_voxel(Method::TimeMarching, Precision::F64), 118.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64), 197.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32), 141.0);
+        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64), 453.0);
         assert_eq!(human_time(30.0), "30.0 s");
         assert_eq!(human_time(600.0), "10 min");
         assert_eq!(human_time(7200.0), "2.0 h");

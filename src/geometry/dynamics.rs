@@ -155,7 +155,7 @@ pub struct DynParams {
     /// Relaxation steps allowed per batch (≥ 1, default 20 000).
     pub max_steps_per_batch: u64,
     /// First-order steps of a batch after which, if it has not converged,
-    /// its relaxation continues with FIRE (default 2 000; 0: FIRE from the
+    /// its relaxation continues with FIRE (default 200; 0: FIRE from the
     /// start, `u64::MAX`: never).
     pub fire_after_steps: u64,
     /// Size distribution and clustering per species; empty: defaults.
@@ -175,7 +175,7 @@ impl DynParams {
             overlap_tolerance: 0.01,
             batch_fraction: 0.1,
             max_steps_per_batch: 20_000,
-            fire_after_steps: 2_000,
+            fire_after_steps: 200,
             options: Vec::new(),
             relief_fraction: 0.0,
         }
@@ -473,6 +473,10 @@ struct State {
     nb_skin: f64,
     /// Largest centre distance at which two particles can interact, nm.
     max_reach: f64,
+    /// Every particle is one sphere and none is in a seeded cluster; then
+    /// `radius0` holds the radii (FIRE stage fast path).
+    plain_spheres: bool,
+    radius0: Vec<f64>,
     moving_mark: Vec<u64>,
     touched_mark: Vec<u64>,
     epoch: u64,
@@ -912,6 +916,15 @@ impl State {
     /// interaction reach plus `nb_skin`, in cell order: deterministic).
     fn build_neighbours(&mut self) {
         let n = self.center.len();
+        self.plain_spheres = (0..n).all(|p| {
+            self.cluster[p] == EMPTY && self.specs[self.species[p] as usize].spheres.len() == 1
+        });
+        self.radius0.clear();
+        if self.plain_spheres {
+            self.radius0.extend(
+                (0..n).map(|p| self.specs[self.species[p] as usize].spheres[0].1 * self.scale[p]),
+            );
+        }
         self.nb_start.clear();
         self.nb.clear();
         self.nb_disp.clear();
@@ -986,6 +999,38 @@ impl State {
                     let (mut fi, mut mi, w) = this.walls(i);
                     worst = worst.max(w);
                     let (a, b) = (this.nb_start[i] as usize, this.nb_start[i + 1] as usize);
+                    if this.plain_spheres {
+                        // Same force as `pair` for two one-sphere particles
+                        // without a cluster bond, inlined.
+                        let ci = this.center[i];
+                        let ri = this.radius0[i];
+                        for &j in &this.nb[a..b] {
+                            let j = j as usize;
+                            let cj = this.center[j];
+                            let d = [
+                                near_image(cj[0] - ci[0], this.size[0]),
+                                near_image(cj[1] - ci[1], this.size[1]),
+                                cj[2] - ci[2],
+                            ];
+                            let rsum = ri + this.radius0[j];
+                            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                            if d2 >= rsum * rsum {
+                                continue;
+                            }
+                            let dist = d2.sqrt();
+                            let l = rsum - dist;
+                            worst = worst.max(l);
+                            let mag = -K * (l + this.push);
+                            if dist > 1e-12 * rsum {
+                                add(&mut fi, &d, mag / dist);
+                            } else {
+                                fi[2] -= mag;
+                            }
+                        }
+                        *f = fi;
+                        *m = mi;
+                        continue;
+                    }
                     for &j in &this.nb[a..b] {
                         if let Some(pf) = this.pair(i, j as usize) {
                             worst = worst.max(pf.worst);
@@ -1217,6 +1262,8 @@ impl DynamicsPacker {
             nb_disp: Vec::new(),
             nb_skin: VERLET_SKIN * if r_min_all.is_finite() { r_min_all } else { 0.0 },
             max_reach: cell,
+            plain_spheres: false,
+            radius0: Vec::new(),
             moving_mark: Vec::with_capacity(total),
             touched_mark: Vec::with_capacity(total),
             epoch: 0,

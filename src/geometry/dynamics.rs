@@ -164,6 +164,10 @@ pub struct DynParams {
     /// fraction of their effective diameter, `[0, MAX_RELIEF_FRACTION]`
     /// (default 0: flat top).
     pub relief_fraction: f64,
+    /// Hard-particle Monte Carlo sweeps run on the packed fragment
+    /// ([`super::mc::equilibrate`], moves may not deepen an overlap beyond
+    /// the tolerance), `[0, mc::MAX_SWEEPS]` (default 0: none).
+    pub equilibrate_sweeps: u64,
 }
 
 impl DynParams {
@@ -178,6 +182,7 @@ impl DynParams {
             fire_after_steps: 200,
             options: Vec::new(),
             relief_fraction: 0.0,
+            equilibrate_sweeps: 0,
         }
     }
 }
@@ -227,6 +232,7 @@ fn validate(p: &DynParams, seed: u64) -> Result<(Vec<Spec>, Vec<Vec<f64>>), Geom
     }
     let options = options_of(&p.options, p.species.len())?;
     check_relief(p.relief_fraction)?;
+    super::check_sweeps(p.equilibrate_sweeps)?;
     let volume = lx * ly * h;
     let mut total = 0.0;
     let mut out = Vec::with_capacity(p.species.len());
@@ -1517,7 +1523,20 @@ pub fn pack_dynamics(params: &DynParams, seed: u64) -> Result<Geometry, Geometry
     while packer.insert_batch() {
         packer.relax()?;
     }
-    Ok(packer.geometry())
+    let mut g = packer.geometry();
+    if params.equilibrate_sweeps > 0 {
+        super::mc::equilibrate(
+            g.size_nm,
+            &mut g.particles,
+            params.relief_fraction,
+            packer.tolerance_nm(),
+            params.equilibrate_sweeps,
+            seed,
+        );
+        g.stats.min_gap_nm = min_gap_nm(g.size_nm, &g.particles);
+        g.stats.worst_overlap_nm = (-g.stats.min_gap_nm).max(0.0);
+    }
+    Ok(g)
 }
 
 /// Unit axes of the particles of `g` (first to last sphere, nearest periodic

@@ -21,6 +21,7 @@
 
 mod cells;
 mod dynamics;
+pub mod mc;
 mod rsa;
 mod shapes;
 pub mod stats;
@@ -106,6 +107,18 @@ pub(crate) fn check_relief(f: f64) -> Result<f64, GeometryError> {
     } else {
         Err(GeometryError::Invalid(format!(
             "relief fraction {f} must be in [0, {MAX_RELIEF_FRACTION}]"
+        )))
+    }
+}
+
+/// Checks a number of Monte Carlo sweeps against `[0, mc::MAX_SWEEPS]`.
+pub(crate) fn check_sweeps(n: u64) -> Result<u64, GeometryError> {
+    if n <= mc::MAX_SWEEPS {
+        Ok(n)
+    } else {
+        Err(GeometryError::Invalid(format!(
+            "equilibrate_sweeps {n} must be in [0, {}]",
+            mc::MAX_SWEEPS
         )))
     }
 }
@@ -233,6 +246,9 @@ pub struct PackParams {
     /// Grains may protrude through the top surface `z = 0` by up to this
     /// fraction of their diameter, `[0, MAX_RELIEF_FRACTION]` (0: flat).
     pub relief_fraction: f64,
+    /// Hard-sphere Monte Carlo sweeps run on the packed fragment
+    /// ([`mc::equilibrate`]), `[0, mc::MAX_SWEEPS]` (0: none).
+    pub equilibrate_sweeps: u64,
 }
 
 /// The METHOD §1 default fragment (10 × 10 µm, 1 µm thick), no species,
@@ -255,6 +271,7 @@ impl PackParams {
             max_attempts_per_particle: Self::DEFAULT_MAX_ATTEMPTS,
             options: Vec::new(),
             relief_fraction: 0.0,
+            equilibrate_sweeps: 0,
         }
     }
 }
@@ -367,6 +384,7 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
     }
     let options = options_of(&params.options, params.species.len())?;
     check_relief(params.relief_fraction)?;
+    check_sweeps(params.equilibrate_sweeps)?;
     let volume = lx * ly * h;
     let mut total_fraction = 0.0;
     for (i, s) in params.species.iter().enumerate() {
@@ -418,7 +436,15 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
 pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryError> {
     let diameters = validate(params, seed)?;
     let options = options_of(&params.options, params.species.len())?;
-    let (particles, attempts) = rsa::pack(params, &diameters, &options, seed)?;
+    let (mut particles, attempts) = rsa::pack(params, &diameters, &options, seed)?;
+    mc::equilibrate(
+        params.size_nm,
+        &mut particles,
+        params.relief_fraction,
+        0.0,
+        params.equilibrate_sweeps,
+        seed,
+    );
     let volume = params.size_nm.iter().product::<f64>();
     let achieved_fraction = diameters
         .iter()

@@ -612,21 +612,22 @@ fn size_distributions_are_drawn_truncated_and_reach_the_target() {
 #[test]
 fn rsa_agglomeration_makes_clusters() {
     let base = PackParams::new([1500.0, 1500.0, 500.0], vec![species(50.0, 0.1)]);
-    let stats = |c: usize| {
-        let p = with_options(
+    let stats = |c: usize, sweeps: u64| {
+        let mut p = with_options(
             base.clone(),
             SpeciesOptions {
                 size: SizeDistribution::Fixed,
                 cluster_size: c,
             },
         );
+        p.equilibrate_sweeps = sweeps;
         let g = pack_rsa(&p, 3).unwrap();
         assert!(brute_min_gap(&g) >= 0.0);
         check_inside(&g);
         analyse(&g, &StatsParams::default())
     };
-    let free = stats(1);
-    let clumped = stats(8);
+    let free = stats(1, 0);
+    let clumped = stats(8, 0);
     eprintln!(
         "RSA 10 %: clusters of 1 → mean {:.2} (weighted {:.2}); of 8 → mean {:.2} (weighted {:.2}), largest {}",
         free.cluster_mean(),
@@ -637,6 +638,21 @@ fn rsa_agglomeration_makes_clusters() {
     );
     assert!(free.cluster_weighted_mean() < 2.0);
     assert!(clumped.cluster_weighted_mean() > 6.0);
+    // After Monte Carlo sweeps (mates stick) chance contacts open: the mean
+    // cluster size is the seeded one.
+    let (free, clumped) = (stats(1, 20), stats(8, 20));
+    eprintln!(
+        "RSA 10 % + 20 MC sweeps: clusters of 1 → mean {:.2}; of 8 → mean {:.2} (weighted {:.2})",
+        free.cluster_mean(),
+        clumped.cluster_mean(),
+        clumped.cluster_weighted_mean()
+    );
+    assert!(free.cluster_mean() < 1.1, "{}", free.cluster_mean());
+    assert!(
+        (6.5..=9.0).contains(&clumped.cluster_mean()),
+        "{}",
+        clumped.cluster_mean()
+    );
     let bad = with_options(
         base,
         SpeciesOptions {

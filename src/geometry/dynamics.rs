@@ -152,7 +152,7 @@ pub struct DynParams {
     pub overlap_tolerance: f64,
     /// Volume fraction added per batch, in `(0, 1]` (default 0.1).
     pub batch_fraction: f64,
-    /// Relaxation steps allowed per batch (≥ 1, default 20 000).
+    /// Relaxation steps allowed per batch (≥ 1, default 100 000).
     pub max_steps_per_batch: u64,
     /// First-order steps of a batch after which, if it has not converged,
     /// its relaxation continues with FIRE (default 200; 0: FIRE from the
@@ -178,7 +178,7 @@ impl DynParams {
             species,
             overlap_tolerance: 0.01,
             batch_fraction: 0.1,
-            max_steps_per_batch: 20_000,
+            max_steps_per_batch: 100_000,
             fire_after_steps: 200,
             options: Vec::new(),
             relief_fraction: 0.0,
@@ -501,7 +501,18 @@ struct State {
 /// `x` wrapped into `[0, l)`.
 #[inline]
 fn wrap(x: f64, l: f64) -> f64 {
-    let w = x.rem_euclid(l);
+    let w = if x < 0.0 {
+        x + l
+    } else if x >= l {
+        x - l
+    } else {
+        return x;
+    };
+    let w = if (0.0..l).contains(&w) {
+        w
+    } else {
+        w.rem_euclid(l)
+    };
     if w >= l {
         0.0
     } else {
@@ -629,11 +640,7 @@ impl State {
         self.moving.sort_unstable();
         self.moving_mark.iter_mut().for_each(|m| *m = 0);
         self.touched_mark.iter_mut().for_each(|m| *m = 0);
-        self.grid.head.iter_mut().for_each(|h| *h = EMPTY);
-        for p in (0..n).rev() {
-            let f = self.grid.flat(self.grid.coords(&self.center[p]));
-            self.grid.link(p, f);
-        }
+        self.relink();
         inv
     }
 
@@ -922,6 +929,8 @@ impl State {
     /// interaction reach plus `nb_skin`, in cell order: deterministic).
     fn build_neighbours(&mut self) {
         let n = self.center.len();
+        // The FIRE stage moves particles without updating their cells.
+        self.relink();
         self.plain_spheres = (0..n).all(|p| {
             self.cluster[p] == EMPTY && self.specs[self.species[p] as usize].spheres.len() == 1
         });
@@ -1077,7 +1086,7 @@ impl State {
         for k in 0..self.touched.len() {
             let p = self.touched[k] as usize;
             let (f, mut m) = (self.force[p], self.torque[p]);
-            if norm(&f) != 0.0 || norm(&m) != 0.0 {
+            if f != [0.0; 3] || m != [0.0; 3] {
                 let spec = &self.specs[self.species[p] as usize];
                 add_field_torque(spec, self.scale[p], &self.axis[p], &mut m);
                 self.torque[p] = m;
@@ -1149,7 +1158,7 @@ impl State {
         for k in 0..self.touched.len() {
             let p = self.touched[k] as usize;
             let (v, w) = (self.vel[p], self.ang[p]);
-            if norm(&v) == 0.0 && norm(&w) == 0.0 {
+            if v == [0.0; 3] && w == [0.0; 3] {
                 continue;
             }
             let c0 = self.center[p];
@@ -1160,7 +1169,6 @@ impl State {
             ];
             self.axis[p] = rotate(&self.axis[p], &w, dt_move);
             self.center[p] = c;
-            self.grid.update(p, &c);
             self.moving.push(p as u32);
             let spec = &self.specs[self.species[p] as usize];
             self.nb_disp[p] += (norm(&v) + norm(&w) * spec.s_max * self.scale[p]) * dt_move;
@@ -1172,9 +1180,23 @@ impl State {
         worst
     }
 
+    /// Rebuilds every cell list from the particle centres (deterministic:
+    /// each cell lists its particles in index order).
+    fn relink(&mut self) {
+        self.grid.head.iter_mut().for_each(|h| *h = EMPTY);
+        for p in (0..self.center.len()).rev() {
+            let f = self.grid.flat(self.grid.coords(&self.center[p]));
+            self.grid.link(p, f);
+        }
+    }
+
     /// Sets every velocity to zero (only particles of the moving list can
-    /// have one).
+    /// have one) and, after a FIRE stage, puts every particle back in its
+    /// cell.
     fn stop(&mut self) {
+        if !self.nb_start.is_empty() {
+            self.relink();
+        }
         self.nb_start.clear();
         for k in 0..self.moving.len() {
             let p = self.moving[k] as usize;
@@ -1528,6 +1550,7 @@ pub fn pack_dynamics(params: &DynParams, seed: u64) -> Result<Geometry, Geometry
         super::mc::equilibrate(
             g.size_nm,
             &mut g.particles,
+            &packer.st.cluster,
             params.relief_fraction,
             packer.tolerance_nm(),
             params.equilibrate_sweeps,

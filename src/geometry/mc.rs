@@ -14,6 +14,15 @@
 //! every allowed configuration has the same weight, so this is the Metropolis
 //! rule exactly.
 //!
+//! Agglomerates: with seeded cluster groups (`groups`, one id per particle,
+//! `u32::MAX` for none), two spheres of mates whose surfaces are within
+//! `contact_nm` stay so — a move that would take them apart is rejected
+//! (mates stick once in contact, an irreversible rule: the agglomerates are
+//! kept, everything else equilibrates), and every sweep also proposes one
+//! rigid translation of each agglomerate as a whole. Non-mates that the
+//! packer left touching separate, so contact clusters then measure the
+//! agglomerates.
+//!
 //! One sweep proposes one move per particle, in index order, with a
 //! displacement uniform in `[−δ, δ]³`; between sweeps `δ` is scaled by 1.1
 //! towards an acceptance of one half (`δ` starts at 0.1 and stays within
@@ -28,6 +37,19 @@ use super::Particle;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
+/// `x` wrapped into `[0, l)`.
+fn wrap(x: f64, l: f64) -> f64 {
+    let w = x.rem_euclid(l);
+    if w >= l {
+        0.0
+    } else {
+        w
+    }
+}
+
+/// Contact gap of sticking mates, in units of the smallest sphere radius
+/// (the default contact gap of the cluster statistics).
+pub const CONTACT_GAP: f64 = 0.05;
 /// Largest number of sweeps [`equilibrate`] accepts (config limit).
 pub const MAX_SWEEPS: u64 = 100_000;
 
@@ -106,11 +128,19 @@ impl Cells {
 pub fn equilibrate(
     size: [f64; 3],
     particles: &mut [Particle],
+    groups: &[u32],
     relief_fraction: f64,
     allow_nm: f64,
     sweeps: u64,
     seed: u64,
 ) -> McReport {
+    let contact_nm = CONTACT_GAP
+        * particles
+            .iter()
+            .flat_map(|p| &p.spheres)
+            .map(|s| s.radius)
+            .fold(f64::INFINITY, f64::min);
+    let sticky = groups.len() == particles.len() && groups.iter().any(|&g| g != u32::MAX);
     let n = particles.len();
     if n == 0 || sweeps == 0 {
         return McReport::default();
@@ -140,7 +170,15 @@ pub fn equilibrate(
         .map(|(c, r)| c[2] - r)
         .fold(0.0, f64::min)
         .min(-relief_fraction * 2.0 * r_max);
-    let width = 2.0 * r_max + allow_nm.max(0.0);
+    // Cells wide enough that every mate in contact with a sphere's old place
+    // is found around its trial place (δ ≤ r_min).
+    let width = 2.0 * r_max
+        + allow_nm.max(0.0)
+        + if sticky {
+            contact_nm + 2.0 * r_min
+        } else {
+            0.0
+        };
     let span = [size[0], size[1], size[2] - z_lo + allow_nm.max(0.0)];
     let cn = [0, 1, 2].map(|a| ((span[a] / width).floor() as usize).max(1));
     let mut cells = Cells {
@@ -156,6 +194,22 @@ pub fn equilibrate(
         cell_of.push(f as u32);
     }
 
+    // Members of every seeded agglomerate of two or more particles.
+    let mut agglomerates: Vec<Vec<usize>> = Vec::new();
+    if sticky {
+        let mut by_group: Vec<(u32, usize)> = groups
+            .iter()
+            .enumerate()
+            .filter(|(_, &g)| g != u32::MAX)
+            .map(|(p, &g)| (g, p))
+            .collect();
+        by_group.sort_unstable();
+        for run in by_group.chunk_by(|a, b| a.0 == b.0) {
+            if run.len() > 1 {
+                agglomerates.push(run.iter().map(|&(_, p)| p).collect());
+            }
+        }
+    }
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ 0x3c6e_f372_fe94_f82b);
     let mut step = 0.1 * r_min;
     let (mut accepted, mut proposed) = (0u64, 0u64);
@@ -213,9 +267,25 @@ pub fn equilibrate(
                                     let dy = near_image(t[1] - b[1], size[1]);
                                     let dz = t[2] - b[2];
                                     let reach = r + rad[o] - allow_nm;
-                                    if reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach {
+                                    let d2 = dx * dx + dy * dy + dz * dz;
+                                    if reach > 0.0 && d2 < reach * reach {
                                         ok = false;
                                         break 'spheres;
+                                    }
+                                    let g = groups.get(p).copied().unwrap_or(u32::MAX);
+                                    if sticky && g != u32::MAX && groups[owner[o] as usize] == g {
+                                        let touch = r + rad[o] + contact_nm;
+                                        let a = pos[start[p] + k];
+                                        let old = [
+                                            near_image(a[0] - b[0], size[0]),
+                                            near_image(a[1] - b[1], size[1]),
+                                            a[2] - b[2],
+                                        ];
+                                        let o2 = old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
+                                        if o2 <= touch * touch && d2 > touch * touch {
+                                            ok = false;
+                                            break 'spheres;
+                                        }
                                     }
                                 }
                             }
@@ -238,6 +308,81 @@ pub fn equilibrate(
                     v.swap_remove(at);
                     cells.list[f].push(q as u32);
                     cell_of[q] = f as u32;
+                }
+            }
+        }
+        // One rigid move per agglomerate, so that agglomerates left touching
+        // by the packer can drift apart.
+        for members in &agglomerates {
+            let dv = [
+                step * (2.0 * rng.gen::<f64>() - 1.0),
+                step * (2.0 * rng.gen::<f64>() - 1.0),
+                step * (2.0 * rng.gen::<f64>() - 1.0),
+            ];
+            let g = groups[members[0]];
+            trial.clear();
+            let mut ok = true;
+            'members: for &p in members {
+                for q in start[p]..start[p + 1] {
+                    let c = pos[q];
+                    let t = [
+                        wrap(c[0] + dv[0], size[0]),
+                        wrap(c[1] + dv[1], size[1]),
+                        c[2] + dv[2],
+                    ];
+                    if t[2] - rad[q] < z_min[p] || t[2] + rad[q] > h + allow_nm {
+                        ok = false;
+                        break 'members;
+                    }
+                    let cc = cells.coords(cells.index(&t));
+                    let (z0, z1) = cells.range(2, cc[2]);
+                    let (y0, y1) = cells.range(1, cc[1]);
+                    let (x0, x1) = cells.range(0, cc[0]);
+                    for cz in z0..=z1 {
+                        for cy in y0..=y1 {
+                            let wy = cy.rem_euclid(cells.n[1] as isize) as usize;
+                            for cx in x0..=x1 {
+                                let wx = cx.rem_euclid(cells.n[0] as isize) as usize;
+                                let f = (cz as usize * cells.n[1] + wy) * cells.n[0] + wx;
+                                for &o in &cells.list[f] {
+                                    let o = o as usize;
+                                    if groups[owner[o] as usize] == g {
+                                        continue;
+                                    }
+                                    let b = pos[o];
+                                    let dx = near_image(t[0] - b[0], size[0]);
+                                    let dy = near_image(t[1] - b[1], size[1]);
+                                    let dz = t[2] - b[2];
+                                    let reach = rad[q] + rad[o] - allow_nm;
+                                    if reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach {
+                                        ok = false;
+                                        break 'members;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    trial.push(t);
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let mut k = 0;
+            for &p in members {
+                for q in start[p]..start[p + 1] {
+                    let t = trial[k];
+                    k += 1;
+                    pos[q] = t;
+                    let f = cells.index(&t);
+                    let old = cell_of[q] as usize;
+                    if f != old {
+                        let v = &mut cells.list[old];
+                        let at = v.iter().position(|&x| x as usize == q).unwrap_or(0);
+                        v.swap_remove(at);
+                        cells.list[f].push(q as u32);
+                        cell_of[q] = f as u32;
+                    }
                 }
             }
         }

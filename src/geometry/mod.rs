@@ -436,10 +436,11 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
 pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryError> {
     let diameters = validate(params, seed)?;
     let options = options_of(&params.options, params.species.len())?;
-    let (mut particles, attempts) = rsa::pack(params, &diameters, &options, seed)?;
+    let (mut particles, groups, attempts) = rsa::pack(params, &diameters, &options, seed)?;
     mc::equilibrate(
         params.size_nm,
         &mut particles,
+        &groups,
         params.relief_fraction,
         0.0,
         params.equilibrate_sweeps,

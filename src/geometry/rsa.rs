@@ -217,13 +217,14 @@ fn wrap(x: f64, l: f64) -> f64 {
 }
 
 /// Places every species' spheres (`diameters[s]`); returns the particles in
-/// placement order and the number of centres drawn.
+/// placement order, the seeded group of each (`u32::MAX`: none) and the
+/// number of centres drawn.
 pub(crate) fn pack(
     params: &PackParams,
     diameters: &[Vec<f64>],
     options: &[SpeciesOptions],
     seed: u64,
-) -> Result<(Vec<Particle>, u64), GeometryError> {
+) -> Result<(Vec<Particle>, Vec<u32>, u64), GeometryError> {
     let size = params.size_nm;
     let total: usize = diameters.iter().map(Vec::len).sum();
     let dmax = diameters.iter().flatten().copied().fold(0.0, f64::max);
@@ -238,6 +239,7 @@ pub(crate) fn pack(
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut cells = CellList::new(size, dmax.max(f64::MIN_POSITIVE), total);
     let mut particles: Vec<Particle> = Vec::with_capacity(total);
+    let mut groups: Vec<u32> = Vec::with_capacity(total);
     let mut attempts = 0u64;
     let box_volume = size[0] * size[1] * size[2];
     let mut placed_volume = 0.0;
@@ -328,6 +330,11 @@ pub(crate) fn pack(
                 radius: r,
             };
             cells.insert(sphere, particles.len() as u32);
+            groups.push(if group > 1 {
+                group_start as u32
+            } else {
+                u32::MAX
+            });
             particles.push(Particle {
                 species: s,
                 spheres: vec![sphere],
@@ -335,5 +342,5 @@ pub(crate) fn pack(
             placed_volume += sphere_volume(r);
         }
     }
-    Ok((particles, attempts))
+    Ok((particles, groups, attempts))
 }

@@ -418,7 +418,9 @@ fn mc_equilibration_gives_carnahan_starling_contact_value() {
     assert!((contact / cs - 1.0).abs() < 0.04, "{contact} vs {cs}");
     let mut bad = PackParams::new([1600.0, 1600.0, 480.0], vec![species(d, phi)]);
     bad.equilibrate_sweeps = 100_001;
-    assert!(matches!(pack_rsa(&bad, 1), Err(GeometryError::Invalid(m)) if m.contains("equilibrate_sweeps")));
+    assert!(
+        matches!(pack_rsa(&bad, 1), Err(GeometryError::Invalid(m)) if m.contains("equilibrate_sweeps"))
+    );
 }
 
 #[test]

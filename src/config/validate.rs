@@ -33,13 +33,13 @@
 use super::raw::{RawAppearance, RawAxis, RawBody, RawProduct, RawStructure, RawSubstrate};
 use super::raw::{RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod};
 use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSize, RawSolver};
+use super::MAX_EQUILIBRATE_SWEEPS;
 use super::{
     Appearance, Body, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence,
     Layer, Material, Method, OutputSpec, Primitive, Products, Provenance, Scene, SolverSpec,
     Species, Structure, Substrate, MAX_CLUSTER_SIZE, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA,
     MAX_PVC, MAX_RELIEF_FRACTION,
 };
-use super::MAX_EQUILIBRATE_SWEEPS;
 use crate::config::materials::BUILTIN_NAMES;
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;

@@ -924,7 +924,6 @@ impl State {
         worst
     }
 
-
     /// Builds the Verlet list of every particle (neighbours within their
     /// interaction reach plus `nb_skin`, in cell order: deterministic).
     fn build_neighbours(&mut self) {
@@ -944,7 +943,9 @@ impl State {
         self.nb.clear();
         self.nb_disp.clear();
         self.nb_disp.resize(n, 0.0);
-        let w = self.grid.cell[0].min(self.grid.cell[1]).min(self.grid.cell[2]);
+        let w = self.grid.cell[0]
+            .min(self.grid.cell[1])
+            .min(self.grid.cell[2]);
         let k = ((self.max_reach + self.nb_skin) / w).ceil().max(1.0) as usize;
         let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
         self.nb_start.push(0);
@@ -1092,7 +1093,8 @@ impl State {
                 self.torque[p] = m;
             }
             let (v, w) = (self.vel[p], self.ang[p]);
-            power += f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2];
+            power +=
+                f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2];
         }
         if power > 0.0 {
             fire.n_pos += 1;
@@ -1288,7 +1290,12 @@ impl DynamicsPacker {
             nb_start: Vec::new(),
             nb: Vec::new(),
             nb_disp: Vec::new(),
-            nb_skin: VERLET_SKIN * if r_min_all.is_finite() { r_min_all } else { 0.0 },
+            nb_skin: VERLET_SKIN
+                * if r_min_all.is_finite() {
+                    r_min_all
+                } else {
+                    0.0
+                },
             max_reach: cell,
             plain_spheres: false,
             radius0: Vec::new(),

@@ -281,7 +281,8 @@ pub fn equilibrate(
                                             near_image(a[1] - b[1], size[1]),
                                             a[2] - b[2],
                                         ];
-                                        let o2 = old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
+                                        let o2 =
+                                            old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
                                         if o2 <= touch * touch && d2 > touch * touch {
                                             ok = false;
                                             break 'spheres;

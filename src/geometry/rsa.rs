@@ -95,11 +95,7 @@ impl Voxels {
         for k in 0..n[2] {
             for j in 0..n[1] {
                 for i in 0..n[0] {
-                    let lo = [
-                        i as f64 * h[0],
-                        j as f64 * h[1],
-                        z_lo + k as f64 * h[2],
-                    ];
+                    let lo = [i as f64 * h[0], j as f64 * h[1], z_lo + k as f64 * h[2]];
                     if !covered(cells, size, &lo, &h, r) {
                         list.push(lo);
                     }
@@ -123,12 +119,14 @@ impl Voxels {
         let h = [
             0.5 * self.h[0],
             0.5 * self.h[1],
-            if self.span > 0.0 { 0.5 * self.h[2] } else { 0.0 },
+            if self.span > 0.0 {
+                0.5 * self.h[2]
+            } else {
+                0.0
+            },
         ];
         let nz = if self.span > 0.0 { 2 } else { 1 };
-        if h[0].max(h[1]).max(h[2]) < MIN_VOXEL * self.r
-            || self.list.len() * 4 * nz > MAX_VOXELS
-        {
+        if h[0].max(h[1]).max(h[2]) < MIN_VOXEL * self.r || self.list.len() * 4 * nz > MAX_VOXELS {
             return false;
         }
         self.scratch.clear();
@@ -282,10 +280,7 @@ pub(crate) fn pack(
             }
             // Once the saturation search has begun, later grains of the same
             // radius go straight to it.
-            let mut fails = if voxels
-                .as_ref()
-                .is_some_and(|v| v.r == r && v.z_lo == z_lo)
-            {
+            let mut fails = if voxels.as_ref().is_some_and(|v| v.r == r && v.z_lo == z_lo) {
                 params.max_attempts_per_particle
             } else {
                 0
@@ -299,8 +294,8 @@ pub(crate) fn pack(
                     if voxels.as_ref().is_some_and(|v| v.r != r || v.z_lo != z_lo) {
                         voxels = None;
                     }
-                    let vox = voxels
-                        .get_or_insert_with(|| Voxels::build(&cells, &size, r, z_lo, z_span));
+                    let vox =
+                        voxels.get_or_insert_with(|| Voxels::build(&cells, &size, r, z_lo, z_span));
                     if let Some(c) = vox.place(&cells, &size, &mut rng, &mut attempts) {
                         break c;
                     }

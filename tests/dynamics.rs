@@ -597,6 +597,35 @@ fn thread_count_does_not_change_the_packing() {
     assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
 }
 
+/// The FIRE stage (forced from the first step here) gives overlap-free
+/// packings inside the walls and bit-identical particles with 1 and 2
+/// threads, for rice grains (torques, generic pair path) and for spheres
+/// (fast path).
+#[test]
+fn fire_stage_packs_and_is_thread_count_independent() {
+    for (shape, d, f) in [(RICE, 40.0, 0.45), (Shape::Sphere, 40.0, 0.55)] {
+        let mut params = DynParams::new(
+            [600.0, 600.0, 300.0],
+            vec![sp(shape, d, f, Orientation::Random, 0.0)],
+        );
+        params.fire_after_steps = 0;
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| pack_dynamics(&params, 5).unwrap())
+        };
+        let (a, b) = (run(1), run(2));
+        assert!(a.particles.len() > 1000);
+        assert_eq!(a.particles, b.particles);
+        let tol = params.overlap_tolerance * min_radius(&a);
+        let worst = brute_worst_overlap(&a);
+        assert!(worst < tol, "overlap {worst} ≥ {tol}");
+        check_inside_and_rigid(&a, tol);
+    }
+}
+
 /// g(r) of the dynamics packer at 25 % (for the docs):
 /// `cargo test --release --test dynamics rdf_report -- --ignored --nocapture`.
 #[test]

@@ -53,6 +53,24 @@
 //! of threads. The work per step is linear in the number of moving
 //! particles.
 //!
+//! FIRE stage (an addition to METHOD §2, for batches near jamming): a batch
+//! not relaxed within [`DynParams::fire_after_steps`] first-order steps
+//! continues with FIRE (Bitzek et al. 2006, parameters as LAMMPS's
+//! `min_style fire`): semi-implicit Euler of `v̇ = F`, `J Ω̇ = M` (unit
+//! mass), velocities mixed towards the force direction and the step grown
+//! while the power `F·v + M·Ω` stays positive, everything stopped and the
+//! step halved when it turns negative; the overlap and wall forces lose the
+//! `δ` offset there (a smooth energy: with the kink at contact the power
+//! changes sign every step and FIRE stalls). Every sphere moves at most
+//! [`FIRE_MAX_MOVE`] of its particle's smallest radius per step. Forces come
+//! from a Verlet list (neighbours within reach + a skin of
+//! [`VERLET_SKIN`] r_min, rebuilt when a sphere may have moved half the
+//! skin), each particle summing its own neighbours in list order; the FIRE
+//! sums run serially in particle order, so this stage is deterministic for
+//! any thread count too. First-order dynamics stays the core: at the
+//! issue's 50–55 % targets batches converge in it or need a short FIRE tail;
+//! near jamming FIRE's inertia unjams far faster.
+//!
 //! A batch is relaxed until the worst overlap (pairs and walls) is below the
 //! tolerance, or fails after `max_steps_per_batch` steps with
 //! [`GeometryError::DynamicsNotReached`] and the density of the last

@@ -15,9 +15,10 @@
 //! - particle counts are `N_s = round(f_s · V / v_s)`, so the achieved fraction
 //!   differs from the target only by that rounding (reported in
 //!   [`GeometryStats`]);
-//! - RSA cannot exceed its jamming limit (≈ 0.38 for spheres in bulk, lower
-//!   next to walls); it reports [`GeometryError::NotReached`] with the fraction
-//!   it reached instead of looping.
+//! - RSA cannot exceed its saturation (jamming) limit (0.384 for spheres in
+//!   bulk, lower next to walls); it runs to saturation (sampling only the
+//!   uncovered space once plain draws fail) and reports
+//!   [`GeometryError::NotReached`] with the exact saturation density.
 
 mod cells;
 mod dynamics;
@@ -238,8 +239,8 @@ pub struct PackParams {
     /// `[Lx, Ly, H]`, nm.
     pub size_nm: [f64; 3],
     pub species: Vec<SpeciesParams>,
-    /// Consecutive rejected draws after which one particle counts as
-    /// unplaceable and packing stops (≥ 1).
+    /// Consecutive rejected plain draws after which the packer samples only
+    /// the uncovered space (saturation search, see `rsa`), ≥ 1.
     pub max_attempts_per_particle: u64,
     /// Size distribution and clustering per species; empty: defaults.
     pub options: Vec<SpeciesOptions>,
@@ -323,10 +324,10 @@ pub enum GeometryError {
         thickness_nm: f64,
     },
     #[error(
-        "random sequential addition stalled: species {species} placed {placed} of {wanted} \
+        "random sequential addition saturated: species {species} placed {placed} of {wanted} \
          particles; reached total volume fraction {reached:.4} of target {target:.4} after \
-         {attempts} draws (RSA jams near 0.30–0.38; lower the PVC or raise \
-         max_attempts_per_particle)"
+         {attempts} draws, and no room is left for another grain (RSA of spheres saturates \
+         at 0.384 in bulk, lower in thin slabs; lower the PVC or use the dynamics packer)"
     )]
     NotReached {
         /// Species being placed when packing stopped.

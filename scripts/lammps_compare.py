@@ -12,8 +12,12 @@ energy minimisation with FIRE, steps of at most 0.05 σ
 (`min_modify dmax 0.05`, `minimize 0 1e-12 200000 2000000`). A run
 counts as overlap-free when the deepest pair overlap σ − r_min is below
 1 % of the radius and no centre is closer than 0.995 σ/2 to a wall: the
-criterion inksim uses (overlap tolerance 0.01 r). The target fraction is
-raised in steps of 0.02 from 0.50 until a run fails.
+criterion inksim uses (overlap tolerance 0.01 r). LAMMPS stops as soon as
+that criterion holds (`fix halt`, checked every 50 iterations with
+`compute pair/local dist` reduced to its minimum and the extreme z), as
+inksim does, so both are timed to the same criterion; otherwise after
+200 000 iterations. The target fraction is raised in steps of 0.02 from
+0.50 until a run fails.
 
 inksim: the same ladder with 100 nm spheres in 2000 × 2000 × 100 t nm
 (`slab_density_ladder` in tests/dynamics.rs), with 1 and with 2 rayon
@@ -76,18 +80,25 @@ neighbor 0.3 bin
 neigh_modify every 1 delay 0 check yes
 fix walls all wall/harmonic zlo EDGE 100.0 0.0 0.5 zhi EDGE 100.0 0.0 0.5
 fix_modify walls energy yes
+compute pd all pair/local dist
+compute dmin all reduce min c_pd inputs local
+compute zlo all reduce min z
+compute zhi all reduce max z
+variable ok equal "(c_dmin > 0.995) && (c_zlo > 0.4975) && (c_zhi < {h} - 0.4975)"
+fix stop all halt 50 v_ok == 1 error continue message no
 min_style fire
 min_modify dmax 0.05
 minimize 0.0 1.0e-12 200000 2000000
 """)
     secs = time.perf_counter() - start
+    iters = int(lmp.get_thermo("step"))
     x = np.array(lmp.numpy.extract_atom("x")[:n], dtype=float)
     lmp.close()
     overlap = 1.0 - min_distance(x, lx, ly)
     wall = max(0.5 - x[:, 2].min(), x[:, 2].max() - (h - 0.5))
     ok = overlap < 0.01 * 0.5 and wall < 0.005 * 0.5
     achieved = n * np.pi / 6.0 / (lx * ly * h)
-    return ok, achieved, secs, overlap * 100.0
+    return ok, achieved, secs, overlap * 100.0, iters
 
 
 def inksim_ladder(threads):
@@ -97,6 +108,7 @@ def inksim_ladder(threads):
          "--", "--ignored", "--nocapture"],
         env=env, capture_output=True, text=True, check=True).stdout
     runs = {}
+    sys.stderr.write(out)
     for line in out.splitlines():
         if line.startswith("SLAB "):
             _, t, phi, status, reached, secs, worst = line.split()
@@ -122,10 +134,10 @@ def main():
     for t in THICKNESS:
         lmp_runs[t] = []
         for phi in PHIS:
-            ok, achieved, secs, worst = lammps_run(t, phi)
+            ok, achieved, secs, worst, iters = lammps_run(t, phi)
             print(f"LAMMPS t={t} phi={phi:.2f} ({achieved:.4f}): "
-                  f"{'ok' if ok else 'fail'} in {secs:.2f} s, overlap {worst:.3f} % of σ",
-                  file=sys.stderr)
+                  f"{'ok' if ok else 'fail'} in {secs:.2f} s ({iters} iterations), "
+                  f"overlap {worst:.3f} % of σ", file=sys.stderr)
             lmp_runs[t].append((phi, ok, achieved, secs, worst))
             if not ok:
                 break

@@ -711,3 +711,24 @@ fn size_agglomeration_and_relief_keys() {
         }
     }
 }
+
+#[test]
+fn equilibrate_sweeps_key() {
+    let text = BASE.replacen("[layer]", "[layer]\nequilibrate_sweeps = 200", 1);
+    assert_eq!(parse(&text).unwrap().layer.equilibrate_sweeps, 200);
+    assert_eq!(parse(BASE).unwrap().layer.equilibrate_sweeps, 0);
+    assert_eq!(
+        inksim::config::MAX_EQUILIBRATE_SWEEPS,
+        inksim::geometry::mc::MAX_SWEEPS
+    );
+    for bad in ["-1", "100001"] {
+        let text = BASE.replacen(
+            "[layer]",
+            &format!("[layer]\nequilibrate_sweeps = {bad}"),
+            1,
+        );
+        let (key, shown) = invalid(&text);
+        assert_eq!(key, "layer.equilibrate_sweeps", "{shown}");
+        assert!(shown.contains("100000"), "{shown}");
+    }
+}

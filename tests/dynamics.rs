@@ -489,32 +489,51 @@ fn size_distribution_packs_without_overlap() {
     assert!(hi / lo > 1.8);
 }
 
+/// Agglomeration at 15 % PVC, 50 nm spheres. Straight out of the packer,
+/// non-mates that were pushed apart rest exactly touching, so contact
+/// clusters link many grains whether or not clusters were asked for. A few
+/// Monte Carlo sweeps (mates stick, agglomerates move as a whole too, the
+/// rest equilibrates) open those contacts: then clusters of 8 give a mean
+/// cluster size near 8 and no clusters near 1.
 #[test]
 fn agglomeration_keeps_seeded_clusters_together() {
-    let run = |c: usize| {
+    let run = |c: usize, sweeps: u64| {
         let mut params = DynParams::new(
             [1000.0, 1000.0, 400.0],
             vec![sp(Shape::Sphere, 50.0, 0.15, Orientation::Random, 0.0)],
         );
         params.options = vec![opts(SizeDistribution::Fixed, c)];
+        params.equilibrate_sweeps = sweeps;
         let g = pack_dynamics(&params, 6).unwrap();
         let worst = brute_worst_overlap(&g);
         assert!(worst < 0.01 * 25.0, "overlap {worst}");
+        check_inside_and_rigid(&g, 0.01 * 25.0);
         analyse(&g, &StatsParams::default())
     };
-    let free = run(1);
-    let clumped = run(8);
+    let (free0, clumped0) = (run(1, 0), run(8, 0));
+    let (free, clumped) = (run(1, 100), run(8, 100));
     eprintln!(
-        "dynamics 15 %: clusters of 1 → mean {:.2} (weighted {:.2}); of 8 → mean {:.2} \
+        "dynamics 15 %, no MC: clusters of 1 → mean {:.2} (weighted {:.2}); of 8 → mean {:.2} \
+         (weighted {:.2}); 100 MC sweeps: of 1 → mean {:.2} (weighted {:.2}); of 8 → mean {:.2} \
          (weighted {:.2}), largest {}",
+        free0.cluster_mean(),
+        free0.cluster_weighted_mean(),
+        clumped0.cluster_mean(),
+        clumped0.cluster_weighted_mean(),
         free.cluster_mean(),
         free.cluster_weighted_mean(),
         clumped.cluster_mean(),
         clumped.cluster_weighted_mean(),
         clumped.cluster_sizes[0]
     );
-    assert!(clumped.cluster_weighted_mean() > 2.0 * free.cluster_weighted_mean());
-    assert!(clumped.cluster_mean() > 4.0);
+    assert!(clumped0.cluster_weighted_mean() > 2.0 * free0.cluster_weighted_mean());
+    assert!(free.cluster_mean() < 1.3, "{}", free.cluster_mean());
+    // Measured 9.55: a few agglomerates still touch after 100 sweeps.
+    assert!(
+        (6.5..=10.5).contains(&clumped.cluster_mean()),
+        "{}",
+        clumped.cluster_mean()
+    );
 }
 
 #[test]
@@ -576,6 +595,35 @@ fn thread_count_does_not_change_the_packing() {
     assert!(a.particles.len() > 1000);
     assert_eq!(a.particles, b.particles);
     assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
+}
+
+/// The FIRE stage (forced from the first step here) gives overlap-free
+/// packings inside the walls and bit-identical particles with 1 and 2
+/// threads, for rice grains (torques, generic pair path) and for spheres
+/// (fast path).
+#[test]
+fn fire_stage_packs_and_is_thread_count_independent() {
+    for (shape, d, f) in [(RICE, 40.0, 0.45), (Shape::Sphere, 40.0, 0.55)] {
+        let mut params = DynParams::new(
+            [600.0, 600.0, 300.0],
+            vec![sp(shape, d, f, Orientation::Random, 0.0)],
+        );
+        params.fire_after_steps = 0;
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| pack_dynamics(&params, 5).unwrap())
+        };
+        let (a, b) = (run(1), run(2));
+        assert!(a.particles.len() > 1000);
+        assert_eq!(a.particles, b.particles);
+        let tol = params.overlap_tolerance * min_radius(&a);
+        let worst = brute_worst_overlap(&a);
+        assert!(worst < tol, "overlap {worst} ≥ {tol}");
+        check_inside_and_rigid(&a, tol);
+    }
 }
 
 /// g(r) of the dynamics packer at 25 % (for the docs):

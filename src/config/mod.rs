@@ -67,8 +67,15 @@ pub struct Layer {
     /// Grains may protrude through the top surface `z = 0` by up to this
     /// fraction of their diameter, `[0, MAX_RELIEF_FRACTION]` (0: flat).
     pub relief_fraction: f64,
+    /// Hard-sphere Monte Carlo sweeps run on the packed grains (Brownian
+    /// settling in the wet ink: equilibrium structure at the same density),
+    /// `[0, MAX_EQUILIBRATE_SWEEPS]`, one sweep = one attempted move per
+    /// grain; 0 (default): none.
+    pub equilibrate_sweeps: u64,
 }
 
+/// Largest `layer.equilibrate_sweeps`.
+pub const MAX_EQUILIBRATE_SWEEPS: u64 = 100_000;
 /// Largest `layer.relief_fraction`.
 pub const MAX_RELIEF_FRACTION: f64 = 0.5;
 /// Largest relative `sigma` of a normal grain-size distribution.

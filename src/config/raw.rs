@@ -89,6 +89,9 @@ pub struct RawLayer {
     /// Grains may protrude through the top surface by this fraction of
     /// their diameter.
     pub relief_fraction: Option<f64>,
+    /// Hard-sphere Monte Carlo sweeps after packing (Brownian settling of
+    /// the grains in the wet ink; one sweep = one attempted move per grain).
+    pub equilibrate_sweeps: Option<i64>,
 }
 
 #[derive(Debug, Deserialize)]

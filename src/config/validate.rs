@@ -23,7 +23,8 @@
 //!   log-normal: σ of ln d ≤ [`MAX_LOG_NORMAL_SIGMA`]); the largest draw
 //!   (3 σ) must fit the layer and the fragment like `diameter_nm`.
 //!   `pigment.agglomeration = { cluster_size }` in `[1, MAX_CLUSTER_SIZE]`;
-//!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`.
+//!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`;
+//!   `layer.equilibrate_sweeps` in `[0, MAX_EQUILIBRATE_SWEEPS]`.
 //! - `Provenance::input_hash` is SHA-256 over the config text followed by each
 //!   pigment's table text, in pigment order, then each structure primitive's
 //!   table text or the bytes of the structure's HDF5 file.
@@ -34,6 +35,7 @@ use super::raw::{
     RawConfig, RawGrid, RawIllumination, RawLayer, RawMaterial, RawMethod, RawPrecision,
 };
 use super::raw::{RawOrientation, RawOutput, RawPigment, RawShape, RawSize, RawSolver};
+use super::MAX_EQUILIBRATE_SWEEPS;
 use super::{
     Appearance, Body, ConfigError, GrainOrientation, GrainShape, GrainSize, GridSpec, Incidence,
     Layer, Material, Method, OutputSpec, Precision, Primitive, Products, Provenance, Scene,
@@ -512,12 +514,23 @@ impl Checker<'_> {
             (0.0..=MAX_RELIEF_FRACTION).contains(&r),
             &format!("[0, {MAX_RELIEF_FRACTION}] (fraction of a grain's diameter)"),
         )?;
+        let sweeps = raw.equilibrate_sweeps.unwrap_or(0);
+        if !(0..=MAX_EQUILIBRATE_SWEEPS as i64).contains(&sweeps) {
+            return Err(self.invalid(
+                "layer.equilibrate_sweeps",
+                format!(
+                    "must be in [0, {MAX_EQUILIBRATE_SWEEPS}] (Monte Carlo sweeps, one attempted \
+                     move per grain each; 0 = off), got {sweeps}"
+                ),
+            ));
+        }
         Ok(Layer {
             thickness_nm,
             fragment_x_nm: frag[0],
             fragment_y_nm: frag[1],
             binder_index,
             relief_fraction,
+            equilibrate_sweeps: sweeps as u64,
         })
     }
 

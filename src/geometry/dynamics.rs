@@ -53,6 +53,24 @@
 //! of threads. The work per step is linear in the number of moving
 //! particles.
 //!
+//! FIRE stage (an addition to METHOD §2, for batches near jamming): a batch
+//! not relaxed within [`DynParams::fire_after_steps`] first-order steps
+//! continues with FIRE (Bitzek et al. 2006, parameters as LAMMPS's
+//! `min_style fire`): semi-implicit Euler of `v̇ = F`, `J Ω̇ = M` (unit
+//! mass), velocities mixed towards the force direction and the step grown
+//! while the power `F·v + M·Ω` stays positive, everything stopped and the
+//! step halved when it turns negative; the overlap and wall forces lose the
+//! `δ` offset there (a smooth energy: with the kink at contact the power
+//! changes sign every step and FIRE stalls). Every sphere moves at most
+//! [`FIRE_MAX_MOVE`] of its particle's smallest radius per step. Forces come
+//! from a Verlet list (neighbours within reach + a skin of
+//! [`VERLET_SKIN`] r_min, rebuilt when a sphere may have moved half the
+//! skin), each particle summing its own neighbours in list order; the FIRE
+//! sums run serially in particle order, so this stage is deterministic for
+//! any thread count too. First-order dynamics stays the core: at the
+//! issue's 50–55 % targets batches converge in it or need a short FIRE tail;
+//! near jamming FIRE's inertia unjams far faster.
+//!
 //! A batch is relaxed until the worst overlap (pairs and walls) is below the
 //! tolerance, or fails after `max_steps_per_batch` steps with
 //! [`GeometryError::DynamicsNotReached`] and the density of the last
@@ -89,6 +107,43 @@ pub const ATTRACTION_RANGE: f64 = 0.25;
 /// on the thread count).
 pub const CHUNK: usize = 256;
 
+/// FIRE stage (Bitzek et al. 2006, PRL 97, 170201; parameters as LAMMPS's
+/// `min_style fire`, time in units of `√(m/k)` with `m = k = 1`): initial,
+/// largest and smallest time step.
+const FIRE_DT0: f64 = 0.1;
+const FIRE_DT_MAX: f64 = 10.0 * FIRE_DT0;
+const FIRE_DT_MIN: f64 = 0.02 * FIRE_DT0;
+/// Steps with positive power before the step grows.
+const FIRE_DELAY: u32 = 20;
+const FIRE_GROW: f64 = 1.1;
+const FIRE_SHRINK: f64 = 0.5;
+const FIRE_ALPHA0: f64 = 0.25;
+const FIRE_ALPHA_SHRINK: f64 = 0.99;
+/// Largest sphere displacement per FIRE step, in units of the particle's
+/// smallest radius.
+const FIRE_MAX_MOVE: f64 = 0.1;
+/// Skin of the FIRE stage's Verlet list, in units of the smallest sphere
+/// radius of all particles.
+const VERLET_SKIN: f64 = 0.4;
+
+/// FIRE's adaptive state (reset at every batch).
+#[derive(Debug, Clone, Copy)]
+struct Fire {
+    dt: f64,
+    alpha: f64,
+    n_pos: u32,
+}
+
+impl Fire {
+    fn new() -> Self {
+        Fire {
+            dt: FIRE_DT0,
+            alpha: FIRE_ALPHA0,
+            n_pos: 0,
+        }
+    }
+}
+
 /// One species for [`pack_dynamics`].
 #[derive(Debug, Clone)]
 pub struct DynSpecies {
@@ -115,14 +170,22 @@ pub struct DynParams {
     pub overlap_tolerance: f64,
     /// Volume fraction added per batch, in `(0, 1]` (default 0.1).
     pub batch_fraction: f64,
-    /// Relaxation steps allowed per batch (≥ 1, default 20 000).
+    /// Relaxation steps allowed per batch (≥ 1, default 100 000).
     pub max_steps_per_batch: u64,
+    /// First-order steps of a batch after which, if it has not converged,
+    /// its relaxation continues with FIRE (default 200; 0: FIRE from the
+    /// start, `u64::MAX`: never).
+    pub fire_after_steps: u64,
     /// Size distribution and clustering per species; empty: defaults.
     pub options: Vec<SpeciesOptions>,
     /// Grains may protrude through the top surface `z = 0` by up to this
     /// fraction of their effective diameter, `[0, MAX_RELIEF_FRACTION]`
     /// (default 0: flat top).
     pub relief_fraction: f64,
+    /// Hard-particle Monte Carlo sweeps run on the packed fragment
+    /// ([`super::mc::equilibrate`], moves may not deepen an overlap beyond
+    /// the tolerance), `[0, mc::MAX_SWEEPS]` (default 0: none).
+    pub equilibrate_sweeps: u64,
 }
 
 impl DynParams {
@@ -133,9 +196,11 @@ impl DynParams {
             species,
             overlap_tolerance: 0.01,
             batch_fraction: 0.1,
-            max_steps_per_batch: 20_000,
+            max_steps_per_batch: 100_000,
+            fire_after_steps: 200,
             options: Vec::new(),
             relief_fraction: 0.0,
+            equilibrate_sweeps: 0,
         }
     }
 }
@@ -185,6 +250,7 @@ fn validate(p: &DynParams, seed: u64) -> Result<(Vec<Spec>, Vec<Vec<f64>>), Geom
     }
     let options = options_of(&p.options, p.species.len())?;
     check_relief(p.relief_fraction)?;
+    super::check_sweeps(p.equilibrate_sweeps)?;
     let volume = lx * ly * h;
     let mut total = 0.0;
     let mut out = Vec::with_capacity(p.species.len());
@@ -374,6 +440,21 @@ impl Grid {
             ((c - 1).max(0), (c + 1).min(n - 1))
         }
     }
+
+    /// Cell ranges within `k` cells of `c` along axis `a` (no cell twice).
+    fn range_k(&self, a: usize, c: usize, k: usize) -> (isize, isize) {
+        let n = self.n[a] as isize;
+        let (c, k) = (c as isize, k as isize);
+        if a < 2 {
+            if 2 * k + 1 >= n {
+                (0, n - 1)
+            } else {
+                (c - k, c + k)
+            }
+        } else {
+            ((c - k).max(0), (c + k).min(n - 1))
+        }
+    }
 }
 
 /// A force contribution to one particle: `(particle, force, torque)`.
@@ -404,6 +485,22 @@ struct State {
     grid: Grid,
     force: Vec<[f64; 3]>,
     torque: Vec<[f64; 3]>,
+    /// Velocity and angular velocity (FIRE stage only; zero otherwise).
+    vel: Vec<[f64; 3]>,
+    ang: Vec<[f64; 3]>,
+    /// FIRE stage's Verlet list (every particle's neighbours within reach +
+    /// `nb_skin`, CSR), and how far each sphere may have moved since it was
+    /// built (an upper bound); `nb_start` empty: no valid list.
+    nb_start: Vec<u32>,
+    nb: Vec<u32>,
+    nb_disp: Vec<f64>,
+    nb_skin: f64,
+    /// Largest centre distance at which two particles can interact, nm.
+    max_reach: f64,
+    /// Every particle is one sphere and none is in a seeded cluster; then
+    /// `radius0` holds the radii (FIRE stage fast path).
+    plain_spheres: bool,
+    radius0: Vec<f64>,
     moving_mark: Vec<u64>,
     touched_mark: Vec<u64>,
     epoch: u64,
@@ -414,12 +511,26 @@ struct State {
     /// New (centre, axis) of the touched particles (reused).
     moves: Vec<Option<([f64; 3], [f64; 3])>>,
     skin: f64,
+    /// Offset of the overlap and wall forces: `skin` in the first-order
+    /// stage, 0 in the FIRE stage (a smooth energy for the inertial step).
+    push: f64,
 }
 
 /// `x` wrapped into `[0, l)`.
 #[inline]
 fn wrap(x: f64, l: f64) -> f64 {
-    let w = x.rem_euclid(l);
+    let w = if x < 0.0 {
+        x + l
+    } else if x >= l {
+        x - l
+    } else {
+        return x;
+    };
+    let w = if (0.0..l).contains(&w) {
+        w
+    } else {
+        w.rem_euclid(l)
+    };
     if w >= l {
         0.0
     } else {
@@ -476,6 +587,36 @@ fn norm(a: &[f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
+/// `a` turned by the rotation vector `om dt` (Rodrigues), renormalised.
+#[inline]
+fn rotate(a: &[f64; 3], om: &[f64; 3], dt: f64) -> [f64; 3] {
+    let no = norm(om);
+    let phi = no * dt;
+    if phi <= 0.0 {
+        return *a;
+    }
+    let k = [om[0] / no, om[1] / no, om[2] / no];
+    let kxa = cross(&k, a);
+    let kd = k[0] * a[0] + k[1] * a[1] + k[2] * a[2];
+    let (s, co) = phi.sin_cos();
+    let mut b = [0.0; 3];
+    for ax in 0..3 {
+        b[ax] = a[ax] * co + kxa[ax] * s + k[ax] * kd * (1.0 - co);
+    }
+    let nb = norm(&b);
+    [b[0] / nb, b[1] / nb, b[2] / nb]
+}
+
+/// Adds the alignment torque of a particle of `spec`, diameter `d`, axis `a`.
+#[inline]
+fn add_field_torque(spec: &Spec, d: f64, a: &[f64; 3], m: &mut [f64; 3]) {
+    if spec.field != 0.0 {
+        let t = cross(a, &[0.0, 0.0, 1.0]);
+        let r_max = spec.r_max * d;
+        add(m, &t, spec.field * K * r_max * r_max * a[2]);
+    }
+}
+
 impl State {
     fn add_particle(&mut self, s: usize, d: f64, cluster: u32, c: [f64; 3], a: [f64; 3]) {
         self.center.push(c);
@@ -486,6 +627,8 @@ impl State {
         self.grid.push(&c);
         self.force.push([0.0; 3]);
         self.torque.push([0.0; 3]);
+        self.vel.push([0.0; 3]);
+        self.ang.push([0.0; 3]);
         self.moving_mark.push(0);
         self.touched_mark.push(0);
         self.moving.push((self.center.len() - 1) as u32);
@@ -507,17 +650,15 @@ impl State {
         self.species = order.iter().map(|&p| self.species[p as usize]).collect();
         self.scale = order.iter().map(|&p| self.scale[p as usize]).collect();
         self.cluster = order.iter().map(|&p| self.cluster[p as usize]).collect();
+        self.vel = order.iter().map(|&p| self.vel[p as usize]).collect();
+        self.ang = order.iter().map(|&p| self.ang[p as usize]).collect();
         for m in self.moving.iter_mut() {
             *m = inv[*m as usize];
         }
         self.moving.sort_unstable();
         self.moving_mark.iter_mut().for_each(|m| *m = 0);
         self.touched_mark.iter_mut().for_each(|m| *m = 0);
-        self.grid.head.iter_mut().for_each(|h| *h = EMPTY);
-        for p in (0..n).rev() {
-            let f = self.grid.flat(self.grid.coords(&self.center[p]));
-            self.grid.link(p, f);
-        }
+        self.relink();
         inv
     }
 
@@ -545,6 +686,27 @@ impl State {
         let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if d2 >= reach * reach {
             return None;
+        }
+        if si.spheres.len() == 1 && sj.spheres.len() == 1 && !bonded {
+            // Two one-sphere particles (centred spheres, no torque).
+            let rsum = (si.spheres[0].1 * di) + (sj.spheres[0].1 * dj);
+            if d2 >= rsum * rsum {
+                return None;
+            }
+            let dist = d2.sqrt();
+            let l = rsum - dist;
+            let mag = -K * (l + self.push);
+            let f = if dist > 1e-12 * rsum {
+                [mag * d[0] / dist, mag * d[1] / dist, mag * d[2] / dist]
+            } else {
+                [0.0, 0.0, -mag]
+            };
+            return Some(PairForce {
+                f,
+                mi: [0.0; 3],
+                mj: [0.0; 3],
+                worst: l,
+            });
         }
         let (ai, aj) = (self.axis[i], self.axis[j]);
         if si.spheres.len() > 1 || sj.spheres.len() > 1 {
@@ -578,7 +740,7 @@ impl State {
                 let l = ri + rj - dist;
                 let mag = if l > 0.0 {
                     worst = worst.max(l);
-                    K * (l + self.skin)
+                    K * (l + self.push)
                 } else if bonded && -l > self.skin && -l < ATTRACTION_RANGE * (ri + rj) {
                     (K * ATTRACTION * l).max(-ATTRACTION_CAP * self.skin)
                 } else {
@@ -620,9 +782,9 @@ impl State {
             let above = z + r - h;
             worst = worst.max(below).max(above);
             let fz = if below > 0.0 {
-                K * (below + self.skin)
+                K * (below + self.push)
             } else if above > 0.0 {
-                -K * (above + self.skin)
+                -K * (above + self.push)
             } else {
                 continue;
             };
@@ -680,11 +842,7 @@ impl State {
         let spec = &self.specs[self.species[p] as usize];
         let d = self.scale[p];
         let a = self.axis[p];
-        if spec.field != 0.0 {
-            let t = cross(&a, &[0.0, 0.0, 1.0]);
-            let r_max = spec.r_max * d;
-            add(&mut m, &t, spec.field * K * r_max * r_max * a[2]);
-        }
+        add_field_torque(spec, d, &a, &mut m);
         let inertia = spec.inertia * d * d;
         let v = f; // η = 1
         let om = [m[0] / inertia, m[1] / inertia, m[2] / inertia];
@@ -699,27 +857,13 @@ impl State {
             wrap(c0[1] + v[1] * dt, self.size[1]),
             c0[2] + v[2] * dt,
         ];
-        let phi = norm(&om) * dt;
-        let mut axis = a;
-        if phi > 0.0 {
-            let no = norm(&om);
-            let k = [om[0] / no, om[1] / no, om[2] / no];
-            let kxa = cross(&k, &a);
-            let kd = k[0] * a[0] + k[1] * a[1] + k[2] * a[2];
-            let (s, co) = phi.sin_cos();
-            let mut b = [0.0; 3];
-            for ax in 0..3 {
-                b[ax] = a[ax] * co + kxa[ax] * s + k[ax] * kd * (1.0 - co);
-            }
-            let nb = norm(&b);
-            axis = [b[0] / nb, b[1] / nb, b[2] / nb];
-        }
-        Some((c, axis))
+        Some((c, rotate(&a, &om, dt)))
     }
 
-    /// One relaxation step. Returns the worst overlap at the current
-    /// positions; moves the particles only when it is `≥ tol`.
-    fn step(&mut self, tol: f64) -> f64 {
+    /// Worst overlap at the current positions; when it is `≥ tol`, also the
+    /// force and torque on every particle of the moving list and on each
+    /// neighbour one of them pushes (`force`, `torque` of `touched`).
+    fn forces(&mut self, tol: f64) -> f64 {
         self.epoch += 1;
         let ep = self.epoch;
         for k in 0..self.moving.len() {
@@ -766,6 +910,17 @@ impl State {
             }
         }
         self.bufs = bufs;
+        worst
+    }
+
+    /// One first-order relaxation step. Returns the worst overlap at the
+    /// current positions; moves the particles only when it is `≥ tol`.
+    fn step(&mut self, tol: f64) -> f64 {
+        self.push = self.skin;
+        let worst = self.forces(tol);
+        if worst < tol {
+            return worst;
+        }
         // Move every particle that felt a force; they form the next moving list.
         let mut moves = std::mem::take(&mut self.moves);
         let this = &*self;
@@ -785,6 +940,289 @@ impl State {
         }
         self.moves = moves;
         worst
+    }
+
+    /// Builds the Verlet list of every particle (neighbours within their
+    /// interaction reach plus `nb_skin`, in cell order: deterministic).
+    fn build_neighbours(&mut self) {
+        let n = self.center.len();
+        // The FIRE stage moves particles without updating their cells.
+        self.relink();
+        self.plain_spheres = (0..n).all(|p| {
+            self.cluster[p] == EMPTY && self.specs[self.species[p] as usize].spheres.len() == 1
+        });
+        self.radius0.clear();
+        if self.plain_spheres {
+            self.radius0.extend(
+                (0..n).map(|p| self.specs[self.species[p] as usize].spheres[0].1 * self.scale[p]),
+            );
+        }
+        self.nb_start.clear();
+        self.nb.clear();
+        self.nb_disp.clear();
+        self.nb_disp.resize(n, 0.0);
+        let w = self.grid.cell[0]
+            .min(self.grid.cell[1])
+            .min(self.grid.cell[2]);
+        let k = ((self.max_reach + self.nb_skin) / w).ceil().max(1.0) as usize;
+        let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
+        self.nb_start.push(0);
+        for i in 0..n {
+            let ci = self.center[i];
+            let si = &self.specs[self.species[i] as usize];
+            let di = self.scale[i];
+            let cc = self.grid.coords(&ci);
+            let (z0, z1) = self.grid.range_k(2, cc[2], k);
+            let (y0, y1) = self.grid.range_k(1, cc[1], k);
+            let (x0, x1) = self.grid.range_k(0, cc[0], k);
+            for cz in z0..=z1 {
+                for cy in y0..=y1 {
+                    let wy = cy.rem_euclid(ny) as usize;
+                    for cx in x0..=x1 {
+                        let wx = cx.rem_euclid(nx) as usize;
+                        let mut j = self.grid.head[self.grid.flat([wx, wy, cz as usize])];
+                        while j != EMPTY {
+                            let ju = j as usize;
+                            j = self.grid.next[ju];
+                            if ju == i {
+                                continue;
+                            }
+                            let sj = &self.specs[self.species[ju] as usize];
+                            let dj = self.scale[ju];
+                            let cj = self.center[ju];
+                            let d = [
+                                near_image(cj[0] - ci[0], self.size[0]),
+                                near_image(cj[1] - ci[1], self.size[1]),
+                                cj[2] - ci[2],
+                            ];
+                            let bonded =
+                                self.cluster[i] != EMPTY && self.cluster[i] == self.cluster[ju];
+                            let gap = if bonded {
+                                ATTRACTION_RANGE * 2.0 * (si.r_max * di).max(sj.r_max * dj)
+                            } else {
+                                self.skin
+                            };
+                            let reach =
+                                si.half_length * di + sj.half_length * dj + gap + self.nb_skin;
+                            if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach {
+                                self.nb.push(ju as u32);
+                            }
+                        }
+                    }
+                }
+            }
+            self.nb_start.push(self.nb.len() as u32);
+        }
+    }
+
+    /// Worst overlap over every pair and wall (Verlet list), and the force
+    /// and torque on every particle (`touched` = all).
+    fn forces_all(&mut self) -> f64 {
+        let n = self.center.len();
+        let mut force = std::mem::take(&mut self.force);
+        let mut torque = std::mem::take(&mut self.torque);
+        let this = &*self;
+        let worst = force
+            .par_chunks_mut(CHUNK)
+            .zip(torque.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(c, (fs, ms))| {
+                let mut worst = f64::NEG_INFINITY;
+                for (k, (f, m)) in fs.iter_mut().zip(ms.iter_mut()).enumerate() {
+                    let i = c * CHUNK + k;
+                    let (mut fi, mut mi, w) = this.walls(i);
+                    worst = worst.max(w);
+                    let (a, b) = (this.nb_start[i] as usize, this.nb_start[i + 1] as usize);
+                    if this.plain_spheres {
+                        // Same force as `pair` for two one-sphere particles
+                        // without a cluster bond, inlined.
+                        let ci = this.center[i];
+                        let ri = this.radius0[i];
+                        for &j in &this.nb[a..b] {
+                            let j = j as usize;
+                            let cj = this.center[j];
+                            let d = [
+                                near_image(cj[0] - ci[0], this.size[0]),
+                                near_image(cj[1] - ci[1], this.size[1]),
+                                cj[2] - ci[2],
+                            ];
+                            let rsum = ri + this.radius0[j];
+                            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                            if d2 >= rsum * rsum {
+                                continue;
+                            }
+                            let dist = d2.sqrt();
+                            let l = rsum - dist;
+                            worst = worst.max(l);
+                            let mag = -K * (l + this.push);
+                            if dist > 1e-12 * rsum {
+                                add(&mut fi, &d, mag / dist);
+                            } else {
+                                fi[2] -= mag;
+                            }
+                        }
+                        *f = fi;
+                        *m = mi;
+                        continue;
+                    }
+                    for &j in &this.nb[a..b] {
+                        if let Some(pf) = this.pair(i, j as usize) {
+                            worst = worst.max(pf.worst);
+                            add(&mut fi, &pf.f, 1.0);
+                            add(&mut mi, &pf.mi, 1.0);
+                        }
+                    }
+                    *f = fi;
+                    *m = mi;
+                }
+                worst
+            })
+            .reduce(|| f64::NEG_INFINITY, f64::max);
+        self.force = force;
+        self.torque = torque;
+        self.touched.clear();
+        self.touched.extend(0..n as u32);
+        worst
+    }
+
+    /// One FIRE step (see the module docs): semi-implicit Euler of
+    /// `v̇ = F`, `J Ω̇ = M` with FIRE's velocity mixing and adaptive time
+    /// step, the step capped so that no sphere moves more than
+    /// [`FIRE_MAX_MOVE`] of its particle's smallest radius. Returns the worst
+    /// overlap at the current positions; moves only when it is `≥ tol`.
+    /// Global sums run serially in the order of `touched` (deterministic).
+    fn fire_step(&mut self, tol: f64, fire: &mut Fire) -> f64 {
+        self.push = 0.0;
+        if self.nb_start.len() != self.center.len() + 1 {
+            self.build_neighbours();
+        }
+        let worst = self.forces_all();
+        if worst < tol {
+            return worst;
+        }
+        // Power P = Σ F·v + M·Ω (only touched particles can move or be pushed).
+        let mut power = 0.0;
+        for k in 0..self.touched.len() {
+            let p = self.touched[k] as usize;
+            let (f, mut m) = (self.force[p], self.torque[p]);
+            if f != [0.0; 3] || m != [0.0; 3] {
+                let spec = &self.specs[self.species[p] as usize];
+                add_field_torque(spec, self.scale[p], &self.axis[p], &mut m);
+                self.torque[p] = m;
+            }
+            let (v, w) = (self.vel[p], self.ang[p]);
+            power +=
+                f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2];
+        }
+        if power > 0.0 {
+            fire.n_pos += 1;
+            if fire.n_pos > FIRE_DELAY {
+                fire.dt = (fire.dt * FIRE_GROW).min(FIRE_DT_MAX);
+                fire.alpha *= FIRE_ALPHA_SHRINK;
+            }
+        } else {
+            fire.n_pos = 0;
+            fire.dt = (fire.dt * FIRE_SHRINK).max(FIRE_DT_MIN);
+            fire.alpha = FIRE_ALPHA0;
+            for k in 0..self.touched.len() {
+                let p = self.touched[k] as usize;
+                self.vel[p] = [0.0; 3];
+                self.ang[p] = [0.0; 3];
+            }
+        }
+        // Velocity update, then mixing in the mass-weighted metric
+        // (u = (v, √J Ω), g = (F, M/√J)).
+        let dt = fire.dt;
+        let (mut u2, mut g2) = (0.0, 0.0);
+        for k in 0..self.touched.len() {
+            let p = self.touched[k] as usize;
+            let spec = &self.specs[self.species[p] as usize];
+            let d = self.scale[p];
+            let inertia = spec.inertia * d * d;
+            let (f, m) = (self.force[p], self.torque[p]);
+            add(&mut self.vel[p], &f, dt);
+            add(&mut self.ang[p], &m, dt / inertia);
+            let (v, w) = (self.vel[p], self.ang[p]);
+            u2 += v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+            u2 += inertia * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+            g2 += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+            g2 += (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) / inertia;
+        }
+        let mix = if g2 > 0.0 {
+            fire.alpha * (u2 / g2).sqrt()
+        } else {
+            0.0
+        };
+        let mut rate = 0.0f64;
+        for k in 0..self.touched.len() {
+            let p = self.touched[k] as usize;
+            let spec = &self.specs[self.species[p] as usize];
+            let d = self.scale[p];
+            let inertia = spec.inertia * d * d;
+            let (f, m) = (self.force[p], self.torque[p]);
+            let (v, w) = (&mut self.vel[p], &mut self.ang[p]);
+            for a in 0..3 {
+                v[a] = (1.0 - fire.alpha) * v[a] + mix * f[a];
+                w[a] = (1.0 - fire.alpha) * w[a] + mix * m[a] / inertia;
+            }
+            let speed = norm(v) + norm(w) * spec.s_max * d;
+            rate = rate.max(speed / (spec.r_min * d));
+        }
+        let dt_move = if rate * dt > FIRE_MAX_MOVE {
+            FIRE_MAX_MOVE / rate
+        } else {
+            dt
+        };
+        self.moving.clear();
+        let mut disp = 0.0f64;
+        for k in 0..self.touched.len() {
+            let p = self.touched[k] as usize;
+            let (v, w) = (self.vel[p], self.ang[p]);
+            if v == [0.0; 3] && w == [0.0; 3] {
+                continue;
+            }
+            let c0 = self.center[p];
+            let c = [
+                wrap(c0[0] + v[0] * dt_move, self.size[0]),
+                wrap(c0[1] + v[1] * dt_move, self.size[1]),
+                c0[2] + v[2] * dt_move,
+            ];
+            self.axis[p] = rotate(&self.axis[p], &w, dt_move);
+            self.center[p] = c;
+            self.moving.push(p as u32);
+            let spec = &self.specs[self.species[p] as usize];
+            self.nb_disp[p] += (norm(&v) + norm(&w) * spec.s_max * self.scale[p]) * dt_move;
+            disp = disp.max(self.nb_disp[p]);
+        }
+        if 2.0 * disp > self.nb_skin {
+            self.build_neighbours();
+        }
+        worst
+    }
+
+    /// Rebuilds every cell list from the particle centres (deterministic:
+    /// each cell lists its particles in index order).
+    fn relink(&mut self) {
+        self.grid.head.iter_mut().for_each(|h| *h = EMPTY);
+        for p in (0..self.center.len()).rev() {
+            let f = self.grid.flat(self.grid.coords(&self.center[p]));
+            self.grid.link(p, f);
+        }
+    }
+
+    /// Sets every velocity to zero (only particles of the moving list can
+    /// have one) and, after a FIRE stage, puts every particle back in its
+    /// cell.
+    fn stop(&mut self) {
+        if !self.nb_start.is_empty() {
+            self.relink();
+        }
+        self.nb_start.clear();
+        for k in 0..self.moving.len() {
+            let p = self.moving[k] as usize;
+            self.vel[p] = [0.0; 3];
+            self.ang[p] = [0.0; 3];
+        }
     }
 }
 
@@ -865,6 +1303,20 @@ impl DynamicsPacker {
             cluster: Vec::with_capacity(total),
             force: Vec::with_capacity(total),
             torque: Vec::with_capacity(total),
+            vel: Vec::with_capacity(total),
+            ang: Vec::with_capacity(total),
+            nb_start: Vec::new(),
+            nb: Vec::new(),
+            nb_disp: Vec::new(),
+            nb_skin: VERLET_SKIN
+                * if r_min_all.is_finite() {
+                    r_min_all
+                } else {
+                    0.0
+                },
+            max_reach: cell,
+            plain_spheres: false,
+            radius0: Vec::new(),
             moving_mark: Vec::with_capacity(total),
             touched_mark: Vec::with_capacity(total),
             epoch: 0,
@@ -873,6 +1325,7 @@ impl DynamicsPacker {
             bufs: Vec::new(),
             moves: Vec::new(),
             skin: 0.5 * tol,
+            push: 0.5 * tol,
         };
         let batches = ((target / params.batch_fraction).ceil() as usize).max(1);
         Ok(DynamicsPacker {
@@ -1013,9 +1466,15 @@ impl DynamicsPacker {
     /// `max_steps_per_batch` steps.
     pub fn relax(&mut self) -> Result<u64, GeometryError> {
         let mut steps = 0u64;
+        let mut fire = Fire::new();
         loop {
-            let worst = self.st.step(self.tol);
+            let worst = if steps < self.params.fire_after_steps {
+                self.st.step(self.tol)
+            } else {
+                self.st.fire_step(self.tol, &mut fire)
+            };
             if worst < self.tol {
+                self.st.stop();
                 self.steps += steps;
                 return Ok(steps);
             }
@@ -1111,7 +1570,21 @@ pub fn pack_dynamics(params: &DynParams, seed: u64) -> Result<Geometry, Geometry
     while packer.insert_batch() {
         packer.relax()?;
     }
-    Ok(packer.geometry())
+    let mut g = packer.geometry();
+    if params.equilibrate_sweeps > 0 {
+        super::mc::equilibrate(
+            g.size_nm,
+            &mut g.particles,
+            &packer.st.cluster,
+            params.relief_fraction,
+            packer.tolerance_nm(),
+            params.equilibrate_sweeps,
+            seed,
+        );
+        g.stats.min_gap_nm = min_gap_nm(g.size_nm, &g.particles);
+        g.stats.worst_overlap_nm = (-g.stats.min_gap_nm).max(0.0);
+    }
+    Ok(g)
 }
 
 /// Unit axes of the particles of `g` (first to last sphere, nearest periodic

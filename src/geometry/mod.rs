@@ -15,12 +15,14 @@
 //! - particle counts are `N_s = round(f_s · V / v_s)`, so the achieved fraction
 //!   differs from the target only by that rounding (reported in
 //!   [`GeometryStats`]);
-//! - RSA cannot exceed its jamming limit (≈ 0.38 for spheres in bulk, lower
-//!   next to walls); it reports [`GeometryError::NotReached`] with the fraction
-//!   it reached instead of looping.
+//! - RSA cannot exceed its saturation (jamming) limit (0.384 for spheres in
+//!   bulk, lower next to walls); it runs to saturation (sampling only the
+//!   uncovered space once plain draws fail) and reports
+//!   [`GeometryError::NotReached`] with the exact saturation density.
 
 mod cells;
 mod dynamics;
+pub mod mc;
 mod rsa;
 mod shapes;
 pub mod stats;
@@ -106,6 +108,18 @@ pub(crate) fn check_relief(f: f64) -> Result<f64, GeometryError> {
     } else {
         Err(GeometryError::Invalid(format!(
             "relief fraction {f} must be in [0, {MAX_RELIEF_FRACTION}]"
+        )))
+    }
+}
+
+/// Checks a number of Monte Carlo sweeps against `[0, mc::MAX_SWEEPS]`.
+pub(crate) fn check_sweeps(n: u64) -> Result<u64, GeometryError> {
+    if n <= mc::MAX_SWEEPS {
+        Ok(n)
+    } else {
+        Err(GeometryError::Invalid(format!(
+            "equilibrate_sweeps {n} must be in [0, {}]",
+            mc::MAX_SWEEPS
         )))
     }
 }
@@ -225,14 +239,17 @@ pub struct PackParams {
     /// `[Lx, Ly, H]`, nm.
     pub size_nm: [f64; 3],
     pub species: Vec<SpeciesParams>,
-    /// Consecutive rejected draws after which one particle counts as
-    /// unplaceable and packing stops (≥ 1).
+    /// Consecutive rejected plain draws after which the packer samples only
+    /// the uncovered space (saturation search, see `rsa`), ≥ 1.
     pub max_attempts_per_particle: u64,
     /// Size distribution and clustering per species; empty: defaults.
     pub options: Vec<SpeciesOptions>,
     /// Grains may protrude through the top surface `z = 0` by up to this
     /// fraction of their diameter, `[0, MAX_RELIEF_FRACTION]` (0: flat).
     pub relief_fraction: f64,
+    /// Hard-sphere Monte Carlo sweeps run on the packed fragment
+    /// ([`mc::equilibrate`]), `[0, mc::MAX_SWEEPS]` (0: none).
+    pub equilibrate_sweeps: u64,
 }
 
 /// The METHOD §1 default fragment (10 × 10 µm, 1 µm thick), no species,
@@ -255,6 +272,7 @@ impl PackParams {
             max_attempts_per_particle: Self::DEFAULT_MAX_ATTEMPTS,
             options: Vec::new(),
             relief_fraction: 0.0,
+            equilibrate_sweeps: 0,
         }
     }
 }
@@ -306,10 +324,10 @@ pub enum GeometryError {
         thickness_nm: f64,
     },
     #[error(
-        "random sequential addition stalled: species {species} placed {placed} of {wanted} \
+        "random sequential addition saturated: species {species} placed {placed} of {wanted} \
          particles; reached total volume fraction {reached:.4} of target {target:.4} after \
-         {attempts} draws (RSA jams near 0.30–0.38; lower the PVC or raise \
-         max_attempts_per_particle)"
+         {attempts} draws, and no room is left for another grain (RSA of spheres saturates \
+         at 0.384 in bulk, lower in thin slabs; lower the PVC or use the dynamics packer)"
     )]
     NotReached {
         /// Species being placed when packing stopped.
@@ -367,6 +385,7 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
     }
     let options = options_of(&params.options, params.species.len())?;
     check_relief(params.relief_fraction)?;
+    check_sweeps(params.equilibrate_sweeps)?;
     let volume = lx * ly * h;
     let mut total_fraction = 0.0;
     for (i, s) in params.species.iter().enumerate() {
@@ -418,7 +437,16 @@ fn validate(params: &PackParams, seed: u64) -> Result<Vec<Vec<f64>>, GeometryErr
 pub fn pack_rsa(params: &PackParams, seed: u64) -> Result<Geometry, GeometryError> {
     let diameters = validate(params, seed)?;
     let options = options_of(&params.options, params.species.len())?;
-    let (particles, attempts) = rsa::pack(params, &diameters, &options, seed)?;
+    let (mut particles, groups, attempts) = rsa::pack(params, &diameters, &options, seed)?;
+    mc::equilibrate(
+        params.size_nm,
+        &mut particles,
+        &groups,
+        params.relief_fraction,
+        0.0,
+        params.equilibrate_sweeps,
+        seed,
+    );
     let volume = params.size_nm.iter().product::<f64>();
     let achieved_fraction = diameters
         .iter()

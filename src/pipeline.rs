@@ -156,6 +156,7 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
                 .collect(),
             options,
             relief_fraction: l.relief_fraction,
+            equilibrate_sweeps: l.equilibrate_sweeps,
             ..PackParams::default()
         };
         return Ok(geometry::pack_rsa(&params, seed)?);
@@ -182,6 +183,7 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
     let params = DynParams {
         options,
         relief_fraction: l.relief_fraction,
+        equilibrate_sweeps: l.equilibrate_sweeps,
         ..DynParams::new(size_nm, species)
     };
     Ok(geometry::pack_dynamics(&params, seed)?)
@@ -296,6 +298,13 @@ impl RunPlan {
             } else {
                 "surface relief: none (grains stay inside the binder)".to_string()
             });
+            if scene.layer.equilibrate_sweeps > 0 {
+                lines.push(format!(
+                    "equilibration: {} hard-particle Monte Carlo sweeps after packing \
+                     (Brownian settling; agglomerates move as a whole)",
+                    scene.layer.equilibrate_sweeps
+                ));
+            }
             for s in &scene.species {
                 if s.cluster_size > 1 {
                     lines.push(format!(

@@ -679,3 +679,60 @@ fn rsa_relief_lets_grains_protrude_by_the_fraction() {
     p.relief_fraction = 0.6;
     assert!(matches!(pack_rsa(&p, 1), Err(GeometryError::Invalid(m)) if m.contains("relief")));
 }
+
+/// `layer.equilibrate_sweeps` reaches the packers through the pipeline: the
+/// plan says so, the grains move, and they still do not overlap.
+#[test]
+fn equilibration_key_moves_the_grains_through_the_pipeline() {
+    let text = |sweeps: u64| {
+        format!(
+            r#"
+seed = 4
+[layer]
+thickness_nm = 400.0
+fragment_nm = [600.0, 600.0]
+equilibrate_sweeps = {sweeps}
+[[pigment]]
+name = "red"
+material = {{ builtin = "red" }}
+pvc = 0.2
+diameter_nm = 80.0
+[grid]
+cell_nm = 25.0
+[illumination]
+wavelengths_nm = [550.0]
+polar_deg = [0.0]
+"#
+        )
+    };
+    let scene = |sweeps| {
+        inksim::config::parse_scene(std::path::Path::new("eq.toml"), &text(sweeps)).unwrap()
+    };
+    let (plain, settled) = (scene(0), scene(30));
+    let line = |s: &inksim::config::Scene| {
+        inksim::pipeline::RunPlan::of(s)
+            .lines
+            .iter()
+            .any(|l| l.starts_with("equilibration: 30 "))
+    };
+    assert!(!line(&plain) && line(&settled));
+    let a = inksim::pipeline::build_geometry_seeded(&plain, 4).unwrap();
+    let b = inksim::pipeline::build_geometry_seeded(&settled, 4).unwrap();
+    assert_eq!(a.particles.len(), b.particles.len());
+    let moved = a
+        .particles
+        .iter()
+        .zip(&b.particles)
+        .filter(|(p, q)| p.spheres[0].center != q.spheres[0].center)
+        .count();
+    assert!(
+        moved > a.particles.len() / 2,
+        "{moved} of {} moved",
+        a.particles.len()
+    );
+    assert!(
+        b.stats.worst_overlap_nm <= 0.01 * 40.0,
+        "{}",
+        b.stats.worst_overlap_nm
+    );
+}

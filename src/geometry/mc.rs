@@ -120,6 +120,25 @@ impl Cells {
             ((c - 1).max(0), (c + 1).min(n - 1))
         }
     }
+
+    /// Flat indices of the cells around the one holding `t`, each once
+    /// (periodic in x and y, clipped in z).
+    fn around(&self, t: &[f64; 3]) -> impl Iterator<Item = usize> + '_ {
+        let cc = self.coords(self.index(t));
+        let (z0, z1) = self.range(2, cc[2]);
+        let (y0, y1) = self.range(1, cc[1]);
+        let (x0, x1) = self.range(0, cc[0]);
+        let n = self.n;
+        (z0..=z1).flat_map(move |cz| {
+            (y0..=y1).flat_map(move |cy| {
+                let wy = cy.rem_euclid(n[1] as isize) as usize;
+                (x0..=x1).map(move |cx| {
+                    let wx = cx.rem_euclid(n[0] as isize) as usize;
+                    (cz as usize * n[1] + wy) * n[0] + wx
+                })
+            })
+        })
+    }
 }
 
 /// Equilibrates `particles` in the fragment `size` by `sweeps` Monte Carlo
@@ -247,47 +266,35 @@ pub fn equilibrate(
             if ok {
                 'spheres: for (k, t) in trial.iter().enumerate() {
                     let r = rad[start[p] + k];
-                    let cc = cells.coords(cells.index(t));
-                    let (z0, z1) = cells.range(2, cc[2]);
-                    let (y0, y1) = cells.range(1, cc[1]);
-                    let (x0, x1) = cells.range(0, cc[0]);
-                    for cz in z0..=z1 {
-                        for cy in y0..=y1 {
-                            let wy = cy.rem_euclid(cells.n[1] as isize) as usize;
-                            for cx in x0..=x1 {
-                                let wx = cx.rem_euclid(cells.n[0] as isize) as usize;
-                                let f = (cz as usize * cells.n[1] + wy) * cells.n[0] + wx;
-                                for &o in &cells.list[f] {
-                                    let o = o as usize;
-                                    if owner[o] as usize == p {
-                                        continue;
-                                    }
-                                    let b = pos[o];
-                                    let dx = near_image(t[0] - b[0], size[0]);
-                                    let dy = near_image(t[1] - b[1], size[1]);
-                                    let dz = t[2] - b[2];
-                                    let reach = r + rad[o] - allow_nm;
-                                    let d2 = dx * dx + dy * dy + dz * dz;
-                                    if reach > 0.0 && d2 < reach * reach {
-                                        ok = false;
-                                        break 'spheres;
-                                    }
-                                    let g = groups.get(p).copied().unwrap_or(u32::MAX);
-                                    if sticky && g != u32::MAX && groups[owner[o] as usize] == g {
-                                        let touch = r + rad[o] + contact_nm;
-                                        let a = pos[start[p] + k];
-                                        let old = [
-                                            near_image(a[0] - b[0], size[0]),
-                                            near_image(a[1] - b[1], size[1]),
-                                            a[2] - b[2],
-                                        ];
-                                        let o2 =
-                                            old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
-                                        if o2 <= touch * touch && d2 > touch * touch {
-                                            ok = false;
-                                            break 'spheres;
-                                        }
-                                    }
+                    for f in cells.around(t) {
+                        for &o in &cells.list[f] {
+                            let o = o as usize;
+                            if owner[o] as usize == p {
+                                continue;
+                            }
+                            let b = pos[o];
+                            let dx = near_image(t[0] - b[0], size[0]);
+                            let dy = near_image(t[1] - b[1], size[1]);
+                            let dz = t[2] - b[2];
+                            let reach = r + rad[o] - allow_nm;
+                            let d2 = dx * dx + dy * dy + dz * dz;
+                            if reach > 0.0 && d2 < reach * reach {
+                                ok = false;
+                                break 'spheres;
+                            }
+                            let g = groups.get(p).copied().unwrap_or(u32::MAX);
+                            if sticky && g != u32::MAX && groups[owner[o] as usize] == g {
+                                let touch = r + rad[o] + contact_nm;
+                                let a = pos[start[p] + k];
+                                let old = [
+                                    near_image(a[0] - b[0], size[0]),
+                                    near_image(a[1] - b[1], size[1]),
+                                    a[2] - b[2],
+                                ];
+                                let o2 = old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
+                                if o2 <= touch * touch && d2 > touch * touch {
+                                    ok = false;
+                                    break 'spheres;
                                 }
                             }
                         }
@@ -335,31 +342,20 @@ pub fn equilibrate(
                         ok = false;
                         break 'members;
                     }
-                    let cc = cells.coords(cells.index(&t));
-                    let (z0, z1) = cells.range(2, cc[2]);
-                    let (y0, y1) = cells.range(1, cc[1]);
-                    let (x0, x1) = cells.range(0, cc[0]);
-                    for cz in z0..=z1 {
-                        for cy in y0..=y1 {
-                            let wy = cy.rem_euclid(cells.n[1] as isize) as usize;
-                            for cx in x0..=x1 {
-                                let wx = cx.rem_euclid(cells.n[0] as isize) as usize;
-                                let f = (cz as usize * cells.n[1] + wy) * cells.n[0] + wx;
-                                for &o in &cells.list[f] {
-                                    let o = o as usize;
-                                    if groups[owner[o] as usize] == g {
-                                        continue;
-                                    }
-                                    let b = pos[o];
-                                    let dx = near_image(t[0] - b[0], size[0]);
-                                    let dy = near_image(t[1] - b[1], size[1]);
-                                    let dz = t[2] - b[2];
-                                    let reach = rad[q] + rad[o] - allow_nm;
-                                    if reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach {
-                                        ok = false;
-                                        break 'members;
-                                    }
-                                }
+                    for f in cells.around(&t) {
+                        for &o in &cells.list[f] {
+                            let o = o as usize;
+                            if groups[owner[o] as usize] == g {
+                                continue;
+                            }
+                            let b = pos[o];
+                            let dx = near_image(t[0] - b[0], size[0]);
+                            let dy = near_image(t[1] - b[1], size[1]);
+                            let dz = t[2] - b[2];
+                            let reach = rad[q] + rad[o] - allow_nm;
+                            if reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach {
+                                ok = false;
+                                break 'members;
                             }
                         }
                     }

@@ -44,18 +44,25 @@ fn write_config(dir: &Path, text: &str) -> PathBuf {
     p
 }
 
-/// Run a broken config; expect failure with one error line mentioning `needle`
-/// and nothing written to the output folder.
-fn expect_error(text: &str, needle: &str) {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), text);
-    let out = dir.path().join("out");
+/// `inksim run` on `text` written into `dir`, results in `dir/out`:
+/// (success, stderr, config path, output folder).
+fn run_scene(dir: &Path, text: &str) -> (bool, String, PathBuf, PathBuf) {
+    let cfg = write_config(dir, text);
+    let out = dir.join("out");
     let (ok, _, err) = inksim(&[
         "run",
         cfg.to_str().unwrap(),
         "--output-dir",
         out.to_str().unwrap(),
     ]);
+    (ok, err, cfg, out)
+}
+
+/// Run a broken config; expect failure with one error line mentioning `needle`
+/// and nothing written to the output folder.
+fn expect_error(text: &str, needle: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, err, _, out) = run_scene(dir.path(), text);
     assert!(!ok, "should fail: {needle}");
     assert!(!err.contains("panicked"), "{err}");
     let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
@@ -181,14 +188,7 @@ fn grain_longer_than_half_the_fragment_is_named_once() {
         "diameter_nm = 150.0",
         "diameter_nm = 200.0\nshape = { kind = \"rice\", aspect = 3.0, spheres = 3 }",
     );
-    let cfg = write_config(dir.path(), &text);
-    let out = dir.path().join("out");
-    let (ok, _, err) = inksim(&[
-        "run",
-        cfg.to_str().unwrap(),
-        "--output-dir",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, err, _, out) = run_scene(dir.path(), &text);
     assert!(!ok, "{err}");
     assert!(!err.contains("panicked"), "{err}");
     let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
@@ -214,14 +214,7 @@ fn dense_rice_layer_uses_dynamics_and_runs() {
         )
         .replace("wavelengths_nm = [500.0, 600.0]", "wavelengths_nm = [550.0]")
         .replace("polar_deg = [0.0, 40.0]", "polar_deg = [20.0]");
-    let cfg = write_config(dir.path(), &text);
-    let out = dir.path().join("out");
-    let (ok, _, err) = inksim(&[
-        "run",
-        cfg.to_str().unwrap(),
-        "--output-dir",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, err, cfg, out) = run_scene(dir.path(), &text);
     assert!(ok, "{err}");
     assert!(err.contains("geometry: dynamics"), "{err}");
     let s_value: f64 = err

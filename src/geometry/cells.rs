@@ -59,6 +59,22 @@ pub(crate) struct CellList {
     owner: Vec<u32>,
 }
 
+/// Cell range `(lo, hi)` around cell `c` of an axis of `n` cells, each
+/// cell once: periodic axes wrap (the caller reduces modulo `n`; fewer than
+/// three cells give the whole axis), the z axis is clipped to the slab.
+pub(crate) fn stencil(n: usize, c: usize, periodic: bool) -> (isize, isize) {
+    let (n, c) = (n as isize, c as isize);
+    if periodic {
+        if n < 3 {
+            (0, n - 1)
+        } else {
+            (c - 1, c + 1)
+        }
+    } else {
+        ((c - 1).max(0), (c + 1).min(n - 1))
+    }
+}
+
 /// Cells per axis for a grid over `size` with cells no narrower than
 /// `min_cell`, widened until there are at most ~4 per expected item (so
 /// memory stays linear in `capacity`).

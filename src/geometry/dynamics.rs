@@ -428,17 +428,7 @@ impl Grid {
 
     /// Cell ranges around `c` along axis `a` (no cell twice).
     fn range(&self, a: usize, c: usize) -> (isize, isize) {
-        let n = self.n[a] as isize;
-        let c = c as isize;
-        if a < 2 {
-            if n < 3 {
-                (0, n - 1)
-            } else {
-                (c - 1, c + 1)
-            }
-        } else {
-            ((c - 1).max(0), (c + 1).min(n - 1))
-        }
+        super::cells::stencil(self.n[a], c, a < 2)
     }
 
     /// Cell ranges within `k` cells of `c` along axis `a` (no cell twice).

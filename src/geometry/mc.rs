@@ -108,17 +108,7 @@ impl Cells {
     }
 
     fn range(&self, a: usize, c: usize) -> (isize, isize) {
-        let n = self.n[a] as isize;
-        let c = c as isize;
-        if a < 2 {
-            if n < 3 {
-                (0, n - 1)
-            } else {
-                (c - 1, c + 1)
-            }
-        } else {
-            ((c - 1).max(0), (c + 1).min(n - 1))
-        }
+        super::cells::stencil(self.n[a], c, a < 2)
     }
 
     /// Flat indices of the cells around the one holding `t`, each once

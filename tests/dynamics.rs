@@ -6,7 +6,7 @@ use common::brute_min_gap;
 use inksim::geometry::{
     analyse, axis_from_uniforms, order_parameter, pack_dynamics, particle_axis, union_volume,
     DynParams, DynSpecies, Geometry, GeometryError, Orientation, Shape, ShapeTemplate,
-    SizeDistribution, SpeciesOptions, StatsParams,
+    SizeDistribution, SpeciesOptions, StatsParams, PARALLEL_MIN_PARTICLES,
 };
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -600,12 +600,18 @@ fn thread_count_does_not_change_the_packing() {
 /// The FIRE stage (forced from the first step here) gives overlap-free
 /// packings inside the walls and bit-identical particles with 1 and 2
 /// threads, for rice grains (torques, generic pair path) and for spheres
-/// (fast path).
+/// (fast path), below `PARALLEL_MIN_PARTICLES` (serial passes, half
+/// Verlet list) and above it (parallel passes, full list).
 #[test]
 fn fire_stage_packs_and_is_thread_count_independent() {
-    for (shape, d, f) in [(RICE, 40.0, 0.45), (Shape::Sphere, 40.0, 0.55)] {
+    for (shape, d, f, side, parallel) in [
+        (RICE, 40.0, 0.45, 600.0, false),
+        (Shape::Sphere, 40.0, 0.55, 600.0, false),
+        (RICE, 40.0, 0.45, 1100.0, true),
+        (Shape::Sphere, 40.0, 0.55, 1100.0, true),
+    ] {
         let mut params = DynParams::new(
-            [600.0, 600.0, 300.0],
+            [side, side, 300.0],
             vec![sp(shape, d, f, Orientation::Random, 0.0)],
         );
         params.fire_after_steps = 0;
@@ -618,9 +624,15 @@ fn fire_stage_packs_and_is_thread_count_independent() {
         };
         let (a, b) = (run(1), run(2));
         assert!(a.particles.len() > 1000);
+        assert_eq!(a.particles.len() >= PARALLEL_MIN_PARTICLES, parallel);
         assert_eq!(a.particles, b.particles);
         let tol = params.overlap_tolerance * min_radius(&a);
-        let worst = brute_worst_overlap(&a);
+        // Brute force on the small ensembles, the grid on the large ones.
+        let worst = if parallel {
+            a.stats.worst_overlap_nm
+        } else {
+            brute_worst_overlap(&a)
+        };
         assert!(worst < tol, "overlap {worst} ≥ {tol}");
         check_inside_and_rigid(&a, tol);
     }

@@ -55,21 +55,28 @@
 //!
 //! FIRE stage (an addition to METHOD §2, for batches near jamming): a batch
 //! not relaxed within [`DynParams::fire_after_steps`] first-order steps
-//! continues with FIRE (Bitzek et al. 2006, parameters as LAMMPS's
-//! `min_style fire`): semi-implicit Euler of `v̇ = F`, `J Ω̇ = M` (unit
-//! mass), velocities mixed towards the force direction and the step grown
-//! while the power `F·v + M·Ω` stays positive, everything stopped and the
-//! step halved when it turns negative; the overlap and wall forces lose the
-//! `δ` offset there (a smooth energy: with the kink at contact the power
-//! changes sign every step and FIRE stalls). Every sphere moves at most
-//! [`FIRE_MAX_MOVE`] of its particle's smallest radius per step. Forces come
-//! from a Verlet list (neighbours within reach + a skin of
-//! [`VERLET_SKIN`] r_min, rebuilt when a sphere may have moved half the
-//! skin), each particle summing its own neighbours in list order; the FIRE
-//! sums run serially in particle order, so this stage is deterministic for
-//! any thread count too. First-order dynamics stays the core: at the
-//! issue's 50–55 % targets batches converge in it or need a short FIRE tail;
-//! near jamming FIRE's inertia unjams far faster.
+//! continues with FIRE (Bitzek et al. 2006; parameters and integrator as
+//! LAMMPS's `min_style fire`, i.e. FIRE 2.0 of Guénolé et al. 2020 with
+//! `integrator eulerimplicit` and `halfstepback yes`) on `v̇ = F`,
+//! `J Ω̇ = M` (unit mass): when the power `P = F·v + M·Ω` is positive the
+//! velocities are mixed towards the force, `v ← (1 − α)(v + dt F) +
+//! α (|v|/|F|) F` (norms before the update, mass-weighted metric) and after
+//! 20 such steps the step grows; when it is not, every particle goes back
+//! half its last move, stops, and the step halves. The overlap and wall
+//! forces lose the `δ` offset there (a smooth energy: with the kink at
+//! contact the power changes sign every step and FIRE stalls). Every sphere
+//! moves at most [`FIRE_MAX_MOVE`] of its particle's smallest radius per
+//! step. Forces come from a Verlet list (neighbours within reach + a skin
+//! of [`VERLET_SKIN`] r_min, rebuilt when a sphere may have moved half of
+//! it since the last build). Below [`PARALLEL_MIN_PARTICLES`] particles the
+//! passes run serially and the list holds each pair once (both particles
+//! updated); from there on they run on the rayon pool in [`CHUNK`]s with a
+//! list holding each pair from both sides (each particle sums its own). The
+//! choice depends on the size only, and FIRE's sums are taken per chunk
+//! then over chunks in order, so this stage is deterministic for any thread
+//! count too. First-order dynamics stays the core: at the 50–55 %
+//! targets batches converge in it or need a short FIRE tail; near jamming
+//! FIRE's inertia unjams far faster.
 //!
 //! A batch is relaxed until the worst overlap (pairs and walls) is below the
 //! tolerance, or fails after `max_steps_per_batch` steps with
@@ -106,6 +113,9 @@ pub const ATTRACTION_RANGE: f64 = 0.25;
 /// Moving particles per parallel work unit (fixed, so results do not depend
 /// on the thread count).
 pub const CHUNK: usize = 256;
+/// Smallest ensemble whose FIRE passes run on the rayon pool; below it the
+/// pool's hand-offs cost more than the work.
+pub const PARALLEL_MIN_PARTICLES: usize = 4096;
 
 /// FIRE stage (Bitzek et al. 2006, PRL 97, 170201; parameters as LAMMPS's
 /// `min_style fire`, time in units of `√(m/k)` with `m = k = 1`): initial,
@@ -126,12 +136,25 @@ const FIRE_MAX_MOVE: f64 = 0.1;
 /// radius of all particles.
 const VERLET_SKIN: f64 = 0.4;
 
+/// FIRE's sums over the particles of one chunk: `F·v + M·Ω`,
+/// `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
+#[derive(Debug, Clone, Copy, Default)]
+struct FireSums {
+    vf: f64,
+    vv: f64,
+    ff: f64,
+}
+
 /// FIRE's adaptive state (reset at every batch).
 #[derive(Debug, Clone, Copy)]
 struct Fire {
     dt: f64,
     alpha: f64,
     n_pos: u32,
+    /// FIRE steps taken in this batch.
+    steps: u64,
+    /// Time step of the last move.
+    last_move: f64,
 }
 
 impl Fire {
@@ -140,6 +163,8 @@ impl Fire {
             dt: FIRE_DT0,
             alpha: FIRE_ALPHA0,
             n_pos: 0,
+            steps: 0,
+            last_move: 0.0,
         }
     }
 }
@@ -426,25 +451,64 @@ impl Grid {
         }
     }
 
+    /// Puts every centre in its cell (each cell lists its particles in
+    /// index order: deterministic).
+    fn relink_all(&mut self, centers: &[[f64; 3]]) {
+        let n = centers.len();
+        self.next.resize(n, EMPTY);
+        self.prev.resize(n, EMPTY);
+        self.cell_of.resize(n, 0);
+        self.head.iter_mut().for_each(|h| *h = EMPTY);
+        for p in (0..n).rev() {
+            let f = self.flat(self.coords(&centers[p]));
+            self.link(p, f);
+        }
+    }
+
+    /// Bins `centers` by cell into `bins` (a counting sort; each cell's
+    /// particles in index order, with their centres, contiguous).
+    fn bin(&self, centers: &[[f64; 3]], bins: &mut Bins) {
+        let cells = self.head.len();
+        bins.cell.clear();
+        bins.cell
+            .extend(centers.iter().map(|c| self.flat(self.coords(c)) as u32));
+        bins.start.clear();
+        bins.start.resize(cells + 1, 0);
+        for &f in &bins.cell {
+            bins.start[f as usize + 1] += 1;
+        }
+        for f in 0..cells {
+            bins.start[f + 1] += bins.start[f];
+        }
+        bins.items.clear();
+        bins.items.resize(centers.len(), (0, [0.0; 3]));
+        let mut fill = std::mem::take(&mut bins.fill);
+        fill.clear();
+        fill.extend_from_slice(&bins.start[..cells]);
+        for (p, &f) in bins.cell.iter().enumerate() {
+            let k = &mut fill[f as usize];
+            bins.items[*k as usize] = (p as u32, centers[p]);
+            *k += 1;
+        }
+        bins.fill = fill;
+    }
+
     /// Cell ranges around `c` along axis `a` (no cell twice).
     fn range(&self, a: usize, c: usize) -> (isize, isize) {
         super::cells::stencil(self.n[a], c, a < 2)
     }
+}
 
-    /// Cell ranges within `k` cells of `c` along axis `a` (no cell twice).
-    fn range_k(&self, a: usize, c: usize, k: usize) -> (isize, isize) {
-        let n = self.n[a] as isize;
-        let (c, k) = (c as isize, k as isize);
-        if a < 2 {
-            if 2 * k + 1 >= n {
-                (0, n - 1)
-            } else {
-                (c - k, c + k)
-            }
-        } else {
-            ((c - k).max(0), (c + k).min(n - 1))
-        }
-    }
+/// Particles binned by cell (see [`Grid::bin`]); buffers reused.
+#[derive(Debug, Clone, Default)]
+struct Bins {
+    /// Cell `f` holds `items[start[f]..start[f + 1]]`.
+    start: Vec<u32>,
+    /// `(particle, centre)`.
+    items: Vec<(u32, [f64; 3])>,
+    /// Cell of every particle, and the fill pointers (scratch).
+    cell: Vec<u32>,
+    fill: Vec<u32>,
 }
 
 /// A force contribution to one particle: `(particle, force, torque)`.
@@ -478,19 +542,30 @@ struct State {
     /// Velocity and angular velocity (FIRE stage only; zero otherwise).
     vel: Vec<[f64; 3]>,
     ang: Vec<[f64; 3]>,
-    /// FIRE stage's Verlet list (every particle's neighbours within reach +
-    /// `nb_skin`, CSR), and how far each sphere may have moved since it was
-    /// built (an upper bound); `nb_start` empty: no valid list.
+    /// Verlet list (every particle's neighbours within reach + `nb_skin`,
+    /// CSR); `nb_start` empty: no valid list.
     nb_start: Vec<u32>,
     nb: Vec<u32>,
-    nb_disp: Vec<f64>,
     nb_skin: f64,
+    /// Centre and axis of every particle when the Verlet list was built.
+    nb_ref: Vec<([f64; 3], [f64; 3])>,
+    /// Centres binned for the list build.
+    nb_bins: Bins,
+    /// Half length of every particle (scratch of the list build).
+    nb_ext: Vec<f64>,
+    /// The Verlet list holds each pair once (serial force pass) rather
+    /// than from both sides (parallel force pass).
+    nb_half: bool,
+    /// Cells of the Verlet list build (at least reach + skin wide).
+    nb_grid: Option<Grid>,
     /// Largest centre distance at which two particles can interact, nm.
     max_reach: f64,
     /// Every particle is one sphere and none is in a seeded cluster; then
     /// `radius0` holds the radii (FIRE stage fast path).
     plain_spheres: bool,
     radius0: Vec<f64>,
+    /// FIRE sums per chunk (reused).
+    fire_sums: Vec<FireSums>,
     moving_mark: Vec<u64>,
     touched_mark: Vec<u64>,
     epoch: u64,
@@ -573,6 +648,11 @@ fn add(a: &mut [f64; 3], b: &[f64; 3], s: f64) {
 }
 
 #[inline]
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline]
 fn norm(a: &[f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
@@ -595,6 +675,38 @@ fn rotate(a: &[f64; 3], om: &[f64; 3], dt: f64) -> [f64; 3] {
     }
     let nb = norm(&b);
     [b[0] / nb, b[1] / nb, b[2] / nb]
+}
+
+/// Runs `f(p, &mut a[p], &mut b[p])` for every particle `p` in chunks of
+/// [`CHUNK`], on the rayon pool when `parallel`, and returns the largest
+/// value `f` gave (0 if none): a maximum, so the result does not depend on
+/// how the chunks were shared out.
+fn for_each_max<A: Send, B: Send>(
+    a: &mut [A],
+    b: &mut [B],
+    parallel: bool,
+    f: impl Fn(usize, &mut A, &mut B) -> f64 + Sync,
+) -> f64 {
+    let chunk = |(c, (xs, ys)): (usize, (&mut [A], &mut [B]))| {
+        let mut m = 0.0f64;
+        for (k, (x, y)) in xs.iter_mut().zip(ys.iter_mut()).enumerate() {
+            m = m.max(f(c * CHUNK + k, x, y));
+        }
+        m
+    };
+    if parallel {
+        a.par_chunks_mut(CHUNK)
+            .zip(b.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(chunk)
+            .reduce(|| 0.0, f64::max)
+    } else {
+        a.chunks_mut(CHUNK)
+            .zip(b.chunks_mut(CHUNK))
+            .enumerate()
+            .map(chunk)
+            .fold(0.0, f64::max)
+    }
 }
 
 /// Adds the alignment torque of a particle of `spec`, diameter `d`, axis `a`.
@@ -936,8 +1048,13 @@ impl State {
     /// interaction reach plus `nb_skin`, in cell order: deterministic).
     fn build_neighbours(&mut self) {
         let n = self.center.len();
-        // The FIRE stage moves particles without updating their cells.
-        self.relink();
+        // A grid whose 3×3×3 stencil covers reach + skin; the FIRE stage
+        // moves particles without updating any cell, so it is relinked.
+        let min_cell = self.max_reach + self.nb_skin;
+        let grid = self
+            .nb_grid
+            .get_or_insert_with(|| Grid::new(self.size, min_cell, n));
+        grid.bin(&self.center, &mut self.nb_bins);
         self.plain_spheres = (0..n).all(|p| {
             self.cluster[p] == EMPTY && self.specs[self.species[p] as usize].spheres.len() == 1
         });
@@ -949,66 +1066,78 @@ impl State {
         }
         self.nb_start.clear();
         self.nb.clear();
-        self.nb_disp.clear();
-        self.nb_disp.resize(n, 0.0);
-        let w = self.grid.cell[0]
-            .min(self.grid.cell[1])
-            .min(self.grid.cell[2]);
-        let k = ((self.max_reach + self.nb_skin) / w).ceil().max(1.0) as usize;
-        let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
+        self.nb_ref.clear();
+        self.nb_ref
+            .extend(self.center.iter().copied().zip(self.axis.iter().copied()));
+        // Half length of every particle, nm.
+        let mut ext = std::mem::take(&mut self.nb_ext);
+        ext.clear();
+        ext.extend(
+            (0..n).map(|p| self.specs[self.species[p] as usize].half_length * self.scale[p]),
+        );
+        self.nb_half = !self.parallel();
+        let half = self.nb_half;
+        let grid = self.nb_grid.as_ref().expect("built above");
+        let bins = &self.nb_bins;
+        let (nx, ny) = (grid.n[0] as isize, grid.n[1] as isize);
         self.nb_start.push(0);
         for i in 0..n {
             let ci = self.center[i];
             let si = &self.specs[self.species[i] as usize];
             let di = self.scale[i];
-            let cc = self.grid.coords(&ci);
-            let (z0, z1) = self.grid.range_k(2, cc[2], k);
-            let (y0, y1) = self.grid.range_k(1, cc[1], k);
-            let (x0, x1) = self.grid.range_k(0, cc[0], k);
+            let cc = grid.coords(&ci);
+            let (z0, z1) = grid.range(2, cc[2]);
+            let (y0, y1) = grid.range(1, cc[1]);
+            let (x0, x1) = grid.range(0, cc[0]);
             for cz in z0..=z1 {
                 for cy in y0..=y1 {
                     let wy = cy.rem_euclid(ny) as usize;
                     for cx in x0..=x1 {
                         let wx = cx.rem_euclid(nx) as usize;
-                        let mut j = self.grid.head[self.grid.flat([wx, wy, cz as usize])];
-                        while j != EMPTY {
+                        let f = grid.flat([wx, wy, cz as usize]);
+                        let cell = bins.start[f] as usize..bins.start[f + 1] as usize;
+                        // Branch-free compaction: every candidate is written,
+                        // the write position advances only for a neighbour
+                        // (the tests are coin tosses for the predictor).
+                        let mut w = self.nb.len();
+                        self.nb.resize(w + cell.len(), 0);
+                        for &(j, cj) in &bins.items[cell] {
                             let ju = j as usize;
-                            j = self.grid.next[ju];
-                            if ju == i {
-                                continue;
-                            }
-                            let sj = &self.specs[self.species[ju] as usize];
-                            let dj = self.scale[ju];
-                            let cj = self.center[ju];
                             let d = [
                                 near_image(cj[0] - ci[0], self.size[0]),
                                 near_image(cj[1] - ci[1], self.size[1]),
                                 cj[2] - ci[2],
                             ];
-                            let bonded =
-                                self.cluster[i] != EMPTY && self.cluster[i] == self.cluster[ju];
-                            let gap = if bonded {
+                            let gap = if self.cluster[i] != EMPTY
+                                && self.cluster[i] == self.cluster[ju]
+                            {
+                                let sj = &self.specs[self.species[ju] as usize];
+                                let dj = self.scale[ju];
                                 ATTRACTION_RANGE * 2.0 * (si.r_max * di).max(sj.r_max * dj)
                             } else {
                                 self.skin
                             };
-                            let reach =
-                                si.half_length * di + sj.half_length * dj + gap + self.nb_skin;
-                            if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach {
-                                self.nb.push(ju as u32);
-                            }
+                            let reach = ext[i] + ext[ju] + gap + self.nb_skin;
+                            let keep =
+                                (dot(&d, &d) < reach * reach) & (ju != i) & (!half | (ju > i));
+                            self.nb[w] = j;
+                            w += usize::from(keep);
                         }
+                        self.nb.truncate(w);
                     }
                 }
             }
             self.nb_start.push(self.nb.len() as u32);
         }
+        self.nb_ext = ext;
     }
 
-    /// Worst overlap over every pair and wall (Verlet list), and the force
-    /// and torque on every particle (`touched` = all).
+    /// Force and torque on every particle (walls, Verlet list, alignment
+    /// torque on pushed particles); returns the worst overlap.
     fn forces_all(&mut self) -> f64 {
-        let n = self.center.len();
+        if self.nb_half {
+            return self.forces_half();
+        }
         let mut force = std::mem::take(&mut self.force);
         let mut torque = std::mem::take(&mut self.torque);
         let this = &*self;
@@ -1020,48 +1149,22 @@ impl State {
                 let mut worst = f64::NEG_INFINITY;
                 for (k, (f, m)) in fs.iter_mut().zip(ms.iter_mut()).enumerate() {
                     let i = c * CHUNK + k;
-                    let (mut fi, mut mi, w) = this.walls(i);
-                    worst = worst.max(w);
+                    let (mut fi, mut mi, mut w) = this.walls(i);
                     let (a, b) = (this.nb_start[i] as usize, this.nb_start[i + 1] as usize);
-                    if this.plain_spheres {
-                        // Same force as `pair` for two one-sphere particles
-                        // without a cluster bond, inlined.
-                        let ci = this.center[i];
-                        let ri = this.radius0[i];
-                        for &j in &this.nb[a..b] {
-                            let j = j as usize;
-                            let cj = this.center[j];
-                            let d = [
-                                near_image(cj[0] - ci[0], this.size[0]),
-                                near_image(cj[1] - ci[1], this.size[1]),
-                                cj[2] - ci[2],
-                            ];
-                            let rsum = ri + this.radius0[j];
-                            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                            if d2 >= rsum * rsum {
-                                continue;
-                            }
-                            let dist = d2.sqrt();
-                            let l = rsum - dist;
-                            worst = worst.max(l);
-                            let mag = -K * (l + this.push);
-                            if dist > 1e-12 * rsum {
-                                add(&mut fi, &d, mag / dist);
-                            } else {
-                                fi[2] -= mag;
-                            }
-                        }
-                        *f = fi;
-                        *m = mi;
-                        continue;
-                    }
                     for &j in &this.nb[a..b] {
-                        if let Some(pf) = this.pair(i, j as usize) {
-                            worst = worst.max(pf.worst);
+                        let j = j as usize;
+                        if this.plain_spheres {
+                            let (fp, l) = this.sphere_pair(i, j);
+                            w = w.max(l);
+                            add(&mut fi, &fp, 1.0);
+                        } else if let Some(pf) = this.pair(i, j) {
+                            w = w.max(pf.worst);
                             add(&mut fi, &pf.f, 1.0);
                             add(&mut mi, &pf.mi, 1.0);
                         }
                     }
+                    this.add_field_torque_if_pushed(i, &fi, &mut mi);
+                    worst = worst.max(w);
                     *f = fi;
                     *m = mi;
                 }
@@ -1070,17 +1173,164 @@ impl State {
             .reduce(|| f64::NEG_INFINITY, f64::max);
         self.force = force;
         self.torque = torque;
-        self.touched.clear();
-        self.touched.extend(0..n as u32);
         worst
     }
 
-    /// One FIRE step (see the module docs): semi-implicit Euler of
-    /// `v̇ = F`, `J Ω̇ = M` with FIRE's velocity mixing and adaptive time
-    /// step, the step capped so that no sphere moves more than
-    /// [`FIRE_MAX_MOVE`] of its particle's smallest radius. Returns the worst
-    /// overlap at the current positions; moves only when it is `≥ tol`.
-    /// Global sums run serially in the order of `touched` (deterministic).
+    /// [`Self::forces_all`] from a half Verlet list (each pair once, both
+    /// particles updated): serial, for ensembles below [`PARALLEL_MIN_PARTICLES`].
+    fn forces_half(&mut self) -> f64 {
+        let n = self.center.len();
+        let mut force = std::mem::take(&mut self.force);
+        let mut torque = std::mem::take(&mut self.torque);
+        let mut worst = f64::NEG_INFINITY;
+        for i in 0..n {
+            let (f, m, w) = self.walls(i);
+            force[i] = f;
+            torque[i] = m;
+            worst = worst.max(w);
+        }
+        for i in 0..n {
+            let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
+            let (mut fi, mut mi) = (force[i], torque[i]);
+            for &j in &self.nb[a..b] {
+                let j = j as usize;
+                if self.plain_spheres {
+                    let (fp, l) = self.sphere_pair(i, j);
+                    worst = worst.max(l);
+                    add(&mut fi, &fp, 1.0);
+                    add(&mut force[j], &fp, -1.0);
+                } else if let Some(pf) = self.pair(i, j) {
+                    worst = worst.max(pf.worst);
+                    add(&mut fi, &pf.f, 1.0);
+                    add(&mut mi, &pf.mi, 1.0);
+                    add(&mut force[j], &pf.f, -1.0);
+                    add(&mut torque[j], &pf.mj, 1.0);
+                }
+            }
+            force[i] = fi;
+            torque[i] = mi;
+        }
+        if !self.plain_spheres {
+            for i in 0..n {
+                self.add_field_torque_if_pushed(i, &force[i], &mut torque[i]);
+            }
+        }
+        self.force = force;
+        self.torque = torque;
+        worst
+    }
+
+    /// Force on sphere particle `i` from sphere particle `j` (same as
+    /// `pair` for two one-sphere particles without a cluster bond) and
+    /// their overlap depth (negative: a gap). Branch-free: whether a listed
+    /// pair touches is a coin toss near jamming, and a mispredicted branch
+    /// costs more than the arithmetic.
+    #[inline(always)]
+    fn sphere_pair(&self, i: usize, j: usize) -> ([f64; 3], f64) {
+        let (ci, cj) = (self.center[i], self.center[j]);
+        let d = [
+            near_image(cj[0] - ci[0], self.size[0]),
+            near_image(cj[1] - ci[1], self.size[1]),
+            cj[2] - ci[2],
+        ];
+        let rsum = self.radius0[i] + self.radius0[j];
+        let dist = dot(&d, &d).sqrt();
+        let l = rsum - dist;
+        let mag = -K * (l.max(0.0) + if l > 0.0 { self.push } else { 0.0 });
+        let f = if dist > 1e-12 * rsum {
+            let s = mag / dist;
+            [s * d[0], s * d[1], s * d[2]]
+        } else {
+            [0.0, 0.0, -mag]
+        };
+        (f, l)
+    }
+
+    /// Farthest any sphere of particle `p`, now at centre `c` and axis `a`,
+    /// can be from where it was when the Verlet list was built.
+    #[inline]
+    fn displacement(&self, p: usize, c: &[f64; 3], a: &[f64; 3]) -> f64 {
+        let (c0, a0) = &self.nb_ref[p];
+        let moved = [
+            near_image(c[0] - c0[0], self.size[0]),
+            near_image(c[1] - c0[1], self.size[1]),
+            c[2] - c0[2],
+        ];
+        let mut d = norm(&moved);
+        if !self.plain_spheres {
+            let turned = [a[0] - a0[0], a[1] - a0[1], a[2] - a0[2]];
+            let spec = &self.specs[self.species[p] as usize];
+            d += norm(&turned) * spec.s_max * self.scale[p];
+        }
+        d
+    }
+
+    /// Adds the alignment torque to particle `i` when it is pushed (`f`,
+    /// `m` its force and torque): resting particles do not turn, as in the
+    /// first-order stage.
+    #[inline]
+    fn add_field_torque_if_pushed(&self, i: usize, f: &[f64; 3], m: &mut [f64; 3]) {
+        if *f != [0.0; 3] || *m != [0.0; 3] {
+            let spec = &self.specs[self.species[i] as usize];
+            add_field_torque(spec, self.scale[i], &self.axis[i], m);
+        }
+    }
+
+    /// FIRE's sums over particles (mass-weighted metric), per chunk in chunk
+    /// order: `F·v + M·Ω`, `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
+    fn fire_sums(&mut self) {
+        let mut sums = std::mem::take(&mut self.fire_sums);
+        let this = &*self;
+        let n = this.center.len();
+        let work = |c: usize| {
+            let mut out = FireSums::default();
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                let (f, m, v, om) = (this.force[i], this.torque[i], this.vel[i], this.ang[i]);
+                if this.plain_spheres {
+                    out.vf += dot(&f, &v);
+                    out.vv += dot(&v, &v);
+                    out.ff += dot(&f, &f);
+                } else {
+                    let j = this.specs[this.species[i] as usize].inertia
+                        * this.scale[i]
+                        * this.scale[i];
+                    out.vf += dot(&f, &v) + dot(&m, &om);
+                    out.vv += dot(&v, &v) + j * dot(&om, &om);
+                    out.ff += dot(&f, &f) + dot(&m, &m) / j;
+                }
+            }
+            out
+        };
+        let chunks = n.div_ceil(CHUNK);
+        if this.parallel() {
+            (0..chunks)
+                .into_par_iter()
+                .map(work)
+                .collect_into_vec(&mut sums);
+        } else {
+            sums.clear();
+            sums.extend((0..chunks).map(work));
+        }
+        self.fire_sums = sums;
+    }
+
+    /// Whether the per-particle passes run on the rayon pool: only for
+    /// ensembles of at least [`PARALLEL_MIN_PARTICLES`] particles (a choice made from the
+    /// size, never from the thread count, so results stay bit-identical).
+    fn parallel(&self) -> bool {
+        self.center.len() >= PARALLEL_MIN_PARTICLES
+    }
+
+    /// One FIRE step (see the module docs; the integrator is LAMMPS's
+    /// `min_style fire` with `integrator eulerimplicit`): the power
+    /// `P = F·v + M·Ω` decides whether the step grows or everything stops;
+    /// then `v += dt F`, mixed towards the force as
+    /// `v = (1 − α) v + α (|v| / |F|) F` (norms before the update), and the
+    /// move `x += dt' v` with `dt' ≤ dt` so that no sphere moves more than
+    /// [`FIRE_MAX_MOVE`] of its particle's smallest radius. Returns the
+    /// worst overlap at the current positions; moves only when it is
+    /// `≥ tol`. Sums over particles are taken per chunk, then over chunks
+    /// in order (deterministic).
     fn fire_step(&mut self, tol: f64, fire: &mut Fire) -> f64 {
         self.push = 0.0;
         if self.nb_start.len() != self.center.len() + 1 {
@@ -1090,100 +1340,102 @@ impl State {
         if worst < tol {
             return worst;
         }
-        // Power P = Σ F·v + M·Ω (only touched particles can move or be pushed).
-        let mut power = 0.0;
-        for k in 0..self.touched.len() {
-            let p = self.touched[k] as usize;
-            let (f, mut m) = (self.force[p], self.torque[p]);
-            if f != [0.0; 3] || m != [0.0; 3] {
-                let spec = &self.specs[self.species[p] as usize];
-                add_field_torque(spec, self.scale[p], &self.axis[p], &mut m);
-                self.torque[p] = m;
-            }
-            let (v, w) = (self.vel[p], self.ang[p]);
-            power +=
-                f[0] * v[0] + f[1] * v[1] + f[2] * v[2] + m[0] * w[0] + m[1] * w[1] + m[2] * w[2];
+        self.fire_sums();
+        let mut total = FireSums::default();
+        for s in &self.fire_sums {
+            total.vf += s.vf;
+            total.vv += s.vv;
+            total.ff += s.ff;
         }
-        if power > 0.0 {
+        fire.steps += 1;
+        let going = total.vf > 0.0;
+        let (keep, mix) = if going {
+            let mix = if total.ff > 0.0 {
+                fire.alpha * (total.vv / total.ff).sqrt()
+            } else {
+                0.0
+            };
+            let keep = 1.0 - fire.alpha;
             fire.n_pos += 1;
             if fire.n_pos > FIRE_DELAY {
                 fire.dt = (fire.dt * FIRE_GROW).min(FIRE_DT_MAX);
                 fire.alpha *= FIRE_ALPHA_SHRINK;
             }
+            (keep, mix)
         } else {
             fire.n_pos = 0;
-            fire.dt = (fire.dt * FIRE_SHRINK).max(FIRE_DT_MIN);
-            fire.alpha = FIRE_ALPHA0;
-            for k in 0..self.touched.len() {
-                let p = self.touched[k] as usize;
-                self.vel[p] = [0.0; 3];
-                self.ang[p] = [0.0; 3];
+            // As LAMMPS: no shrinking during the first `FIRE_DELAY` steps.
+            if fire.steps > u64::from(FIRE_DELAY) {
+                fire.dt = (fire.dt * FIRE_SHRINK).max(FIRE_DT_MIN);
+                fire.alpha = FIRE_ALPHA0;
             }
-        }
-        // Velocity update, then mixing in the mass-weighted metric
-        // (u = (v, √J Ω), g = (F, M/√J)).
-        let dt = fire.dt;
-        let (mut u2, mut g2) = (0.0, 0.0);
-        for k in 0..self.touched.len() {
-            let p = self.touched[k] as usize;
-            let spec = &self.specs[self.species[p] as usize];
-            let d = self.scale[p];
-            let inertia = spec.inertia * d * d;
-            let (f, m) = (self.force[p], self.torque[p]);
-            add(&mut self.vel[p], &f, dt);
-            add(&mut self.ang[p], &m, dt / inertia);
-            let (v, w) = (self.vel[p], self.ang[p]);
-            u2 += v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-            u2 += inertia * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-            g2 += f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
-            g2 += (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) / inertia;
-        }
-        let mix = if g2 > 0.0 {
-            fire.alpha * (u2 / g2).sqrt()
-        } else {
-            0.0
+            // As LAMMPS (`halfstepback`): go back half the last move.
+            let back = -0.5 * fire.last_move;
+            for p in 0..self.center.len() {
+                let (v, w) = (self.vel[p], self.ang[p]);
+                let c = &mut self.center[p];
+                c[0] = wrap(c[0] + back * v[0], self.size[0]);
+                c[1] = wrap(c[1] + back * v[1], self.size[1]);
+                c[2] += back * v[2];
+                if !self.plain_spheres {
+                    self.axis[p] = rotate(&self.axis[p], &w, back);
+                }
+            }
+            (0.0, 0.0)
         };
-        let mut rate = 0.0f64;
-        for k in 0..self.touched.len() {
-            let p = self.touched[k] as usize;
-            let spec = &self.specs[self.species[p] as usize];
-            let d = self.scale[p];
-            let inertia = spec.inertia * d * d;
-            let (f, m) = (self.force[p], self.torque[p]);
-            let (v, w) = (&mut self.vel[p], &mut self.ang[p]);
+        let dt = fire.dt;
+        // v ← keep (v + dt F) + mix F; after a stop v ← dt F.
+        let (cv, cf) = if going {
+            (keep, keep * dt + mix)
+        } else {
+            (0.0, dt)
+        };
+        // Velocities, and the largest speed relative to the smallest radius.
+        let mut vel = std::mem::take(&mut self.vel);
+        let mut ang = std::mem::take(&mut self.ang);
+        let this = &*self;
+        let rate = for_each_max(&mut vel, &mut ang, this.parallel(), |p, v, w| {
+            let (f, m) = (this.force[p], this.torque[p]);
             for a in 0..3 {
-                v[a] = (1.0 - fire.alpha) * v[a] + mix * f[a];
-                w[a] = (1.0 - fire.alpha) * w[a] + mix * m[a] / inertia;
+                v[a] = cv * v[a] + cf * f[a];
             }
-            let speed = norm(v) + norm(w) * spec.s_max * d;
-            rate = rate.max(speed / (spec.r_min * d));
-        }
+            let spec = &this.specs[this.species[p] as usize];
+            let d = this.scale[p];
+            let mut speed = norm(v);
+            if !this.plain_spheres {
+                let inertia = spec.inertia * d * d;
+                for a in 0..3 {
+                    w[a] = cv * w[a] + cf * m[a] / inertia;
+                }
+                speed += norm(w) * spec.s_max * d;
+            }
+            speed / (spec.r_min * d)
+        });
+        self.vel = vel;
+        self.ang = ang;
         let dt_move = if rate * dt > FIRE_MAX_MOVE {
             FIRE_MAX_MOVE / rate
         } else {
             dt
         };
-        self.moving.clear();
-        let mut disp = 0.0f64;
-        for k in 0..self.touched.len() {
-            let p = self.touched[k] as usize;
-            let (v, w) = (self.vel[p], self.ang[p]);
-            if v == [0.0; 3] && w == [0.0; 3] {
-                continue;
+        fire.last_move = dt_move;
+        // Move; track how far each sphere may have gone since the Verlet
+        // list was built.
+        let mut center = std::mem::take(&mut self.center);
+        let mut axis = std::mem::take(&mut self.axis);
+        let this = &*self;
+        let disp = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
+            let (v, w) = (this.vel[p], this.ang[p]);
+            c[0] = wrap(c[0] + v[0] * dt_move, this.size[0]);
+            c[1] = wrap(c[1] + v[1] * dt_move, this.size[1]);
+            c[2] += v[2] * dt_move;
+            if !this.plain_spheres {
+                *a = rotate(a, &w, dt_move);
             }
-            let c0 = self.center[p];
-            let c = [
-                wrap(c0[0] + v[0] * dt_move, self.size[0]),
-                wrap(c0[1] + v[1] * dt_move, self.size[1]),
-                c0[2] + v[2] * dt_move,
-            ];
-            self.axis[p] = rotate(&self.axis[p], &w, dt_move);
-            self.center[p] = c;
-            self.moving.push(p as u32);
-            let spec = &self.specs[self.species[p] as usize];
-            self.nb_disp[p] += (norm(&v) + norm(&w) * spec.s_max * self.scale[p]) * dt_move;
-            disp = disp.max(self.nb_disp[p]);
-        }
+            this.displacement(p, c, a)
+        });
+        self.center = center;
+        self.axis = axis;
         if 2.0 * disp > self.nb_skin {
             self.build_neighbours();
         }
@@ -1193,26 +1445,21 @@ impl State {
     /// Rebuilds every cell list from the particle centres (deterministic:
     /// each cell lists its particles in index order).
     fn relink(&mut self) {
-        self.grid.head.iter_mut().for_each(|h| *h = EMPTY);
-        for p in (0..self.center.len()).rev() {
-            let f = self.grid.flat(self.grid.coords(&self.center[p]));
-            self.grid.link(p, f);
-        }
+        self.grid.relink_all(&self.center);
     }
 
-    /// Sets every velocity to zero (only particles of the moving list can
-    /// have one) and, after a FIRE stage, puts every particle back in its
-    /// cell.
+    /// Sets every velocity to zero and, after a FIRE stage (which moves
+    /// every particle), puts every particle back in its cell and on the
+    /// moving list.
     fn stop(&mut self) {
         if !self.nb_start.is_empty() {
             self.relink();
+            self.vel.iter_mut().for_each(|v| *v = [0.0; 3]);
+            self.ang.iter_mut().for_each(|w| *w = [0.0; 3]);
+            self.moving.clear();
+            self.moving.extend(0..self.center.len() as u32);
         }
         self.nb_start.clear();
-        for k in 0..self.moving.len() {
-            let p = self.moving[k] as usize;
-            self.vel[p] = [0.0; 3];
-            self.ang[p] = [0.0; 3];
-        }
     }
 }
 
@@ -1297,16 +1544,21 @@ impl DynamicsPacker {
             ang: Vec::with_capacity(total),
             nb_start: Vec::new(),
             nb: Vec::new(),
-            nb_disp: Vec::new(),
             nb_skin: VERLET_SKIN
                 * if r_min_all.is_finite() {
                     r_min_all
                 } else {
                     0.0
                 },
+            nb_ref: Vec::new(),
+            nb_ext: Vec::new(),
+            nb_bins: Bins::default(),
+            nb_half: false,
+            nb_grid: None,
             max_reach: cell,
             plain_spheres: false,
             radius0: Vec::new(),
+            fire_sums: Vec::new(),
             moving_mark: Vec::with_capacity(total),
             touched_mark: Vec::with_capacity(total),
             epoch: 0,
@@ -1455,6 +1707,12 @@ impl DynamicsPacker {
     /// steps taken, or [`GeometryError::DynamicsNotReached`] after
     /// `max_steps_per_batch` steps.
     pub fn relax(&mut self) -> Result<u64, GeometryError> {
+        // On a pool thread, so that the steps' parallel passes start without
+        // handing work over from (and waking) a thread outside the pool.
+        rayon::scope(|_| self.relax_here())
+    }
+
+    fn relax_here(&mut self) -> Result<u64, GeometryError> {
         let mut steps = 0u64;
         let mut fire = Fire::new();
         loop {

@@ -27,7 +27,9 @@ mod rsa;
 mod shapes;
 pub mod stats;
 
-pub use dynamics::{pack_dynamics, particle_axis, DynParams, DynSpecies, DynamicsPacker};
+pub use dynamics::{
+    pack_dynamics, particle_axis, DynParams, DynSpecies, DynamicsPacker, PARALLEL_MIN_PARTICLES,
+};
 pub use shapes::{
     axis_from_uniforms, order_parameter, union_volume, Orientation, Shape, ShapeTemplate,
     SizeDistribution,

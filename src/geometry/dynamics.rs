@@ -142,8 +142,8 @@ const FIRE_MAX_MOVE: f64 = 0.1;
 /// move (for grains of several spheres the lists die within a step or two
 /// of first-order moves and their builds cost more than the grid path).
 const VERLET_SHARE: usize = 4;
-/// Skin of the FIRE stage's Verlet list, in units of the smallest sphere
-/// radius of all particles.
+/// Skin of the Verlet list (FIRE and first-order steps), in units of the
+/// smallest sphere radius of all particles.
 const VERLET_SKIN: f64 = 0.5;
 
 /// FIRE's sums over the particles of one chunk: `F·v + M·Ω`,

@@ -569,6 +569,37 @@ fn relief_lets_grains_protrude_and_raster_covers_them() {
     );
 }
 
+/// Packs `params` with `seed` on 1 and on 2 threads, checks that both give
+/// bit-identical particles after the same number of steps, and returns the
+/// packing.
+fn pack_thread_independent(params: &DynParams, seed: u64) -> Geometry {
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| pack_dynamics(params, seed).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.particles, b.particles);
+    assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
+    a
+}
+
+/// No overlap beyond the tolerance (brute force below
+/// `PARALLEL_MIN_PARTICLES` particles, the grid above), every grain inside
+/// the walls and rigid.
+fn assert_overlap_free(g: &Geometry, params: &DynParams) {
+    let tol = params.overlap_tolerance * min_radius(g);
+    let worst = if g.particles.len() >= PARALLEL_MIN_PARTICLES {
+        g.stats.worst_overlap_nm
+    } else {
+        brute_worst_overlap(g)
+    };
+    assert!(worst < tol, "overlap {worst} ≥ {tol}");
+    check_inside_and_rigid(g, tol);
+}
+
 /// Same seed ⇒ bit-identical particles with 1 and 2 threads (mixture, size
 /// distribution, clusters, alignment field).
 #[test]
@@ -584,17 +615,8 @@ fn thread_count_does_not_change_the_packing() {
         opts(SizeDistribution::Normal { sigma: 0.1 }, 1),
         opts(SizeDistribution::Fixed, 4),
     ];
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| pack_dynamics(&params, 9).unwrap())
-    };
-    let (a, b) = (run(1), run(2));
+    let a = pack_thread_independent(&params, 9);
     assert!(a.particles.len() > 1000);
-    assert_eq!(a.particles, b.particles);
-    assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
 }
 
 /// The FIRE stage (forced from the first step here) gives overlap-free
@@ -615,26 +637,10 @@ fn fire_stage_packs_and_is_thread_count_independent() {
             vec![sp(shape, d, f, Orientation::Random, 0.0)],
         );
         params.fire_after_steps = 0;
-        let run = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| pack_dynamics(&params, 5).unwrap())
-        };
-        let (a, b) = (run(1), run(2));
+        let a = pack_thread_independent(&params, 5);
         assert!(a.particles.len() > 1000);
         assert_eq!(a.particles.len() >= PARALLEL_MIN_PARTICLES, parallel);
-        assert_eq!(a.particles, b.particles);
-        let tol = params.overlap_tolerance * min_radius(&a);
-        // Brute force on the small ensembles, the grid on the large ones.
-        let worst = if parallel {
-            a.stats.worst_overlap_nm
-        } else {
-            brute_worst_overlap(&a)
-        };
-        assert!(worst < tol, "overlap {worst} ≥ {tol}");
-        check_inside_and_rigid(&a, tol);
+        assert_overlap_free(&a, &params);
     }
 }
 
@@ -650,25 +656,9 @@ fn first_order_verlet_steps_pack_and_are_thread_count_independent() {
             vec![sp(Shape::Sphere, 40.0, 0.45, Orientation::Random, 0.0)],
         );
         params.fire_after_steps = u64::MAX;
-        let run = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| pack_dynamics(&params, 3).unwrap())
-        };
-        let (a, b) = (run(1), run(2));
+        let a = pack_thread_independent(&params, 3);
         assert_eq!(a.particles.len() >= PARALLEL_MIN_PARTICLES, parallel);
-        assert_eq!(a.particles, b.particles);
-        assert_eq!(a.stats.relax_steps, b.stats.relax_steps);
-        let tol = params.overlap_tolerance * min_radius(&a);
-        let worst = if parallel {
-            a.stats.worst_overlap_nm
-        } else {
-            brute_worst_overlap(&a)
-        };
-        assert!(worst < tol, "overlap {worst} ≥ {tol}");
-        check_inside_and_rigid(&a, tol);
+        assert_overlap_free(&a, &params);
     }
 }
 

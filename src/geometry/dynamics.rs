@@ -782,8 +782,8 @@ fn for_each_max<A: Send, B: Send>(
 /// Verlet-list entries whose sphere pair forces are computed together.
 const LANES: usize = 4;
 
-/// [`near_image`] for neighbours within half a period of the nearest
-/// image (every Verlet-list entry), with selects instead of branches.
+/// [`near_image`] for two coordinates wrapped into one period (so
+/// `|d| < l`), with selects instead of branches.
 #[inline(always)]
 fn near_image_select(d: f64, l: f64) -> f64 {
     let h = 0.5 * l;
@@ -950,16 +950,16 @@ impl State {
         })
     }
 
-    /// [`Self::sphere_pair`] of `i` with each of `LANES` particles: the
-    /// force components `[x, y, z][lane]` and the overlaps, bit-identical
-    /// to it lane by lane (same operations, selects instead of branches).
+    /// Forces on sphere particle `i` from each of the sphere particles `js`
+    /// (components `[x, y, z][lane]`) and the overlaps: the lanes are
+    /// independent, so the compiler can vectorise a block of them.
     #[inline(always)]
-    fn sphere_pairs(&self, i: usize, js: &[u32; LANES]) -> ([[f64; LANES]; 3], [f64; LANES]) {
+    fn sphere_pairs<const N: usize>(&self, i: usize, js: &[u32; N]) -> ([[f64; N]; 3], [f64; N]) {
         let ci = self.center[i];
         let ri = self.radius0[i];
-        let mut d = [[0.0; LANES]; 3];
-        let mut rsum = [0.0; LANES];
-        for k in 0..LANES {
+        let mut d = [[0.0; N]; 3];
+        let mut rsum = [0.0; N];
+        for k in 0..N {
             let j = js[k] as usize;
             let cj = self.center[j];
             d[0][k] = cj[0] - ci[0];
@@ -967,9 +967,9 @@ impl State {
             d[2][k] = cj[2] - ci[2];
             rsum[k] = ri + self.radius0[j];
         }
-        let mut f = [[0.0; LANES]; 3];
-        let mut l = [0.0; LANES];
-        for k in 0..LANES {
+        let mut f = [[0.0; N]; 3];
+        let mut l = [0.0; N];
+        for k in 0..N {
             let dx = near_image_select(d[0][k], self.size[0]);
             let dy = near_image_select(d[1][k], self.size[1]);
             let dz = d[2][k];
@@ -1390,7 +1390,8 @@ impl State {
                 for block in &mut blocks {
                     // Pair forces of a block at once (independent lanes the
                     // compiler can vectorise), then added in list order.
-                    let (f, l) = self.sphere_pairs(i, block.try_into().expect("LANES entries"));
+                    let js: &[u32; LANES] = block.try_into().expect("LANES entries");
+                    let (f, l) = self.sphere_pairs(i, js);
                     for k in 0..LANES {
                         let j = block[k] as usize;
                         wi = if l[k] > wi { l[k] } else { wi };
@@ -1451,23 +1452,8 @@ impl State {
     /// costs more than the arithmetic.
     #[inline(always)]
     fn sphere_pair(&self, i: usize, j: usize) -> ([f64; 3], f64) {
-        let (ci, cj) = (self.center[i], self.center[j]);
-        let d = [
-            near_image(cj[0] - ci[0], self.size[0]),
-            near_image(cj[1] - ci[1], self.size[1]),
-            cj[2] - ci[2],
-        ];
-        let rsum = self.radius0[i] + self.radius0[j];
-        let dist = dot(&d, &d).sqrt();
-        let l = rsum - dist;
-        let mag = -K * (l.max(0.0) + if l > 0.0 { self.push } else { 0.0 });
-        let f = if dist > 1e-12 * rsum {
-            let s = mag / dist;
-            [s * d[0], s * d[1], s * d[2]]
-        } else {
-            [0.0, 0.0, -mag]
-        };
-        (f, l)
+        let (f, l) = self.sphere_pairs(i, &[j as u32]);
+        ([f[0][0], f[1][0], f[2][0]], l[0])
     }
 
     /// Square of the farthest any sphere of particle `p`, now at centre `c`

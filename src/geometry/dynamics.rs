@@ -1033,30 +1033,23 @@ impl State {
     /// `i` itself). Returns the worst overlap seen.
     fn gather(&self, i: usize, ep: u64, buf: &mut Vec<Contribution>) -> f64 {
         let (mut fi, mut mi, mut worst) = self.walls(i);
-        let cc = self.grid.coords(&self.center[i]);
-        let (z0, z1) = self.grid.range(2, cc[2]);
-        let (y0, y1) = self.grid.range(1, cc[1]);
-        let (x0, x1) = self.grid.range(0, cc[0]);
-        let (nx, ny) = (self.grid.n[0] as isize, self.grid.n[1] as isize);
-        for cz in z0..=z1 {
-            for cy in y0..=y1 {
-                let wy = cy.rem_euclid(ny) as usize;
-                for cx in x0..=x1 {
-                    let wx = cx.rem_euclid(nx) as usize;
-                    let mut j = self.grid.head[self.grid.flat([wx, wy, cz as usize])];
-                    while j != EMPTY {
-                        let ju = j as usize;
-                        j = self.grid.next[ju];
-                        if ju == i || (self.moving_mark[ju] == ep && ju < i) {
-                            continue;
-                        }
-                        if let Some(pf) = self.pair(i, ju) {
-                            worst = worst.max(pf.worst);
-                            add(&mut fi, &pf.f, 1.0);
-                            add(&mut mi, &pf.mi, 1.0);
-                            buf.push((ju as u32, [-pf.f[0], -pf.f[1], -pf.f[2]], pf.mj));
-                        }
-                    }
+        let mut cells = [(0usize, false); 27];
+        let count = self
+            .grid
+            .stencil_cells(self.grid.coords(&self.center[i]), &mut cells);
+        for &(f, _) in &cells[..count] {
+            let mut j = self.grid.head[f];
+            while j != EMPTY {
+                let ju = j as usize;
+                j = self.grid.next[ju];
+                if ju == i || (self.moving_mark[ju] == ep && ju < i) {
+                    continue;
+                }
+                if let Some(pf) = self.pair(i, ju) {
+                    worst = worst.max(pf.worst);
+                    add(&mut fi, &pf.f, 1.0);
+                    add(&mut mi, &pf.mi, 1.0);
+                    buf.push((ju as u32, [-pf.f[0], -pf.f[1], -pf.f[2]], pf.mj));
                 }
             }
         }

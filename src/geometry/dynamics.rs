@@ -1363,17 +1363,7 @@ impl State {
                 *f = [0.0, 0.0, fz];
                 worst = worst.max(w);
             }
-        } else {
-            for i in 0..n {
-                let (f, m, w) = self.walls(i);
-                force[i] = f;
-                torque[i] = m;
-                worst = worst.max(w);
-            }
-        }
-        if self.plain_spheres {
-            // The loop below for one-sphere particles, with nothing but the
-            // force in the loop-carried state.
+            // Nothing but the force in the loop-carried state.
             for i in 0..n {
                 let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
                 let mut fi = force[i];
@@ -1403,32 +1393,29 @@ impl State {
                 force[i] = fi;
                 worst = worst.max(wi);
             }
-            self.force = force;
-            self.torque = torque;
-            return worst;
-        }
-        for i in 0..n {
-            let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
-            let (mut fi, mut mi) = (force[i], torque[i]);
-            for &j in &self.nb[a..b] {
-                let j = j as usize;
-                if self.plain_spheres {
-                    let (fp, l) = self.sphere_pair(i, j);
-                    worst = worst.max(l);
-                    add(&mut fi, &fp, 1.0);
-                    add(&mut force[j], &fp, -1.0);
-                } else if let Some(pf) = self.pair(i, j) {
-                    worst = worst.max(pf.worst);
-                    add(&mut fi, &pf.f, 1.0);
-                    add(&mut mi, &pf.mi, 1.0);
-                    add(&mut force[j], &pf.f, -1.0);
-                    add(&mut torque[j], &pf.mj, 1.0);
-                }
+        } else {
+            for i in 0..n {
+                let (f, m, w) = self.walls(i);
+                force[i] = f;
+                torque[i] = m;
+                worst = worst.max(w);
             }
-            force[i] = fi;
-            torque[i] = mi;
-        }
-        if !self.plain_spheres {
+            for i in 0..n {
+                let (a, b) = (self.nb_start[i] as usize, self.nb_start[i + 1] as usize);
+                let (mut fi, mut mi) = (force[i], torque[i]);
+                for &j in &self.nb[a..b] {
+                    let j = j as usize;
+                    if let Some(pf) = self.pair(i, j) {
+                        worst = worst.max(pf.worst);
+                        add(&mut fi, &pf.f, 1.0);
+                        add(&mut mi, &pf.mi, 1.0);
+                        add(&mut force[j], &pf.f, -1.0);
+                        add(&mut torque[j], &pf.mj, 1.0);
+                    }
+                }
+                force[i] = fi;
+                torque[i] = mi;
+            }
             for i in 0..n {
                 self.add_field_torque_if_pushed(i, &force[i], &mut torque[i]);
             }
@@ -1447,6 +1434,19 @@ impl State {
     fn sphere_pair(&self, i: usize, j: usize) -> ([f64; 3], f64) {
         let (f, l) = self.sphere_pairs(i, &[j as u32]);
         ([f[0][0], f[1][0], f[2][0]], l[0])
+    }
+
+    /// Moves particle `p` (centre `c`, axis `a`) for `dt` at its FIRE
+    /// velocity and angular velocity.
+    #[inline(always)]
+    fn drift(&self, p: usize, c: &mut [f64; 3], a: &mut [f64; 3], dt: f64) {
+        let (v, w) = (self.vel[p], self.ang[p]);
+        c[0] = wrap(c[0] + v[0] * dt, self.size[0]);
+        c[1] = wrap(c[1] + v[1] * dt, self.size[1]);
+        c[2] += v[2] * dt;
+        if !self.plain_spheres {
+            *a = rotate(a, &w, dt);
+        }
     }
 
     /// Square of the farthest any sphere of particle `p`, now at centre `c`
@@ -1575,16 +1575,15 @@ impl State {
             }
             // As LAMMPS (`halfstepback`): go back half the last move.
             let back = -0.5 * fire.last_move;
-            for p in 0..self.center.len() {
-                let (v, w) = (self.vel[p], self.ang[p]);
-                let c = &mut self.center[p];
-                c[0] = wrap(c[0] + back * v[0], self.size[0]);
-                c[1] = wrap(c[1] + back * v[1], self.size[1]);
-                c[2] += back * v[2];
-                if !self.plain_spheres {
-                    self.axis[p] = rotate(&self.axis[p], &w, back);
-                }
-            }
+            let mut center = std::mem::take(&mut self.center);
+            let mut axis = std::mem::take(&mut self.axis);
+            let this = &*self;
+            for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
+                this.drift(p, c, a, back);
+                0.0
+            });
+            self.center = center;
+            self.axis = axis;
             (0.0, 0.0)
         };
         let dt = fire.dt;
@@ -1629,13 +1628,7 @@ impl State {
         let mut axis = std::mem::take(&mut self.axis);
         let this = &*self;
         let disp2 = for_each_max(&mut center, &mut axis, this.parallel(), |p, c, a| {
-            let (v, w) = (this.vel[p], this.ang[p]);
-            c[0] = wrap(c[0] + v[0] * dt_move, this.size[0]);
-            c[1] = wrap(c[1] + v[1] * dt_move, this.size[1]);
-            c[2] += v[2] * dt_move;
-            if !this.plain_spheres {
-                *a = rotate(a, &w, dt_move);
-            }
+            this.drift(p, c, a, dt_move);
             this.displacement2(p, c, a)
         });
         self.center = center;

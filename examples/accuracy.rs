@@ -13,8 +13,8 @@
 //! Identical variants (the baseline recurs in every knob) run once.
 //! Colours are the ones the run stored (`/appearance/tile_lab`).
 
-use inksim::colour::{self, Observer};
-use inksim::io::{read_appearance, AppearanceArrays};
+use inksim::optics::colour::{self, Observer};
+use inksim::output::h5::{read_appearance, AppearanceArrays};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -9,7 +9,7 @@
 //! drawn on the floor line). Reference rows (error 0 by definition) are left
 //! out; a knob's points are joined in table order.
 
-use inksim::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
+use inksim::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 

@@ -4,7 +4,7 @@
 //! `cargo run --release --example compare_methods [config] [tolerance]`
 
 use inksim::config::{load_scene, Method};
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::pipeline::{build_geometry, grid_of, SUPERSAMPLE};
 use inksim::raster::rasterize;
 use inksim::solver::{self, Controls, Problem};

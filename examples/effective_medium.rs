@@ -15,8 +15,8 @@
 //! ```
 
 use inksim::config::{Material, Method, Precision};
-use inksim::farfield::efficiencies;
 use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
+use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::airy::{self, GrainTerm};
 use inksim::solver::{self, Controls, Problem};

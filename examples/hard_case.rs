@@ -8,8 +8,8 @@
 //! `cargo run --release --example hard_case [side_nm] [seed]`
 
 use inksim::config::{Method, Precision};
-use inksim::farfield::efficiencies;
 use inksim::geometry::{pack_dynamics, DynParams, DynSpecies, Orientation, Shape};
+use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, IterativeMethod, Problem, System, SHIFT_MARGIN};
 use ndarray::Array3;

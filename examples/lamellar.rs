@@ -14,7 +14,7 @@
 //! (default cells: 40 20 10 5).
 
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem};
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
@@ -146,7 +146,7 @@ fn run(a: &Args) -> Result<(), String> {
                 .map_err(|e| format!("cell {cell} nm, {name}: {e}"))?;
             let ff = efficiencies(&sol);
             let wall = start.elapsed().as_secs_f64();
-            let pick = |f: fn(&inksim::farfield::Order) -> f64| -> Vec<String> {
+            let pick = |f: fn(&inksim::optics::farfield::Order) -> f64| -> Vec<String> {
                 ORDERS
                     .map(|m| {
                         ff.orders

@@ -10,22 +10,14 @@
 //! The physics and numerics follow `METHOD.md` (shipped beside the project);
 //! each stage's module docs state what it owns and which choices it made.
 
-pub mod accuracy;
-pub mod appearance;
-pub mod colour;
 pub mod config;
-pub mod farfield;
 pub mod geometry;
-pub mod io;
-pub mod merl;
+pub mod optics;
+pub mod output;
 pub mod pipeline;
-pub mod progress;
 pub mod raster;
-pub mod render;
 pub mod solver;
-pub mod structure;
 pub mod study;
-pub mod substrate;
 
 /// Version string embedded in every result file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

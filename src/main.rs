@@ -359,7 +359,7 @@ fn real_main() -> Result<ExitCode> {
                 println!("  {line}");
             }
             println!("expected error of these settings:");
-            for line in inksim::accuracy::expected_error(&scene) {
+            for line in inksim::pipeline::accuracy::expected_error(&scene) {
                 println!("  {line}");
             }
             let (h5, png) = inksim::pipeline::result_paths(&scene);
@@ -550,7 +550,7 @@ fn plan_study(
             "expected error of this profile's settings (variant {}):",
             v.name
         );
-        for line in inksim::accuracy::expected_error(&v.scene) {
+        for line in inksim::pipeline::accuracy::expected_error(&v.scene) {
             println!("  {line}");
         }
     }
@@ -567,7 +567,7 @@ fn plan_study(
                 .iter()
                 .find(|v| !v.scene.is_molecular())
                 .or(exp.variants.first())
-                .and_then(|v| inksim::accuracy::expected_error(&v.scene).pop())
+                .and_then(|v| inksim::pipeline::accuracy::expected_error(&v.scene).pop())
                 .unwrap_or_default();
             println!(
                 "  {:<10} {} variants, {} solves, grid {}, est. {} total, peak memory {} per \
@@ -658,7 +658,7 @@ fn slurm_study(
                 .unwrap_or_default()
         ))
     });
-    inksim::io::write_atomic(&path, slurm::script(&o).as_bytes())?;
+    inksim::output::h5::write_atomic(&path, slurm::script(&o).as_bytes())?;
     println!("wrote {}", path.display());
     println!(
         "{n} variants in {shards} array tasks of {cpus} CPU(s), --mem {mem_mb}M (1.5 × the \

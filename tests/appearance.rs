@@ -5,7 +5,7 @@
 //! export.
 
 use inksim::config::parse_scene;
-use inksim::farfield::Side;
+use inksim::optics::farfield::Side;
 use inksim::pipeline::{self, RunPlan, RunReport};
 use inksim::solver::MethodUsed;
 use num_complex::Complex64 as C64;
@@ -70,7 +70,7 @@ fn bare_paper_renders_its_albedo_as_grey() {
     let dir = tempfile::tempdir().unwrap();
     let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.0, 6));
     let a = rep.appearance.unwrap();
-    let grey = (inksim::colour::srgb_encode(0.9) * 255.0).round() as u8;
+    let grey = (inksim::optics::colour::srgb_encode(0.9) * 255.0).round() as u8;
     assert_eq!(grey, 243);
     let c = a.colours.unwrap();
     assert!(
@@ -441,7 +441,7 @@ name = "mol"
 
 #[test]
 fn merl_export_of_bare_paper_is_albedo_over_pi_everywhere() {
-    use inksim::merl;
+    use inksim::output::merl;
     let dir = tempfile::tempdir().unwrap();
     let text = slab_scene(dir.path(), 1.0, 4).replace(
         "quadrature_points = 4",
@@ -482,7 +482,7 @@ fn colour_between_solved_wavelengths_follows_the_proxy() {
     let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.558, 32));
     let a = rep.appearance.unwrap();
     let eps = 1.558f64.powi(2);
-    let obs = inksim::colour::Observer::cie1931_d65();
+    let obs = inksim::optics::colour::Observer::cie1931_d65();
     let fine: Vec<f64> = (0..=40).map(|k| 450.0 + 5.0 * k as f64).collect();
     for (o, &view) in a.spec.viewing_deg.iter().enumerate() {
         let spectrum: Vec<f64> = fine
@@ -493,19 +493,22 @@ fn colour_between_solved_wavelengths_follows_the_proxy() {
                 r + 0.9 * (1.0 - rdd) * t / (1.0 - 0.9 * rdd)
             })
             .collect();
-        let xyz = inksim::colour::xyz_from_reflectance(&obs, &fine, &spectrum).unwrap();
-        let lab = inksim::colour::xyz_to_lab(xyz, obs.white_xyz());
+        let xyz = inksim::optics::colour::xyz_from_reflectance(&obs, &fine, &spectrum).unwrap();
+        let lab = inksim::optics::colour::xyz_to_lab(xyz, obs.white_xyz());
         let got = a.colours.as_ref().unwrap().natural_lab[o];
-        let de = inksim::colour::delta_e2000(lab, got);
+        let de = inksim::optics::colour::delta_e2000(lab, got);
         assert!(de < 1e-3, "view {view}°: ΔE00 {de}");
         // Linear interpolation of the 3 solved samples is far off.
         let coarse: Vec<f64> = (0..3)
             .map(|l| a.natural.as_ref().unwrap()[[l, o]])
             .collect();
         let lin =
-            inksim::colour::xyz_from_reflectance(&obs, &a.spec.wavelengths_nm, &coarse).unwrap();
-        let de_lin =
-            inksim::colour::delta_e2000(lab, inksim::colour::xyz_to_lab(lin, obs.white_xyz()));
+            inksim::optics::colour::xyz_from_reflectance(&obs, &a.spec.wavelengths_nm, &coarse)
+                .unwrap();
+        let de_lin = inksim::optics::colour::delta_e2000(
+            lab,
+            inksim::optics::colour::xyz_to_lab(lin, obs.white_xyz()),
+        );
         assert!(
             de_lin > 10.0 * de.max(1e-4),
             "linear {de_lin} vs proxy {de}"

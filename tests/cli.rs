@@ -143,7 +143,7 @@ fn run_writes_results_identical_for_one_and_two_threads() {
         assert!(ok, "{err}");
         assert!(stdout.contains("tiny.h5"), "{stdout}");
         assert!(out.join("tiny.png").is_file());
-        let s = inksim::io::read_summary(&out.join("tiny.h5")).unwrap();
+        let s = inksim::output::h5::read_summary(&out.join("tiny.h5")).unwrap();
         let scene = inksim::config::load_scene(&cfg).unwrap();
         assert_eq!(s.entries.len(), inksim::pipeline::planned_solves(&scene));
         for e in &s.entries {
@@ -151,7 +151,7 @@ fn run_writes_results_identical_for_one_and_two_threads() {
         }
         summaries.push(s);
     }
-    let key = |s: &inksim::io::ResultSummary| {
+    let key = |s: &inksim::output::h5::ResultSummary| {
         s.entries
             .iter()
             .map(|e| {
@@ -224,7 +224,7 @@ fn dense_rice_layer_uses_dynamics_and_runs() {
         .and_then(|t| t.parse().ok())
         .expect("order parameter logged");
     assert!(s_value < -0.45, "in-plane grains: S = {s_value}");
-    let s = inksim::io::read_summary(&out.join("tiny.h5")).unwrap();
+    let s = inksim::output::h5::read_summary(&out.join("tiny.h5")).unwrap();
     let scene = inksim::config::load_scene(&cfg).unwrap();
     assert_eq!(s.entries.len(), inksim::pipeline::planned_solves(&scene));
     assert!(s.entries.iter().all(|e| e.energy_balance.abs() < 1e-4));
@@ -259,7 +259,7 @@ fn geometry_command_writes_particles_and_picture() {
     let decoder = png::Decoder::new(std::io::Cursor::new(png));
     let reader = decoder.read_info().unwrap();
     assert!(reader.info().width > 100 && reader.info().height > 100);
-    let s = inksim::io::read_summary(&out.join("tiny-geometry.h5")).unwrap();
+    let s = inksim::output::h5::read_summary(&out.join("tiny-geometry.h5")).unwrap();
     assert!(s.entries.is_empty());
     assert!(
         s.plan.contains("solves: none (geometry only)"),

@@ -4,7 +4,7 @@
 //! colour-science (scripts/make_colour_fixture.py), the CIE D65 white point,
 //! and the CIEDE2000 test pairs of Sharma, Wu & Dalal (2005).
 
-use inksim::colour::{
+use inksim::optics::colour::{
     delta_e2000, encode_srgb8, lambertian_reflectance, reflectance_to_srgb8, srgb_decode,
     srgb_encode, to_srgb8, xyz_from_reflectance, xyz_to_lab, xyz_to_linear_srgb, ColourError,
     Observer,

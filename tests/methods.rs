@@ -4,7 +4,7 @@
 //! valid (Born on strong scattering) — fails loudly; it never returns a wrong
 //! answer. Each case runs with f64 and with f32 field storage.
 use inksim::config::{Method, Precision};
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{
     self, born::Born, green, Controls, IterativeMethod, Problem, SolveError, System, Validity,
 };

@@ -17,8 +17,8 @@
 //! weak, not merely sparse.
 
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
 use inksim::geometry::{Geometry, Particle, Sphere};
+use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;

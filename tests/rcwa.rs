@@ -8,7 +8,7 @@
 //! measured over x and z refined together and must fall monotonically; the
 //! finest grid must agree within 1e-3 per order.
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;

@@ -8,7 +8,7 @@
 //! the bound is 1e-4 — a real asymmetry (a wrong sign, a missing term) shows
 //! up at 1e-3 or worse.
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 

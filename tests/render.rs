@@ -2,8 +2,10 @@
 //! the orders where their directions say.
 
 use inksim::config::Incidence;
-use inksim::farfield::{Efficiencies, Order, Side, SolveEntry};
-use inksim::render::{diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX};
+use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
+use inksim::output::render::{
+    diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX,
+};
 use inksim::solver::{MethodUsed, SolveRecord};
 use num_complex::Complex64;
 

@@ -5,8 +5,8 @@
 //! estimate against full solves of a few layers (docs/ACCURACY.md).
 
 use inksim::config::{parse_scene, Material, Method, Precision, Scene};
-use inksim::farfield::efficiencies;
 use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
+use inksim::optics::farfield::efficiencies;
 use inksim::pipeline::{self, RunPlan, RunReport};
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::airy::{self, GrainTerm};
@@ -96,7 +96,7 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
         .entries
         .iter()
         .all(|e| e.record.method == MethodUsed::Airy && e.record.iterations == 0));
-    let stored = inksim::io::read_summary(&dir.path().join("grains.h5"))
+    let stored = inksim::output::h5::read_summary(&dir.path().join("grains.h5"))
         .unwrap()
         .plan;
     assert!(stored.contains("effective-medium shortcut"), "{stored}");
@@ -155,7 +155,7 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
         .natural_lab
         .iter()
         .zip(&fc.natural_lab)
-        .map(|(a, b)| inksim::colour::delta_e2000(*a, *b))
+        .map(|(a, b)| inksim::optics::colour::delta_e2000(*a, *b))
         .fold(0.0, f64::max);
     let dpx = sc
         .tile_srgb8

@@ -1,8 +1,8 @@
 //! Solves of real grain layers: energy balance, Born divergence and the
 //! time-marching rescue, the molecular-mixture limit, thread independence.
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
 use inksim::geometry::{Geometry, GeometryStats, Particle, Sphere};
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, green, Controls, Problem, SolveError};
 use num_complex::Complex64 as C64;
 

@@ -46,7 +46,7 @@ fn slab_solve(
     .expect("solve");
     let kap = lat.q[0].hypot(lat.q[1]);
     let (r, t) = airy(lat.k0, eps, kap, h);
-    let ff = inksim::farfield::efficiencies(&sol);
+    let ff = inksim::optics::farfield::efficiencies(&sol);
     (
         ff.total_reflectance,
         ff.total_transmittance,

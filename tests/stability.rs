@@ -4,11 +4,11 @@
 //! order, the guided resonance and the 3 µm layer live in tests/traps.rs and
 //! tests/solver_layers.rs. f32 field storage runs the hardest case.
 use inksim::config::{Method, Precision};
-use inksim::farfield::efficiencies;
 use inksim::geometry::{
     pack_dynamics, DynParams, DynSpecies, Geometry, GeometryStats, Orientation, Particle, Shape,
     Sphere,
 };
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 

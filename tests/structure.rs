@@ -5,8 +5,8 @@
 
 use inksim::config::{parse_scene, Body, Material, Primitive};
 use inksim::pipeline;
+use inksim::raster::structure::rasterize_primitives;
 use inksim::raster::Grid;
-use inksim::structure::rasterize_primitives;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use std::path::Path;

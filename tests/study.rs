@@ -3,7 +3,7 @@
 //! truncated or mismatched results redone; shards adding up to the
 //! unsharded run bit for bit; bad sweep files rejected before any work;
 //! merge. Scenes are tiny (8 × 8 × 4 grids) except the kill test's.
-use inksim::io::{read_summary, ResultSummary};
+use inksim::output::h5::{read_summary, ResultSummary};
 use inksim::study::sweep::{variant_seed, Study};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -357,7 +357,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         );
     }
     let grid = std::fs::read(sd.join("grids/pigment-by-d.png")).unwrap();
-    let c = inksim::render::canvas::Canvas::decode_png(&grid).unwrap();
+    let c = inksim::output::render::canvas::Canvas::decode_png(&grid).unwrap();
     assert!(c.w > 100 && c.h > 100);
     // The summary file reaches every variant's file through its links.
     let f = hdf5::File::open(sd.join("summary.h5")).unwrap();
@@ -372,7 +372,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         let above: Vec<_> = s
             .entries
             .iter()
-            .filter(|e| e.side == inksim::farfield::Side::Above)
+            .filter(|e| e.side == inksim::optics::farfield::Side::Above)
             .collect();
         let mean = above.iter().map(|e| e.total_reflectance).sum::<f64>() / above.len() as f64;
         assert!((mean - r).abs() < 1e-15);

@@ -2,9 +2,9 @@
 //! for a lossless scattering layer, from independent solves from above and
 //! from below (the layer flipped).
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
+use inksim::optics::substrate::{Hemisphere, Paper};
 use inksim::solver::{self, Controls, Problem};
-use inksim::substrate::{Hemisphere, Paper};
 use ndarray::{s, Array3};
 
 mod common;

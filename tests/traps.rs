@@ -2,7 +2,7 @@
 //! lossless binder slab (1 − ρ²E ≈ 0), and evanescent harmonics with large
 //! Im γ·H. No inf or NaN; the solve converges or fails loudly.
 use inksim::config::Method;
-use inksim::farfield::efficiencies;
+use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;

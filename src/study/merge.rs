@@ -28,8 +28,8 @@
 use super::run::{self, State};
 use super::sweep::{sanitise, Expansion, GridDecl, Study, Variant};
 use super::StudyError;
-use crate::io::{self, ResultSummary};
-use crate::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
+use crate::output::h5::{self, ResultSummary};
+use crate::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
 use hdf5::types::VarLenUnicode;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -87,15 +87,15 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     }
     let mut rows = Vec::with_capacity(exp.variants.len());
     for v in &exp.variants {
-        let s = io::read_summary(&run::paths(v).0)?;
+        let s = h5::read_summary(&run::paths(v).0)?;
         // Light from above only (solves from below feed the paper term).
-        let above: Vec<&io::EntrySummary> = s
+        let above: Vec<&h5::EntrySummary> = s
             .entries
             .iter()
-            .filter(|e| e.side == crate::farfield::Side::Above)
+            .filter(|e| e.side == crate::optics::farfield::Side::Above)
             .collect();
         let n = above.len().max(1) as f64;
-        let mean = |f: fn(&io::EntrySummary) -> f64| above.iter().map(|e| f(e)).sum::<f64>() / n;
+        let mean = |f: fn(&h5::EntrySummary) -> f64| above.iter().map(|e| f(e)).sum::<f64>() / n;
         let (r, t, a) = (
             mean(|e| e.total_reflectance),
             mean(|e| e.total_transmittance),
@@ -109,7 +109,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     for g in &study.grids {
         for (file, title, canvas) in draw_grid(study, exp, g)? {
             let p = grids_dir.join(file);
-            io::write_atomic(&p, &canvas.encode_png(&title)?)?;
+            h5::write_atomic(&p, &canvas.encode_png(&title)?)?;
             grids.push(p);
         }
     }
@@ -118,8 +118,8 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     let (md, html) = pages(study, exp, &rows, &grids);
     let summary_md = dir.join("summary.md");
     let summary_html = dir.join("summary.html");
-    io::write_atomic(&summary_md, md.as_bytes())?;
-    io::write_atomic(&summary_html, html.as_bytes())?;
+    h5::write_atomic(&summary_md, md.as_bytes())?;
+    h5::write_atomic(&summary_html, html.as_bytes())?;
     Ok(MergeReport {
         summary_h5,
         summary_md,
@@ -194,7 +194,7 @@ fn draw_grid(
                 line.push(match cell(r, c) {
                     Some(v) => {
                         let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
-                            StudyError::Io(io::IoError::File {
+                            StudyError::Io(h5::IoError::File {
                                 path: run::paths(v).1,
                                 source,
                             })
@@ -429,7 +429,7 @@ fn write_summary_h5(
     }
     std::fs::rename(&tmp, path).map_err(|source| {
         let _ = std::fs::remove_file(&tmp);
-        StudyError::Io(io::IoError::File {
+        StudyError::Io(h5::IoError::File {
             path: path.to_path_buf(),
             source,
         })

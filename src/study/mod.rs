@@ -37,11 +37,11 @@ pub enum StudyError {
     #[error("{file}: {message}")]
     Sweep { file: PathBuf, message: String },
     #[error(transparent)]
-    Io(#[from] crate::io::IoError),
+    Io(#[from] crate::output::h5::IoError),
     #[error("{path}: HDF5 error: {source}")]
     Hdf5 { path: PathBuf, source: hdf5::Error },
     #[error("render: {0}")]
-    Render(#[from] crate::render::RenderError),
+    Render(#[from] crate::output::render::RenderError),
     /// `merge` before every variant is finished.
     #[error("{0}")]
     Incomplete(String),

@@ -172,7 +172,7 @@ pub fn measured_applications(variants: &[Variant]) -> Option<(f64, usize)> {
         if run::state(v) != State::Done {
             continue;
         }
-        let Ok(s) = crate::io::read_summary(&run::paths(v).0) else {
+        let Ok(s) = crate::output::h5::read_summary(&run::paths(v).0) else {
             continue;
         };
         files += 1;

@@ -8,7 +8,7 @@
 //! that the next run of that variant removes first.
 //!
 //! Before running, each variant's [`State`] is read from its files: it is
-//! skipped only when its result file reads back ([`io::read_summary`]), its
+//! skipped only when its result file reads back ([`h5::read_summary`]), its
 //! stored `input_hash` equals the hash of the variant's exact scene text,
 //! it holds the planned number of solves and its tile exists; otherwise it
 //! is (re)done and the reason is logged.
@@ -20,9 +20,9 @@
 //! a variant's seed is a function of its name.
 
 use super::sweep::Variant;
-use crate::io;
+use crate::output::h5;
+use crate::output::progress::Progress;
 use crate::pipeline;
-use crate::progress::Progress;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -141,7 +141,7 @@ pub fn state(v: &Variant) -> State {
     if !h5.exists() {
         return State::Missing;
     }
-    match io::read_summary(&h5) {
+    match h5::read_summary(&h5) {
         Err(e) => State::Unreadable(e.to_string()),
         Ok(s) if s.input_hash != v.scene.provenance.input_hash => State::Mismatch {
             stored: s.input_hash,

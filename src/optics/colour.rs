@@ -35,9 +35,9 @@
 use std::f64::consts::PI;
 
 /// CIE 1931 2° colour-matching functions, 360–830 nm at 1 nm (source in the file).
-const CMF_CSV: &str = include_str!("../data/cie/cie1931_2deg_xyz_1nm.csv");
+const CMF_CSV: &str = include_str!("../../data/cie/cie1931_2deg_xyz_1nm.csv");
 /// CIE D65 relative spectral power, 300–830 nm at 1 nm (source in the file).
-const D65_CSV: &str = include_str!("../data/cie/cie_d65_1nm.csv");
+const D65_CSV: &str = include_str!("../../data/cie/cie_d65_1nm.csv");
 
 /// Wavelength range (nm) a spectrum's samples must lie in.
 pub const WAVELENGTH_RANGE_NM: (f64, f64) = (360.0, 830.0);

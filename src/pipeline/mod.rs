@@ -7,26 +7,28 @@
 //! results are written atomically (temp file + rename), so an interrupted run
 //! leaves either the previous file or the complete new one.
 
-use crate::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
-use crate::colour::Observer;
+pub mod accuracy;
+
 use crate::config::Material;
 use crate::config::{
     GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Structure, Substrate,
 };
-use crate::farfield::table::TableSpec;
-use crate::farfield::{self, Side, SolveEntry};
 use crate::geometry::{
     self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SizeDistribution,
     SpeciesOptions, SpeciesParams, StatsParams,
 };
-use crate::io::{self, GeometrySummary, ResultSet};
-use crate::merl;
-use crate::progress::Progress;
+use crate::optics::appearance::{self, Appearance, AppearanceSpec, SpectralProxy};
+use crate::optics::colour::Observer;
+use crate::optics::farfield::table::TableSpec;
+use crate::optics::farfield::{self, Side, SolveEntry};
+use crate::optics::substrate::Hemisphere;
+use crate::output::h5::{self, GeometrySummary, ResultSet};
+use crate::output::merl;
+use crate::output::progress::Progress;
+use crate::output::render;
+use crate::raster::structure::{self, EpsGrid};
 use crate::raster::{self, Grid, Raster};
-use crate::render;
 use crate::solver::{self, airy, Controls, MethodUsed, Problem, SolveRecord};
-use crate::structure::{self, EpsGrid};
-use crate::substrate::Hemisphere;
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 use std::path::{Path, PathBuf};
@@ -53,7 +55,7 @@ pub enum PipelineError {
         wavelength_nm: f64,
     },
     #[error(transparent)]
-    Io(#[from] io::IoError),
+    Io(#[from] h5::IoError),
     #[error("render: {0}")]
     Render(#[from] render::RenderError),
     #[error(transparent)]
@@ -968,7 +970,7 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     };
     if let (Some(a), true) = (appearance.as_ref(), products.merl) {
         let merl = merl::encode(a)?;
-        io::write_atomic(
+        h5::write_atomic(
             &scene
                 .output
                 .dir
@@ -976,8 +978,8 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
             &merl,
         )?;
     }
-    io::write_atomic(&orders_path, &orders_png)?;
-    io::write_atomic(&picture_path, tile_png.as_deref().unwrap_or(&orders_png))?;
+    h5::write_atomic(&orders_path, &orders_png)?;
+    h5::write_atomic(&picture_path, tile_png.as_deref().unwrap_or(&orders_png))?;
     let plan_text = plan_text(&plan, &entries);
     write_result(
         scene,
@@ -1097,7 +1099,7 @@ fn write_result(
         appearance,
         tile_png: pictures.tile,
     };
-    io::write_result(path, &set)?;
+    h5::write_result(path, &set)?;
     Ok(())
 }
 
@@ -1208,7 +1210,7 @@ fn write_geometry_only(
     (result_path, picture_path): (&Path, &Path),
 ) -> Result<(), PipelineError> {
     let png = render::geometry_png(raster, &scene.output.name, lines)?;
-    io::write_atomic(picture_path, &png)?;
+    h5::write_atomic(picture_path, &png)?;
     write_result(
         scene,
         geometry,

@@ -22,8 +22,8 @@
 //! Bin centres are used for every (θh, θd, φd); directions below the horizon
 //! are written as 0.
 
-use crate::appearance::Appearance;
-use crate::colour::{self, Observer};
+use crate::optics::appearance::Appearance;
+use crate::optics::colour::{self, Observer};
 use std::f64::consts::PI;
 
 const N_TH: usize = 90;

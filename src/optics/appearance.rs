@@ -7,7 +7,7 @@
 //! - per wavelength and incidence from above: R, T, A and the specular split
 //!   (coherent `|⟨r00⟩|²`, incoherent `⟨|r00|²⟩ − |⟨r00⟩|²`; the same for t00);
 //! - the diffuse BRDF (and on request BTDF) table of every illumination angle
-//!   ([`crate::farfield::table`]: power-preserving, orders (0,0) excluded) and
+//!   ([`crate::optics::farfield::table`]: power-preserving, orders (0,0) excluded) and
 //!   its values in the plane of incidence on the specular side
 //!   (`φ_o = φ_i`: the diagonal θo = θi holds the specular direction);
 //! - with paper: the layer's albedo for diffuse light from below `R_dd↑` and
@@ -23,11 +23,11 @@
 //! Ensemble-mean quantities are combined (products of means), as METHOD §5
 //! describes the layer by its mean scattering functions.
 
-use crate::colour::{self, ColourError, Observer};
-use crate::farfield::table::{self, AngularTable, Part, TableSpec};
-use crate::farfield::{Side, SolveEntry};
+use crate::optics::colour::{self, ColourError, Observer};
+use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
+use crate::optics::farfield::{Side, SolveEntry};
+use crate::optics::substrate::Hemisphere;
 use crate::solver::airy;
-use crate::substrate::Hemisphere;
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;

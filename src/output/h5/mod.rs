@@ -87,9 +87,9 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{H5Type, Location};
 use ndarray::Array2;
 
-use crate::appearance::{Appearance, Estimate};
-use crate::farfield::{Side, SolveEntry};
 use crate::geometry::Statistics;
+use crate::optics::appearance::{Appearance, Estimate};
+use crate::optics::farfield::{Side, SolveEntry};
 use crate::solver::MethodUsed;
 
 /// Version of the layout described in the module docs, stored as `format_version`.
@@ -793,8 +793,9 @@ fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
         }
     });
     g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
-    let column =
-        |f: fn(&crate::farfield::Order) -> f64| eff.orders.iter().map(f).collect::<Vec<_>>();
+    let column = |f: fn(&crate::optics::farfield::Order) -> f64| {
+        eff.orders.iter().map(f).collect::<Vec<_>>()
+    };
     for (name, values) in [
         ("orders_theta_deg", column(|o| o.theta_deg)),
         ("orders_phi_deg", column(|o| o.phi_deg)),

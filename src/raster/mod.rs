@@ -38,6 +38,8 @@
 //! Particles are assumed narrower than the lateral period (the packer ensures
 //! half of it); parts outside the grid (`z₀ ≤ z ≤ H`) are not rasterised.
 
+pub mod structure;
+
 use crate::geometry::{Geometry, Sphere};
 use ndarray::{Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64;

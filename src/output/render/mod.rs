@@ -39,7 +39,7 @@
 use std::cmp::Ordering;
 
 use crate::config::Incidence;
-use crate::farfield::{Order, SolveEntry};
+use crate::optics::farfield::{Order, SolveEntry};
 
 pub mod canvas;
 pub mod tile;

@@ -1,0 +1,16 @@
+//! Optics — from the solved field to what a person sees.
+//!
+//! Takes the solver's field (order amplitudes per solve) and gives:
+//! - [`farfield`]: the Kirchhoff far field, order efficiencies, absorption,
+//!   the energy balance, and the angular BRDF/BTDF tables;
+//! - [`substrate`]: the Lambertian paper and the layer–paper inter-reflections;
+//! - [`colour`]: CIE colorimetry (XYZ, CIELAB, CIEDE2000, sRGB);
+//! - [`appearance`]: ensemble means with standard errors, natural light and
+//!   the colours of a result.
+//!
+//! Imports only from `config`, `geometry`, `raster` and `solver`.
+
+pub mod appearance;
+pub mod colour;
+pub mod farfield;
+pub mod substrate;

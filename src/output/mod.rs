@@ -1,0 +1,14 @@
+//! Output — what a run leaves behind and what it tells the user.
+//!
+//! - [`h5`]: result and summary files, written atomically;
+//! - [`render`]: PNG pictures (tile, orders, geometry);
+//! - [`merl`]: the BRDF in MERL's binary format for renderers;
+//! - [`progress`]: timestamped progress lines on long work.
+//!
+//! Imports from every earlier stage (`config` … `optics`), never from
+//! `pipeline` or `study`.
+
+pub mod h5;
+pub mod merl;
+pub mod progress;
+pub mod render;

@@ -658,7 +658,7 @@ fn slurm_study(
                 .unwrap_or_default()
         ))
     });
-    inksim::output::h5::write_atomic(&path, slurm::script(&o).as_bytes())?;
+    inksim::output::atomic::write_atomic(&path, slurm::script(&o).as_bytes())?;
     println!("wrote {}", path.display());
     println!(
         "{n} variants in {shards} array tasks of {cpus} CPU(s), --mem {mem_mb}M (1.5 × the \

@@ -7,9 +7,8 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 use inksim::config::Incidence;
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
-use inksim::output::h5::{
-    read_summary, write_atomic, write_result, GeometrySummary, IoError, ResultSet,
-};
+use inksim::output::atomic::write_atomic;
+use inksim::output::h5::{read_summary, write_result, GeometrySummary, IoError, ResultSet};
 use inksim::solver::{MethodUsed, SolveRecord};
 use num_complex::Complex64;
 

@@ -8,6 +8,8 @@
 //! Imports from every earlier stage (`config` … `optics`), never from
 //! `pipeline` or `study`.
 
+pub mod atomic;
+pub mod error;
 pub mod h5;
 pub mod merl;
 pub mod progress;

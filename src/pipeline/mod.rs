@@ -22,6 +22,7 @@ use crate::optics::colour::Observer;
 use crate::optics::farfield::table::TableSpec;
 use crate::optics::farfield::{self, Side, SolveEntry};
 use crate::optics::substrate::Hemisphere;
+use crate::output::atomic;
 use crate::output::h5::{self, GeometrySummary, ResultSet};
 use crate::output::merl;
 use crate::output::progress::Progress;
@@ -970,7 +971,7 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
     };
     if let (Some(a), true) = (appearance.as_ref(), products.merl) {
         let merl = merl::encode(a)?;
-        h5::write_atomic(
+        atomic::write_atomic(
             &scene
                 .output
                 .dir
@@ -978,8 +979,8 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
             &merl,
         )?;
     }
-    h5::write_atomic(&orders_path, &orders_png)?;
-    h5::write_atomic(&picture_path, tile_png.as_deref().unwrap_or(&orders_png))?;
+    atomic::write_atomic(&orders_path, &orders_png)?;
+    atomic::write_atomic(&picture_path, tile_png.as_deref().unwrap_or(&orders_png))?;
     let plan_text = plan_text(&plan, &entries);
     write_result(
         scene,
@@ -1210,7 +1211,7 @@ fn write_geometry_only(
     (result_path, picture_path): (&Path, &Path),
 ) -> Result<(), PipelineError> {
     let png = render::geometry_png(raster, &scene.output.name, lines)?;
-    h5::write_atomic(picture_path, &png)?;
+    atomic::write_atomic(picture_path, &png)?;
     write_result(
         scene,
         geometry,

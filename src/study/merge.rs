@@ -28,6 +28,7 @@
 use super::run::{self, State};
 use super::sweep::{sanitise, Expansion, GridDecl, Study, Variant};
 use super::StudyError;
+use crate::output::atomic;
 use crate::output::h5::{self, ResultSummary};
 use crate::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
 use hdf5::types::VarLenUnicode;
@@ -109,7 +110,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     for g in &study.grids {
         for (file, title, canvas) in draw_grid(study, exp, g)? {
             let p = grids_dir.join(file);
-            h5::write_atomic(&p, &canvas.encode_png(&title)?)?;
+            atomic::write_atomic(&p, &canvas.encode_png(&title)?)?;
             grids.push(p);
         }
     }
@@ -118,8 +119,8 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     let (md, html) = pages(study, exp, &rows, &grids);
     let summary_md = dir.join("summary.md");
     let summary_html = dir.join("summary.html");
-    h5::write_atomic(&summary_md, md.as_bytes())?;
-    h5::write_atomic(&summary_html, html.as_bytes())?;
+    atomic::write_atomic(&summary_md, md.as_bytes())?;
+    atomic::write_atomic(&summary_html, html.as_bytes())?;
     Ok(MergeReport {
         summary_h5,
         summary_md,
@@ -331,15 +332,12 @@ fn write_summary_h5(
     rows: &[Row],
     path: &Path,
 ) -> Result<(), StudyError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    let h = |source| StudyError::Hdf5 {
-        path: tmp.clone(),
-        source,
-    };
-    let result = (|| -> Result<(), StudyError> {
-        let f = hdf5::File::create(&tmp).map_err(h)?;
+    atomic::write_atomic_with(path, |tmp| -> Result<(), StudyError> {
+        let h = |source| StudyError::Hdf5 {
+            path: tmp.to_path_buf(),
+            source,
+        };
+        let f = hdf5::File::create(tmp).map_err(h)?;
         for (name, v) in [
             ("study", study.name.as_str()),
             ("profile", exp.profile.as_deref().unwrap_or("")),
@@ -422,17 +420,6 @@ fn write_summary_h5(
         }
         f.close().map_err(h)?;
         Ok(())
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    std::fs::rename(&tmp, path).map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        StudyError::Io(h5::IoError::File {
-            path: path.to_path_buf(),
-            source,
-        })
     })
 }
 

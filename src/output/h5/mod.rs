@@ -78,9 +78,7 @@
 //!   `tile_srgb8` (V × (1 + I) × 3 u8), `tile_lab` (V × (1 + I) × 3 f64), `natural_srgb8` (V × 3 u8),
 //!   `natural_lab` (V × 3 f64), `tile_png` (u8).
 
-use std::fs;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 
 use hdf5::types::VarLenUnicode;
@@ -254,30 +252,8 @@ pub struct EntrySummary {
     pub residual: f64,
 }
 
-/// Everything that can go wrong while writing or reading output files.
-#[derive(Debug, thiserror::Error)]
-pub enum IoError {
-    #[error("{path}: output folder cannot be created or used: {source}")]
-    Folder {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{path}: {source}")]
-    File {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{path}: HDF5 error: {source}")]
-    Hdf5 { path: PathBuf, source: hdf5::Error },
-    #[error("{path}: cannot write {what}: {message}")]
-    Invalid {
-        path: PathBuf,
-        what: String,
-        message: String,
-    },
-    #[error("{path}: not a valid inksim result file: {message}")]
-    Format { path: PathBuf, message: String },
-}
+use crate::output::atomic::write_atomic_with;
+pub use crate::output::error::IoError;
 
 /// Write a result file atomically (see the module docs for the layout).
 ///
@@ -286,30 +262,15 @@ pub enum IoError {
 /// removed and an existing `path` is left untouched.
 pub fn write_result(path: &Path, set: &ResultSet) -> Result<(), IoError> {
     check_result_set(path, set)?;
-    let tmp = TempFile::prepare(path)?;
-    let hdf = |source| IoError::Hdf5 {
-        path: tmp.path.clone(),
-        source,
-    };
-    {
-        let file = hdf5::File::create(&tmp.path).map_err(hdf)?;
+    write_atomic_with(path, |tmp| {
+        let hdf = |source| IoError::Hdf5 {
+            path: tmp.to_path_buf(),
+            source,
+        };
+        let file = hdf5::File::create(tmp).map_err(hdf)?;
         write_contents(&file, set).map_err(hdf)?;
-        file.close().map_err(hdf)?;
-    }
-    tmp.commit()
-}
-
-/// Write arbitrary bytes atomically (temporary file, sync, rename).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), IoError> {
-    let tmp = TempFile::prepare(path)?;
-    let mut f = fs::OpenOptions::new()
-        .write(true)
-        .truncate(true)
-        .open(&tmp.path)
-        .map_err(|source| tmp.io_err(source))?;
-    f.write_all(bytes).map_err(|source| tmp.io_err(source))?;
-    drop(f);
-    tmp.commit()
+        file.close().map_err(hdf)
+    })
 }
 
 /// Read back the identity of a result file and the per-solve numbers.
@@ -830,88 +791,4 @@ fn write_scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::R
 fn read_str_attr(loc: &Location, name: &str) -> hdf5::Result<String> {
     let v: VarLenUnicode = loc.attr(name)?.read_scalar()?;
     Ok(v.as_str().to_owned())
-}
-
-/// `<path>.tmp`, removed on drop unless renamed onto `<path>` by [`TempFile::commit`].
-struct TempFile {
-    path: PathBuf,
-    target: PathBuf,
-    committed: bool,
-}
-
-impl TempFile {
-    /// Check the destination: folder exists or can be created, and a file can
-    /// be created in it (the temporary file itself, left empty).
-    fn prepare(target: &Path) -> Result<Self, IoError> {
-        let folder_err = |source| IoError::Folder {
-            path: target.to_path_buf(),
-            source,
-        };
-        let Some(name) = target.file_name() else {
-            return Err(folder_err(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "path does not name a file",
-            )));
-        };
-        let folder = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        fs::create_dir_all(&folder).map_err(folder_err)?;
-        if target.is_dir() {
-            return Err(IoError::File {
-                path: target.to_path_buf(),
-                source: std::io::Error::new(
-                    std::io::ErrorKind::AlreadyExists,
-                    "is a directory, expected a file path",
-                ),
-            });
-        }
-        let mut tmp_name = name.to_os_string();
-        tmp_name.push(".tmp");
-        let path = folder.join(tmp_name);
-        fs::File::create(&path).map_err(|source| IoError::Folder {
-            path: path.clone(),
-            source,
-        })?;
-        Ok(TempFile {
-            path,
-            target: target.to_path_buf(),
-            committed: false,
-        })
-    }
-
-    fn io_err(&self, source: std::io::Error) -> IoError {
-        IoError::File {
-            path: self.path.clone(),
-            source,
-        }
-    }
-
-    /// Sync the finished temporary file to disk and rename it onto the target.
-    fn commit(mut self) -> Result<(), IoError> {
-        fs::File::open(&self.path)
-            .and_then(|f| f.sync_all())
-            .map_err(|source| self.io_err(source))?;
-        fs::rename(&self.path, &self.target).map_err(|source| IoError::File {
-            path: self.target.clone(),
-            source,
-        })?;
-        self.committed = true;
-        // Best effort: make the rename itself durable.
-        if let Some(dir) = self.target.parent().filter(|p| !p.as_os_str().is_empty()) {
-            if let Ok(d) = fs::File::open(dir) {
-                let _ = d.sync_all();
-            }
-        }
-        Ok(())
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = fs::remove_file(&self.path);
-        }
-    }
 }

@@ -1,13 +1,14 @@
 //! Tests of the colour stage: tables, integration, sRGB, CIELAB, CIEDE2000.
 //!
-//! References: the fixture tests/fixtures/colour_spectra.json made once with
-//! colour-science (scripts/make_colour_fixture.py), the CIE D65 white point,
-//! and the CIEDE2000 test pairs of Sharma, Wu & Dalal (2005).
+//! References: the fixtures tests/fixtures/colour_*.csv made once with
+//! colour-science (scripts/make_colour_fixture.py), the CIE white points,
+//! Lindbloom's Bradford D50→D65 matrix, and the CIEDE2000 test pairs of
+//! Sharma, Wu & Dalal (2005).
 
 use inksim::optics::colour::{
     delta_e2000, encode_srgb8, lambertian_reflectance, reflectance_to_srgb8, srgb_decode,
     srgb_encode, to_srgb8, xyz_from_reflectance, xyz_to_lab, xyz_to_linear_srgb, ColourError,
-    Observer,
+    Illuminant, Observer, StandardObserver,
 };
 
 fn grid(start: f64, stop: f64, step: f64) -> Vec<f64> {
@@ -386,5 +387,133 @@ fn ciede2000_sharma_pairs() {
         let d21 = delta_e2000(l2, l1);
         assert!((d - d21).abs() < 1e-4, "pair {}: not symmetric", i + 1);
         assert_eq!(delta_e2000(l1, l1), 0.0);
+    }
+}
+
+/// Every illuminant × observer inksim offers against colour-science's
+/// `sd_to_XYZ(method="Integration")` on the same 1 nm grid (D65 from our
+/// table, D50 linearly interpolated from the CIE 5 nm table, A from
+/// colour-science's own evaluation of the CIE formula): XYZ to 1e-8 and
+/// CIELAB (relative to the perfect white under the same conditions) to 1e-8.
+#[test]
+fn every_illuminant_and_observer_matches_colour_science() {
+    let (wl, cases) = fixture();
+    let rows = csv_rows(include_str!("fixtures/colour_conditions.csv"));
+    assert_eq!(rows[0][0], "illuminant");
+    assert_eq!(rows.len() - 1, 3 * 2 * cases.len());
+    let num = |s: &str| s.parse::<f64>().unwrap();
+    for r in &rows[1..] {
+        let ill = Illuminant::from_name(r[0]).unwrap();
+        let obs = StandardObserver::from_degrees(r[1].parse().unwrap()).unwrap();
+        let o = Observer::standard(ill, obs);
+        assert_eq!(o.conditions(), Some((ill, obs)));
+        let case = cases.iter().find(|c| c.name == r[2]).unwrap();
+        let xyz = xyz_from_reflectance(&o, &wl, &case.reflectance).unwrap();
+        let lab = xyz_to_lab(xyz, o.white_xyz());
+        for k in 0..3 {
+            assert!(
+                (xyz[k] - num(r[3 + k])).abs() < 1e-8,
+                "{} {}° {}: XYZ {xyz:?} vs {:?}",
+                r[0],
+                r[1],
+                r[2],
+                &r[3..6]
+            );
+            assert!(
+                (lab[k] - num(r[6 + k])).abs() < 1e-8,
+                "{} {}° {}: Lab {lab:?} vs {:?}",
+                r[0],
+                r[1],
+                r[2],
+                &r[6..9]
+            );
+        }
+    }
+}
+
+/// CIE 015 white points of the perfect diffuser (2°: D50 x = 0.34567,
+/// y = 0.35851; A x = 0.44757, y = 0.40745; 10°: D65 x = 0.31382, y = 0.33100,
+/// D50 x = 0.34773, y = 0.35952; A x = 0.45117, y = 0.40594), to the 1e-4 that
+/// separates the 1 nm integration from the 5 nm tabulation.
+#[test]
+fn white_points_are_the_cie_ones() {
+    use Illuminant::*;
+    use StandardObserver::*;
+    for (ill, obs, x, y) in [
+        (D50, TwoDegree, 0.34567, 0.35851),
+        (A, TwoDegree, 0.44757, 0.40745),
+        (D65, TenDegree, 0.31382, 0.33100),
+        (D50, TenDegree, 0.34773, 0.35952),
+        (A, TenDegree, 0.45117, 0.40594),
+    ] {
+        let w = Observer::standard(ill, obs).white_xyz();
+        let s = w[0] + w[1] + w[2];
+        assert!((w[1] - 100.0).abs() < 1e-10);
+        assert!(
+            (w[0] / s - x).abs() < 1e-4 && (w[1] / s - y).abs() < 1e-4,
+            "{ill} {obs}: x, y = {}, {}",
+            w[0] / s,
+            w[1] / s
+        );
+    }
+}
+
+/// Bradford D50 → D65 against the matrix Lindbloom tabulates (whites
+/// 0.96422, 1, 0.82521 → 0.95047, 1, 1.08883), to its 7 decimals; the same
+/// white maps to itself.
+#[test]
+fn bradford_matches_the_published_matrix() {
+    let m = inksim::optics::colour::bradford([0.96422, 1.0, 0.82521], [0.95047, 1.0, 1.08883]);
+    let lindbloom = [
+        [0.9555766, -0.0230393, 0.0631636],
+        [-0.0282895, 1.0099416, 0.0210077],
+        [0.0122982, -0.0204830, 1.3299098],
+    ];
+    for (row, want) in m.iter().zip(&lindbloom) {
+        for (v, w) in row.iter().zip(want) {
+            assert!((v - w).abs() < 2e-7, "{m:?}");
+        }
+    }
+    let w = [0.9, 1.0, 1.1];
+    let id = inksim::optics::colour::bradford(w, w);
+    for (r, row) in id.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            let e = if r == c { 1.0 } else { 0.0 };
+            assert!((v - e).abs() < 1e-12, "{id:?}");
+        }
+    }
+}
+
+/// Under every illuminant a perfect white displays as exactly (255, 255, 255)
+/// and a neutral grey as a neutral grey (the adaptation carries the
+/// illuminant's white to sRGB's); a coloured patch under A shows warmer (more
+/// red than blue) than under D65 only before adaptation, not after it.
+#[test]
+fn whites_and_greys_display_neutral_under_every_illuminant() {
+    for ill in Illuminant::ALL {
+        for obs in StandardObserver::ALL {
+            let o = Observer::standard(ill, obs);
+            assert_eq!(to_srgb8(&o, o.white_xyz()), [255, 255, 255], "{ill} {obs}");
+            let grey = o.white_xyz().map(|v| v * 0.2);
+            let rgb = o.linear_srgb(grey);
+            for c in rgb {
+                assert!((c - 0.2).abs() < 1e-12, "{ill} {obs}: {rgb:?}");
+            }
+        }
+    }
+}
+
+/// The CIE formula for illuminant A at its anchor and against tabulated
+/// values (CIE 015 Table T.1: 300 nm 0.930483, 500 nm 59.8611, 780 nm 241.675).
+#[test]
+fn illuminant_a_formula() {
+    use inksim::optics::colour::illuminant_a;
+    assert!((illuminant_a(560.0) - 100.0).abs() < 1e-12);
+    for (wl, s) in [(300.0, 0.930483), (500.0, 59.8611), (780.0, 241.675)] {
+        assert!(
+            (illuminant_a(wl) - s).abs() < 1e-4 * s,
+            "{wl}: {}",
+            illuminant_a(wl)
+        );
     }
 }

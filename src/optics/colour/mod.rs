@@ -1,15 +1,18 @@
 //! Colour science — from reflectance spectra to what a display shows.
 //!
 //! This module owns the colorimetric chain of METHOD §6:
-//! spectrum → CIE 1931 2° XYZ under D65 → linear sRGB → sRGB transfer → 8 bit,
-//! plus CIELAB and CIEDE2000 for comparing variants. It is a leaf: it imports
+//! spectrum → CIE XYZ (observer and illuminant of [`conditions`]: CIE 1931 2°
+//! or 1964 10°; D65, D50 or A) → linear sRGB (Bradford-adapted to D65 where
+//! the illuminant is another) → sRGB transfer → 8 bit, plus CIELAB and
+//! CIEDE2000 for comparing variants. It is a leaf: it imports
 //! no other stage, and `render` (and anything after it) uses it.
 //!
 //! **Tables.** The official CIE tables are shipped as data and embedded with
 //! `include_str!`, each file naming its source in a header comment:
-//! `data/cie/cie1931_2deg_xyz_1nm.csv` (x̄ȳz̄, 360–830 nm, 1 nm) and
-//! `data/cie/cie_d65_1nm.csv` (D65, 300–830 nm, 1 nm). The [`Observer`] keeps
-//! them on the CMF grid, 360–830 nm at 1 nm.
+//! `data/cie/cie1931_2deg_xyz_1nm.csv` and `cie1964_10deg_xyz_1nm.csv` (x̄ȳz̄,
+//! 360–830 nm, 1 nm), `data/cie/cie_d65_1nm.csv` (D65, 300–830 nm, 1 nm) and
+//! `cie_d50_5nm.csv` (D50, 300–780 nm, 5 nm); illuminant A is the CIE formula.
+//! The [`Observer`] keeps them on the CMF grid, 360–830 nm at 1 nm.
 //!
 //! **Integration.** Tristimulus values are the sums of CIE 015
 //! `X = k Σ R(λ) S(λ) x̄(λ) Δλ` over the 1 nm table grid (Δλ = 1 nm), with
@@ -34,10 +37,10 @@
 
 use std::f64::consts::PI;
 
-/// CIE 1931 2° colour-matching functions, 360–830 nm at 1 nm (source in the file).
-const CMF_CSV: &str = include_str!("../../data/cie/cie1931_2deg_xyz_1nm.csv");
-/// CIE D65 relative spectral power, 300–830 nm at 1 nm (source in the file).
-const D65_CSV: &str = include_str!("../../data/cie/cie_d65_1nm.csv");
+pub mod conditions;
+
+pub use conditions::{bradford, illuminant_a, Illuminant, StandardObserver, SRGB_WHITE};
+use conditions::{interpolate, mat_vec, D50_CSV, D65_CSV};
 
 /// Wavelength range (nm) a spectrum's samples must lie in.
 pub const WAVELENGTH_RANGE_NM: (f64, f64) = (360.0, 830.0);
@@ -83,9 +86,9 @@ pub enum ColourError {
     },
 }
 
-/// Observer and illuminant on a common wavelength grid: the CIE 1931 2°
-/// colour-matching functions weighted by D65 and normalised so that a perfect
-/// white has `Y = 100`.
+/// Observer and illuminant on a common wavelength grid: colour-matching
+/// functions weighted by the illuminant and normalised so that a perfect white
+/// has `Y = 100`, plus the adaptation that shows its colours on an sRGB display.
 #[derive(Debug, Clone)]
 pub struct Observer {
     /// Grid wavelengths (nm), increasing, uniform spacing `step_nm`.
@@ -94,8 +97,13 @@ pub struct Observer {
     weights: Vec<[f64; 3]>,
     /// XYZ of reflectance 1 everywhere (`Y` = 100 up to rounding).
     white_xyz: [f64; 3],
-    /// Linear sRGB (IEC matrix, before balancing) of `white_xyz / 100`.
+    /// Linear sRGB (IEC matrix, before balancing) of the adapted `white_xyz / 100`.
     white_rgb: [f64; 3],
+    /// Bradford transform to the sRGB (D65) white; `None` for D65 itself,
+    /// whose small difference from sRGB's white the balance absorbs.
+    adapt: Option<[[f64; 3]; 3]>,
+    /// The CIE conditions, when built from the shipped tables.
+    conditions: Option<(Illuminant, StandardObserver)>,
 }
 
 /// Parse `wavelength,v1,v2,…` rows (lines starting with `#` or a letter are
@@ -143,8 +151,47 @@ impl Observer {
     /// CIE 1931 2° standard observer under CIE D65, from the embedded official
     /// tables (360–830 nm, 1 nm).
     pub fn cie1931_d65() -> Observer {
+        Observer::standard(Illuminant::D65, StandardObserver::TwoDegree)
+    }
+
+    /// A CIE standard observer under a CIE illuminant, from the embedded
+    /// official tables on the observer's 1 nm grid, 360–830 nm (see
+    /// [`Illuminant`] for how each illuminant reaches that grid).
+    pub fn standard(illuminant: Illuminant, observer: StandardObserver) -> Observer {
         // The embedded tables are fixed data checked by tests/colour.rs.
-        Observer::from_tables(CMF_CSV, D65_CSV).expect("embedded CIE tables are valid")
+        let cmf = parse_table(observer.cmf_csv(), "colour-matching functions", 3)
+            .expect("embedded CIE tables are valid");
+        let mut obs = match illuminant {
+            Illuminant::D65 => {
+                let ill = parse_table(D65_CSV, "illuminant", 1).expect("embedded table");
+                Observer::from_rows(&cmf, &ill)
+            }
+            Illuminant::D50 => {
+                let tab: Vec<(f64, f64)> = parse_table(D50_CSV, "illuminant", 1)
+                    .expect("embedded table")
+                    .into_iter()
+                    .map(|(w, v)| (w, v[0]))
+                    .collect();
+                let ill: Vec<(f64, Vec<f64>)> = cmf
+                    .iter()
+                    .map(|(w, _)| (*w, vec![interpolate(&tab, *w)]))
+                    .collect();
+                Observer::from_rows(&cmf, &ill)
+            }
+            Illuminant::A => {
+                let ill: Vec<(f64, Vec<f64>)> = cmf
+                    .iter()
+                    .map(|(w, _)| (*w, vec![illuminant_a(*w)]))
+                    .collect();
+                Observer::from_rows(&cmf, &ill)
+            }
+        }
+        .expect("embedded CIE tables are valid");
+        if illuminant != Illuminant::D65 {
+            obs.set_adaptation(bradford(scale(obs.white_xyz, 0.01), SRGB_WHITE));
+        }
+        obs.conditions = Some((illuminant, observer));
+        obs
     }
 
     /// Build an observer from CSV text: `cmf_csv` rows `λ,x̄,ȳ,z̄` on a uniform
@@ -153,6 +200,13 @@ impl Observer {
     pub fn from_tables(cmf_csv: &str, illuminant_csv: &str) -> Result<Observer, ColourError> {
         let cmf = parse_table(cmf_csv, "colour-matching functions", 3)?;
         let ill = parse_table(illuminant_csv, "illuminant", 1)?;
+        Observer::from_rows(&cmf, &ill)
+    }
+
+    fn from_rows(
+        cmf: &[(f64, Vec<f64>)],
+        ill: &[(f64, Vec<f64>)],
+    ) -> Result<Observer, ColourError> {
         if cmf.len() < 2 {
             return Err(ColourError::Table {
                 table: "colour-matching functions",
@@ -212,7 +266,21 @@ impl Observer {
             weights,
             white_xyz,
             white_rgb,
+            adapt: None,
+            conditions: None,
         })
+    }
+
+    /// Show colours through the chromatic adaptation `m` (XYZ → XYZ under the
+    /// sRGB white) and balance the adapted white to (1, 1, 1).
+    fn set_adaptation(&mut self, m: [[f64; 3]; 3]) {
+        self.white_rgb = xyz_to_linear_srgb(scale(mat_vec(&m, self.white_xyz), 0.01));
+        self.adapt = Some(m);
+    }
+
+    /// The CIE illuminant and observer, for an observer built by [`Observer::standard`].
+    pub fn conditions(&self) -> Option<(Illuminant, StandardObserver)> {
+        self.conditions
     }
 
     /// Grid wavelengths (nm).
@@ -227,7 +295,13 @@ impl Observer {
 
     /// Linear sRGB of XYZ (white `Y` = 100), each channel divided by the
     /// white's so that the perfect white is exactly (1, 1, 1).
+    /// Under an illuminant other than D65 the colour is first carried to the
+    /// sRGB white by the Bradford transform.
     pub fn linear_srgb(&self, xyz: [f64; 3]) -> [f64; 3] {
+        let xyz = match &self.adapt {
+            Some(m) => mat_vec(m, xyz),
+            None => xyz,
+        };
         let rgb = xyz_to_linear_srgb(scale(xyz, 0.01));
         [
             rgb[0] / self.white_rgb[0],

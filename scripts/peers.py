@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""inksim side by side with two public peers on one problem (issue 7, docs/PEERS.md).
+"""inksim side by side with two public peers on one problem (docs/PEERS.md).
 
 Problem: a y-invariant lamellar grating at normal incidence. lambda = 550 nm,
 period 4 um, a 1 um binder slab (n = 1.558) with one 0.4 um wide stripe of

@@ -19,7 +19,7 @@ What it does:
    reference's own uncertainty the largest per-order change between the two
    finest truncations and under doubling the cell sampling.
 
-Conventions (METHOD.md §4): incidence from above in the x-z plane at polar
+Conventions (docs/METHOD.md §4): incidence from above in the x-z plane at polar
 angle theta; order m has kappa_m = k0 sin(theta) + 2 pi m / period;
 R_m, T_m are power efficiencies normalised by the incident flux.
 Efficiencies do not depend on where the stripe sits in the cell, so the

@@ -1,14 +1,17 @@
 //! inksim — wave-optics simulator for printed ink layers.
 //!
-//! Data flows one way through the stages, and each module imports only from
-//! the stages before it:
+//! Data flows one way through the stages, one folder each, and a module
+//! imports only from its own stage and the stages before it:
 //!
-//! `config` → `geometry` → `raster` → `solver` → `farfield` → `substrate` → `colour`
-//! → `appearance` → `render` → `io`,
-//! wired together by [`pipeline`]. [`progress`] is a leaf utility.
+//! [`config`] → [`geometry`] → [`raster`] → [`solver`] → [`optics`] (far
+//! field, substrate, colour, appearance) → [`output`] (atomic writes, HDF5,
+//! pictures, MERL, progress) → [`pipeline`] (one scene) → [`study`] (a sweep
+//! of scenes). `tests/layering.rs` checks the rule on the source: no import
+//! from a later stage and no import cycle anywhere.
 //!
-//! The physics and numerics follow `METHOD.md` (shipped beside the project);
-//! each stage's module docs state what it owns and which choices it made.
+//! The physics and numerics are explained in `docs/METHOD.md` (the module
+//! docs cite its sections as "METHOD §N"); each stage's module docs state what
+//! it owns, what it takes and what it gives.
 
 pub mod config;
 pub mod geometry;

@@ -1,4 +1,4 @@
-//! Stage 5c — appearance: from the solves of every realisation to what a
+//! Optics — appearance: from the solves of every realisation to what a
 //! person sees (METHOD §5–§6).
 //!
 //! Inputs are plain solve entries (orders, r00/t00, R, T, A) of `R`

@@ -1,4 +1,4 @@
-//! Stage 5a — the paper substrate (METHOD §5): a flat Lambertian reflector
+//! Optics — the paper substrate (METHOD §5): a flat Lambertian reflector
 //! of albedo ρp under the layer, combined with the layer's scattering by the
 //! geometric series of inter-reflections, which are incoherent.
 //!

@@ -1,4 +1,4 @@
-//! Stage 2 — the fragment on a uniform grid (METHOD §3).
+//! Raster — the fragment on a uniform grid (METHOD §3).
 //!
 //! Owns the volume fraction of every species in every voxel; the permittivity
 //! for a wavelength is then a per-voxel linear mix ([`Raster::epsilon_into`]),

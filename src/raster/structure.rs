@@ -1,4 +1,4 @@
-//! Stage 2b — an explicit layer (issue #7): the permittivity grid from
+//! Raster — an explicit layer: the permittivity grid from
 //! simple bodies or from an HDF5 file, instead of generated grains.
 //!
 //! **Primitives** are rasterised into the same [`Raster`] the grains give

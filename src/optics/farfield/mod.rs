@@ -1,4 +1,4 @@
-//! Stage 4 — far field: order efficiencies, absorption, energy balance.
+//! Optics — far field: order efficiencies, absorption, energy balance.
 //!
 //! The Kirchhoff far field of a periodic layer is a finite set of plane waves,
 //! one per propagating Bloch order, so no numerical far-field integral is

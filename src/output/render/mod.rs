@@ -1,4 +1,4 @@
-//! Stage 5 — pictures of a result (foundation level; CIE colour comes later).
+//! Output — pictures of a result: the orders picture, the tile and the geometry.
 //!
 //! [`diffuse_brdf_png`] draws the diffuse reflection of every solve as an
 //! 8-bit RGB PNG: a grid of panels, one row per distinct direction of

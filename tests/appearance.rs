@@ -515,3 +515,80 @@ fn colour_between_solved_wavelengths_follows_the_proxy() {
         );
     }
 }
+
+/// The standard error of each tile colour against a batch-means estimate:
+/// 32 realisations in 8 batches of 4, each batch's colour assembled from its
+/// own mean spectra; the batch colours scatter around the full colour by
+/// √8 × the standard error. Over every cell and component of L*a*b*, and for
+/// ΔE00, the root of the summed batch variance over the summed squared
+/// standard error lies in [0.6, 1.5] (each estimate has 7 degrees of freedom;
+/// summed over cells the band is wide enough for their correlation).
+#[test]
+fn colour_standard_errors_agree_with_batch_means() {
+    use inksim::optics::appearance::assemble;
+    use inksim::optics::colour::{delta_e2000, Observer};
+    let dir = tempfile::tempdir().unwrap();
+    let rep = run_text(
+        dir.path(),
+        &grains_scene(dir.path(), 32, "[appearance]\nquadrature_points = 4\n"),
+    );
+    let a = rep.appearance.as_ref().unwrap();
+    let c = a.colours.as_ref().unwrap();
+    let spread = c.spread.as_ref().expect("32 realisations have a spread");
+    let (nv, nc, _) = c.tile_lab.dim();
+    assert_eq!(spread.realisation_lab.dim(), (32, nv, nc, 3));
+    assert!(spread.lab_se.iter().all(|v| v.is_finite() && *v > 0.0));
+    let obs = Observer::cie1931_d65();
+    let mut batch_spec = a.spec.clone();
+    batch_spec.realisations = 4;
+    let batches: Vec<_> = (0..8)
+        .map(|b| {
+            let entries: Vec<_> = rep
+                .entries
+                .iter()
+                .filter(|e| e.realisation / 4 == b)
+                .map(|e| {
+                    let mut e = e.clone();
+                    e.realisation %= 4;
+                    e
+                })
+                .collect();
+            assemble(&batch_spec, &entries, &obs)
+                .unwrap()
+                .colours
+                .unwrap()
+                .tile_lab
+        })
+        .collect();
+    let (mut lab_batch, mut lab_se, mut de_batch, mut de_se) = (0.0, 0.0, 0.0, 0.0);
+    for o in 0..nv {
+        for k in 0..nc {
+            let at = |l: &ndarray::Array3<f64>| [l[[o, k, 0]], l[[o, k, 1]], l[[o, k, 2]]];
+            let full = at(&c.tile_lab);
+            for ch in 0..3 {
+                let mean = batches.iter().map(|b| at(b)[ch]).sum::<f64>() / 8.0;
+                lab_batch += batches
+                    .iter()
+                    .map(|b| (at(b)[ch] - mean).powi(2))
+                    .sum::<f64>()
+                    / 7.0
+                    / 8.0;
+                lab_se += spread.lab_se[[o, k, ch]].powi(2);
+            }
+            de_batch += batches
+                .iter()
+                .map(|b| delta_e2000(at(b), full).powi(2))
+                .sum::<f64>()
+                / 8.0
+                / 8.0;
+            de_se += spread.de00_se[[o, k]].powi(2);
+        }
+    }
+    let (r_lab, r_de) = ((lab_batch / lab_se).sqrt(), (de_batch / de_se).sqrt());
+    eprintln!("batch / standard error: L*a*b* {r_lab:.3}, ΔE00 {r_de:.3}");
+    assert!((0.6..1.5).contains(&r_lab), "L*a*b* ratio {r_lab}");
+    assert!((0.6..1.5).contains(&r_de), "ΔE00 ratio {r_de}");
+    // One realisation has no spread.
+    let one = run_text(dir.path(), &grains_scene(dir.path(), 1, ""));
+    assert!(one.appearance.unwrap().colours.unwrap().spread.is_none());
+}

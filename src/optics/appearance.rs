@@ -199,6 +199,62 @@ pub struct Colours {
     /// Sky strip per viewing angle: sRGB8 and CIELAB (D65 white).
     pub natural_srgb8: Vec<[u8; 3]>,
     pub natural_lab: Vec<[f64; 3]>,
+    /// How sure each colour is (R ≥ 2 realisations; `None` for one).
+    pub spread: Option<ColourSpread>,
+}
+
+/// The statistical uncertainty of the tile's colours.
+///
+/// Each realisation's colour is computed from that realisation's own spectra
+/// (layer on paper, through the same spectral proxy); the reported colour is
+/// that of the ensemble-mean spectra. Over `R` realisations:
+/// - `lab_se`: standard error of L*, a*, b* — the sample standard deviation of
+///   the realisations' values divided by √R;
+/// - `de00_se`: standard error of the colour in ΔE00 — the root mean square
+///   ΔE00 between each realisation's colour and the reported colour, with
+///   R − 1 degrees of freedom, divided by √R. A difference between two
+///   variants is resolved when it exceeds about twice the root sum of
+///   squares of their `de00_se`.
+#[derive(Debug, Clone)]
+pub struct ColourSpread {
+    /// CIELAB of every realisation, (realisation, viewing, 1 + illumination, 3).
+    pub realisation_lab: Array4<f64>,
+    /// (viewing, 1 + illumination, 3).
+    pub lab_se: Array3<f64>,
+    /// (viewing, 1 + illumination).
+    pub de00_se: Array2<f64>,
+}
+
+impl ColourSpread {
+    /// The spread of the realisations' colours `labs` around the reported `lab`.
+    pub fn of(labs: &[Array3<f64>], lab: &Array3<f64>) -> ColourSpread {
+        let r = labs.len();
+        assert!(r >= 2, "a spread needs two realisations or more");
+        let (nv, nc, _) = lab.dim();
+        let lab_se = reduce(labs).se.expect("two or more realisations");
+        let mut de00_se = Array2::zeros((nv, nc));
+        for o in 0..nv {
+            for c in 0..nc {
+                let at = |a: &Array3<f64>| [a[[o, c, 0]], a[[o, c, 1]], a[[o, c, 2]]];
+                let sq: f64 = labs
+                    .iter()
+                    .map(|l| colour::delta_e2000(at(l), at(lab)).powi(2))
+                    .sum();
+                de00_se[[o, c]] = (sq / (r as f64 - 1.0) / r as f64).sqrt();
+            }
+        }
+        let mut realisation_lab = Array4::zeros((r, nv, nc, 3));
+        for (k, l) in labs.iter().enumerate() {
+            realisation_lab
+                .index_axis_mut(ndarray::Axis(0), k)
+                .assign(l);
+        }
+        ColourSpread {
+            realisation_lab,
+            lab_se,
+            de00_se,
+        }
+    }
 }
 
 /// Everything assembled; array axes are named in each field.
@@ -414,27 +470,38 @@ pub fn assemble(
             .iter()
             .map(|&v| index_of(&spec.above_deg, v).ok_or(AppearanceError::NotSolved(v)))
             .collect::<Result<_, _>>()?;
-        let t_mean = &transmittance.mean;
-        let mut total = brdf_diffuse.mean.clone();
-        let mut sky = Array2::zeros((nl, nv));
-        for l in 0..nl {
-            for (o, &vo) in view_idx.iter().enumerate() {
-                sky[[l, o]] = reflectance.mean[[l, vo]];
+        let on_paper = |brdf: &Array3<f64>, refl: &Array2<f64>, trans: &Array2<f64>, rdd, td| {
+            let paper = paper.as_ref().map(|p| (p.albedo, rdd, td));
+            layer_on_paper(&illum_idx, &view_idx, brdf, refl, trans, paper)
+        };
+        let (total, sky) = on_paper(
+            &brdf_diffuse.mean,
+            &reflectance.mean,
+            &transmittance.mean,
+            paper.as_ref().map(|p| &p.r_dd_up.mean),
+            paper.as_ref().map(|p| &p.t_d.mean),
+        );
+        let proxy = match (&spec.proxy, spec.paper_albedo, &spec.below) {
+            (Some(p), Some(albedo), Some(h)) => Some((p, p.spectra(spec, albedo, h))),
+            _ => None,
+        };
+        let proxy = proxy.as_ref().map(|(p, (f, sky))| (*p, f, sky));
+        let mut c = colours_of(spec, &total, &sky, observer, proxy)?;
+        if rr >= 2 {
+            let mut labs = Vec::with_capacity(rr);
+            for r in 0..rr {
+                let (total_r, sky_r) = on_paper(
+                    &s_brdf[r],
+                    &s_r[r],
+                    &s_t[r],
+                    Some(&s_rdd[r]),
+                    Some(&s_td[r]),
+                );
+                labs.push(colours_of(spec, &total_r, &sky_r, observer, proxy)?.tile_lab);
             }
-            if let Some(p) = &paper {
-                let denom = 1.0 - p.albedo * p.r_dd_up.mean[l];
-                for (i, &ai) in illum_idx.iter().enumerate() {
-                    for (o, &vo) in view_idx.iter().enumerate() {
-                        total[[l, i, o]] +=
-                            p.albedo * t_mean[[l, ai]] * t_mean[[l, vo]] / (PI * denom);
-                    }
-                }
-                for (o, &vo) in view_idx.iter().enumerate() {
-                    sky[[l, o]] += p.albedo * p.t_d.mean[l] * t_mean[[l, vo]] / denom;
-                }
-            }
+            c.spread = Some(ColourSpread::of(&labs, &c.tile_lab));
         }
-        colours = Some(colours_of(spec, &total, &sky, observer)?);
+        colours = Some(c);
         brdf_total = Some(total);
         natural = Some(sky);
     }
@@ -460,21 +527,20 @@ pub fn assemble(
 }
 
 /// Tile colours from the BRDF of layer + substrate and the sky strip.
+/// `proxy` is the spectral proxy with its BRDF square and sky strip on its
+/// fine grid ([`SpectralProxy::spectra`]).
 fn colours_of(
     spec: &AppearanceSpec,
     total: &Array3<f64>,
     sky: &Array2<f64>,
     obs: &Observer,
+    proxy: Option<(&SpectralProxy, &Array3<f64>, &Array2<f64>)>,
 ) -> Result<Colours, AppearanceError> {
     let wl = &spec.wavelengths_nm;
     let (nv, ni) = (spec.viewing_deg.len(), spec.illumination_deg.len());
-    let proxy = match (&spec.proxy, spec.paper_albedo, &spec.below) {
-        (Some(p), Some(albedo), Some(h)) => Some((p, p.spectra(spec, albedo, h))),
-        _ => None,
-    };
     // XYZ of a spectrum sampled at the solved wavelengths.
     let xyz = |values: Vec<f64>, proxy_fine: Option<Vec<f64>>| match (&proxy, proxy_fine) {
-        (Some((p, _)), Some(pf)) => {
+        (Some((p, _, _)), Some(pf)) => {
             let fine = through_proxy(wl, &values, &p.wavelengths_nm, &pf);
             colour::xyz_from_reflectance(obs, &p.wavelengths_nm, &fine)
         }
@@ -486,7 +552,7 @@ fn colours_of(
     let mut natural_lab = Vec::with_capacity(nv);
     let white = obs.white_xyz();
     for o in 0..nv {
-        let pf = proxy.as_ref().map(|(_, (_, s))| s.column(o).to_vec());
+        let pf = proxy.map(|(_, _, s)| s.column(o).to_vec());
         let x = xyz(sky.column(o).to_vec(), pf)?;
         let rgb = colour::to_srgb8(obs, x);
         natural_srgb8.push(rgb);
@@ -502,7 +568,7 @@ fn colours_of(
             let spectrum: Vec<f64> = (0..wl.len())
                 .map(|l| colour::lambertian_reflectance(total[[l, i, o]]))
                 .collect();
-            let pf = proxy.as_ref().map(|(_, (f, _))| {
+            let pf = proxy.map(|(_, f, _)| {
                 (0..f.dim().0)
                     .map(|l| colour::lambertian_reflectance(f[[l, i, o]]))
                     .collect()
@@ -523,7 +589,43 @@ fn colours_of(
         tile_lab,
         natural_srgb8,
         natural_lab,
+        spread: None,
     })
+}
+
+/// BRDF of layer + substrate `(wavelength, illumination, viewing)` and the
+/// radiance factor under a white sky `(wavelength, viewing)` from the layer's
+/// diffuse BRDF, R and T (per above angle), and with paper its albedo, `R_dd↑`
+/// and `T_d` (per wavelength). `illum_idx`/`view_idx` index the above angles.
+fn layer_on_paper(
+    illum_idx: &[usize],
+    view_idx: &[usize],
+    brdf_diffuse: &Array3<f64>,
+    reflectance: &Array2<f64>,
+    transmittance: &Array2<f64>,
+    paper: Option<(f64, Option<&Array1<f64>>, Option<&Array1<f64>>)>,
+) -> (Array3<f64>, Array2<f64>) {
+    let nl = brdf_diffuse.dim().0;
+    let mut total = brdf_diffuse.clone();
+    let mut sky = Array2::zeros((nl, view_idx.len()));
+    for l in 0..nl {
+        for (o, &vo) in view_idx.iter().enumerate() {
+            sky[[l, o]] = reflectance[[l, vo]];
+        }
+        if let Some((albedo, Some(rdd), Some(td))) = paper {
+            let denom = 1.0 - albedo * rdd[l];
+            for (i, &ai) in illum_idx.iter().enumerate() {
+                for (o, &vo) in view_idx.iter().enumerate() {
+                    total[[l, i, o]] +=
+                        albedo * transmittance[[l, ai]] * transmittance[[l, vo]] / (PI * denom);
+                }
+            }
+            for (o, &vo) in view_idx.iter().enumerate() {
+                sky[[l, o]] += albedo * td[l] * transmittance[[l, vo]] / denom;
+            }
+        }
+    }
+    (total, sky)
 }
 
 #[cfg(test)]

@@ -471,7 +471,11 @@ pub fn assemble(
             .map(|&v| index_of(&spec.above_deg, v).ok_or(AppearanceError::NotSolved(v)))
             .collect::<Result<_, _>>()?;
         let on_paper = |brdf: &Array3<f64>, refl: &Array2<f64>, trans: &Array2<f64>, rdd, td| {
-            let paper = paper.as_ref().map(|p| (p.albedo, rdd, td));
+            let paper = paper
+                .as_ref()
+                .zip(rdd)
+                .zip(td)
+                .map(|((p, r), t)| (p.albedo, r, t));
             layer_on_paper(&illum_idx, &view_idx, brdf, refl, trans, paper)
         };
         let (total, sky) = on_paper(
@@ -603,7 +607,7 @@ fn layer_on_paper(
     brdf_diffuse: &Array3<f64>,
     reflectance: &Array2<f64>,
     transmittance: &Array2<f64>,
-    paper: Option<(f64, Option<&Array1<f64>>, Option<&Array1<f64>>)>,
+    paper: Option<(f64, &Array1<f64>, &Array1<f64>)>,
 ) -> (Array3<f64>, Array2<f64>) {
     let nl = brdf_diffuse.dim().0;
     let mut total = brdf_diffuse.clone();
@@ -612,7 +616,7 @@ fn layer_on_paper(
         for (o, &vo) in view_idx.iter().enumerate() {
             sky[[l, o]] = reflectance[[l, vo]];
         }
-        if let Some((albedo, Some(rdd), Some(td))) = paper {
+        if let Some((albedo, rdd, td)) = paper {
             let denom = 1.0 - albedo * rdd[l];
             for (i, &ai) in illum_idx.iter().enumerate() {
                 for (o, &vo) in view_idx.iter().enumerate() {

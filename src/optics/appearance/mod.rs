@@ -23,14 +23,19 @@
 //! Ensemble-mean quantities are combined (products of means), as METHOD §5
 //! describes the layer by its mean scattering functions.
 
-use crate::optics::colour::{self, ColourError, Observer};
+mod colours;
+mod proxy;
+
+pub use colours::{ColourSpread, Colours};
+pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
+
+use crate::optics::colour::{ColourError, Observer};
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::optics::substrate::Hemisphere;
-use crate::solver::airy;
+use colours::{colours_of, layer_on_paper};
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
 use num_complex::Complex64 as C64;
-use std::f64::consts::PI;
 
 /// What to assemble; built by the pipeline from the scene and its plan.
 #[derive(Debug, Clone)]
@@ -57,120 +62,6 @@ pub struct AppearanceSpec {
     pub proxy: Option<SpectralProxy>,
 }
 
-/// The homogeneous slab of the volume-averaged ε (the molecular mixture of
-/// the same pigments) on the same paper, known in closed form at any
-/// wavelength. Colours integrate spectra over 1 nm; the layer is solved at a
-/// few wavelengths only, and pigment absorption bands are narrower than a
-/// coarse step, so linear interpolation of the layer's spectra misses the
-/// bands' shape (ΔE00 ≈ 9 at a 50 nm step, docs/ACCURACY.md). Instead the
-/// *ratio* layer / proxy is interpolated linearly and multiplied by the proxy
-/// on the fine grid: the proxy carries the bands' shape, the solves the
-/// effect of the grains. At the solved wavelengths the result is exact.
-#[derive(Debug, Clone)]
-pub struct SpectralProxy {
-    /// Fine grid (includes every solved wavelength), nm.
-    pub wavelengths_nm: Vec<f64>,
-    /// ⟨ε⟩ on the fine grid.
-    pub eps: Vec<C64>,
-    pub thickness_nm: f64,
-}
-
-impl SpectralProxy {
-    /// Proxy BRDF square `(fine λ, illumination, viewing)` and sky strip
-    /// `(fine λ, viewing)` of the slab on paper of albedo `albedo`.
-    fn spectra(
-        &self,
-        spec: &AppearanceSpec,
-        albedo: f64,
-        h: &Hemisphere,
-    ) -> (Array3<f64>, Array2<f64>) {
-        let nf = self.wavelengths_nm.len();
-        let (ni, nv) = (spec.illumination_deg.len(), spec.viewing_deg.len());
-        let mut f = Array3::zeros((nf, ni, nv));
-        let mut sky = Array2::zeros((nf, nv));
-        for (l, (&wl, &eps)) in self.wavelengths_nm.iter().zip(&self.eps).enumerate() {
-            let rt = |polar: f64| {
-                let r = airy::slab(eps, self.thickness_nm, wl, polar);
-                (r.r.norm_sqr(), r.t.norm_sqr())
-            };
-            let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(rt).collect();
-            let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
-            let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
-            let denom = 1.0 - albedo * rdd;
-            let ti: Vec<f64> = spec.illumination_deg.iter().map(|&a| rt(a).1).collect();
-            for (o, &v) in spec.viewing_deg.iter().enumerate() {
-                let (ro, to) = rt(v);
-                sky[[l, o]] = ro + albedo * td * to / denom;
-                for i in 0..ni {
-                    f[[l, i, o]] = albedo * ti[i] * to / (PI * denom);
-                }
-            }
-        }
-        (f, sky)
-    }
-}
-
-/// Largest factor by which the ratio layer / proxy may change across one
-/// interval between solved wavelengths for the proxy to be trusted there.
-pub const PROXY_RATIO_SPREAD: f64 = 10.0;
-
-/// Spectrum on the proxy's fine grid: `ratio(λ) · proxy(λ)` with the ratio
-/// interpolated linearly between the solved wavelengths (held at the ends).
-/// Where the ratio changes by more than [`PROXY_RATIO_SPREAD`] across an
-/// interval, the proxy does not describe the layer there (e.g. a strongly
-/// absorbing layer seen by its surface scattering, while the slab's double
-/// pass through the band is orders of magnitude darker): that interval falls
-/// back to linear interpolation of the layer's own values.
-fn through_proxy(wl: &[f64], values: &[f64], fine: &[f64], proxy_fine: &[f64]) -> Vec<f64> {
-    let at = |x: f64| fine.iter().position(|&f| f == x);
-    let ratio: Vec<f64> = wl
-        .iter()
-        .zip(values)
-        .map(|(&w, &v)| {
-            let p = at(w).map_or(0.0, |k| proxy_fine[k]);
-            if p > 0.0 {
-                v / p
-            } else {
-                f64::INFINITY
-            }
-        })
-        .collect();
-    let trusted = |k: usize| {
-        let (a, b) = (ratio[k], ratio[k + 1]);
-        a.is_finite()
-            && b.is_finite()
-            && a > 0.0
-            && b > 0.0
-            && a.max(b) <= PROXY_RATIO_SPREAD * a.min(b)
-    };
-    let n = wl.len();
-    let held = |k: usize, p: f64| {
-        if ratio[k].is_finite() {
-            ratio[k] * p
-        } else {
-            values[k]
-        }
-    };
-    fine.iter()
-        .zip(proxy_fine)
-        .map(|(&x, &p)| {
-            if x <= wl[0] || n == 1 {
-                return held(0, p);
-            }
-            if x >= wl[n - 1] {
-                return held(n - 1, p);
-            }
-            let k = wl.windows(2).position(|w| x < w[1]).unwrap_or(0);
-            let t = (x - wl[k]) / (wl[k + 1] - wl[k]);
-            if trusted(k) {
-                (ratio[k] * (1.0 - t) + ratio[k + 1] * t) * p
-            } else {
-                values[k] * (1.0 - t) + values[k + 1] * t
-            }
-        })
-        .collect()
-}
-
 /// A mean over realisations and its standard error (None when R = 1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate<D: Dimension> {
@@ -186,75 +77,6 @@ pub struct PaperTerms {
     pub r_dd_up: Estimate<Ix1>,
     /// Layer diffuse transmittance, per wavelength.
     pub t_d: Estimate<Ix1>,
-}
-
-/// Colours of the tile.
-#[derive(Debug, Clone)]
-pub struct Colours {
-    /// (viewing, 1 + illumination, 3): column 0 the sky strip, then the
-    /// BRDF square (`π f` as a reflectance factor).
-    pub tile_srgb8: Array3<u8>,
-    /// CIELAB (D65 white) of the same cells.
-    pub tile_lab: Array3<f64>,
-    /// Sky strip per viewing angle: sRGB8 and CIELAB (D65 white).
-    pub natural_srgb8: Vec<[u8; 3]>,
-    pub natural_lab: Vec<[f64; 3]>,
-    /// How sure each colour is (R ≥ 2 realisations; `None` for one).
-    pub spread: Option<ColourSpread>,
-}
-
-/// The statistical uncertainty of the tile's colours.
-///
-/// Each realisation's colour is computed from that realisation's own spectra
-/// (layer on paper, through the same spectral proxy); the reported colour is
-/// that of the ensemble-mean spectra. Over `R` realisations:
-/// - `lab_se`: standard error of L*, a*, b* — the sample standard deviation of
-///   the realisations' values divided by √R;
-/// - `de00_se`: standard error of the colour in ΔE00 — the root mean square
-///   ΔE00 between each realisation's colour and the reported colour, with
-///   R − 1 degrees of freedom, divided by √R. A difference between two
-///   variants is resolved when it exceeds about twice the root sum of
-///   squares of their `de00_se`.
-#[derive(Debug, Clone)]
-pub struct ColourSpread {
-    /// CIELAB of every realisation, (realisation, viewing, 1 + illumination, 3).
-    pub realisation_lab: Array4<f64>,
-    /// (viewing, 1 + illumination, 3).
-    pub lab_se: Array3<f64>,
-    /// (viewing, 1 + illumination).
-    pub de00_se: Array2<f64>,
-}
-
-impl ColourSpread {
-    /// The spread of the realisations' colours `labs` around the reported `lab`.
-    pub fn of(labs: &[Array3<f64>], lab: &Array3<f64>) -> ColourSpread {
-        let r = labs.len();
-        assert!(r >= 2, "a spread needs two realisations or more");
-        let (nv, nc, _) = lab.dim();
-        let lab_se = reduce(labs).se.expect("two or more realisations");
-        let mut de00_se = Array2::zeros((nv, nc));
-        for o in 0..nv {
-            for c in 0..nc {
-                let at = |a: &Array3<f64>| [a[[o, c, 0]], a[[o, c, 1]], a[[o, c, 2]]];
-                let sq: f64 = labs
-                    .iter()
-                    .map(|l| colour::delta_e2000(at(l), at(lab)).powi(2))
-                    .sum();
-                de00_se[[o, c]] = (sq / (r as f64 - 1.0) / r as f64).sqrt();
-            }
-        }
-        let mut realisation_lab = Array4::zeros((r, nv, nc, 3));
-        for (k, l) in labs.iter().enumerate() {
-            realisation_lab
-                .index_axis_mut(ndarray::Axis(0), k)
-                .assign(l);
-        }
-        ColourSpread {
-            realisation_lab,
-            lab_se,
-            de00_se,
-        }
-    }
 }
 
 /// Everything assembled; array axes are named in each field.
@@ -302,7 +124,7 @@ pub enum AppearanceError {
 }
 
 /// Mean and standard error along the first axis of `samples`.
-fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
+pub(super) fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
     let n = samples.len() as f64;
     let mut mean = samples[0].clone();
     for s in &samples[1..] {
@@ -528,140 +350,4 @@ pub fn assemble(
         natural,
         colours,
     })
-}
-
-/// Tile colours from the BRDF of layer + substrate and the sky strip.
-/// `proxy` is the spectral proxy with its BRDF square and sky strip on its
-/// fine grid ([`SpectralProxy::spectra`]).
-fn colours_of(
-    spec: &AppearanceSpec,
-    total: &Array3<f64>,
-    sky: &Array2<f64>,
-    obs: &Observer,
-    proxy: Option<(&SpectralProxy, &Array3<f64>, &Array2<f64>)>,
-) -> Result<Colours, AppearanceError> {
-    let wl = &spec.wavelengths_nm;
-    let (nv, ni) = (spec.viewing_deg.len(), spec.illumination_deg.len());
-    // XYZ of a spectrum sampled at the solved wavelengths.
-    let xyz = |values: Vec<f64>, proxy_fine: Option<Vec<f64>>| match (&proxy, proxy_fine) {
-        (Some((p, _, _)), Some(pf)) => {
-            let fine = through_proxy(wl, &values, &p.wavelengths_nm, &pf);
-            colour::xyz_from_reflectance(obs, &p.wavelengths_nm, &fine)
-        }
-        _ => colour::xyz_from_reflectance(obs, wl, &values),
-    };
-    let mut tile = Array3::zeros((nv, 1 + ni, 3));
-    let mut tile_lab = Array3::zeros((nv, 1 + ni, 3));
-    let mut natural_srgb8 = Vec::with_capacity(nv);
-    let mut natural_lab = Vec::with_capacity(nv);
-    let white = obs.white_xyz();
-    for o in 0..nv {
-        let pf = proxy.map(|(_, _, s)| s.column(o).to_vec());
-        let x = xyz(sky.column(o).to_vec(), pf)?;
-        let rgb = colour::to_srgb8(obs, x);
-        natural_srgb8.push(rgb);
-        natural_lab.push(colour::xyz_to_lab(x, white));
-        for (c, v) in colour::xyz_to_lab(x, white).into_iter().enumerate() {
-            tile_lab[[o, 0, c]] = v;
-        }
-        tile.slice_mut(ndarray::s![o, 0, ..])
-            .iter_mut()
-            .zip(rgb)
-            .for_each(|(t, c)| *t = c);
-        for i in 0..ni {
-            let spectrum: Vec<f64> = (0..wl.len())
-                .map(|l| colour::lambertian_reflectance(total[[l, i, o]]))
-                .collect();
-            let pf = proxy.map(|(_, f, _)| {
-                (0..f.dim().0)
-                    .map(|l| colour::lambertian_reflectance(f[[l, i, o]]))
-                    .collect()
-            });
-            let x = xyz(spectrum, pf)?;
-            for (c, v) in colour::xyz_to_lab(x, white).into_iter().enumerate() {
-                tile_lab[[o, 1 + i, c]] = v;
-            }
-            let rgb = colour::to_srgb8(obs, x);
-            tile.slice_mut(ndarray::s![o, 1 + i, ..])
-                .iter_mut()
-                .zip(rgb)
-                .for_each(|(t, c)| *t = c);
-        }
-    }
-    Ok(Colours {
-        tile_srgb8: tile,
-        tile_lab,
-        natural_srgb8,
-        natural_lab,
-        spread: None,
-    })
-}
-
-/// BRDF of layer + substrate `(wavelength, illumination, viewing)` and the
-/// radiance factor under a white sky `(wavelength, viewing)` from the layer's
-/// diffuse BRDF, R and T (per above angle), and with paper its albedo, `R_dd↑`
-/// and `T_d` (per wavelength). `illum_idx`/`view_idx` index the above angles.
-fn layer_on_paper(
-    illum_idx: &[usize],
-    view_idx: &[usize],
-    brdf_diffuse: &Array3<f64>,
-    reflectance: &Array2<f64>,
-    transmittance: &Array2<f64>,
-    paper: Option<(f64, &Array1<f64>, &Array1<f64>)>,
-) -> (Array3<f64>, Array2<f64>) {
-    let nl = brdf_diffuse.dim().0;
-    let mut total = brdf_diffuse.clone();
-    let mut sky = Array2::zeros((nl, view_idx.len()));
-    for l in 0..nl {
-        for (o, &vo) in view_idx.iter().enumerate() {
-            sky[[l, o]] = reflectance[[l, vo]];
-        }
-        if let Some((albedo, rdd, td)) = paper {
-            let denom = 1.0 - albedo * rdd[l];
-            for (i, &ai) in illum_idx.iter().enumerate() {
-                for (o, &vo) in view_idx.iter().enumerate() {
-                    total[[l, i, o]] +=
-                        albedo * transmittance[[l, ai]] * transmittance[[l, vo]] / (PI * denom);
-                }
-            }
-            for (o, &vo) in view_idx.iter().enumerate() {
-                sky[[l, o]] += albedo * td[l] * transmittance[[l, vo]] / denom;
-            }
-        }
-    }
-    (total, sky)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn proxy_shapes_between_solves_and_falls_back_where_it_does_not_fit() {
-        let fine: Vec<f64> = (0..=20).map(|i| 400.0 + 10.0 * i as f64).collect();
-        let wl = [400.0, 500.0, 600.0];
-        // A proxy with a band at 450 nm and a deep one at 600 nm.
-        let proxy: Vec<f64> = fine
-            .iter()
-            .map(|&x| {
-                0.5 - 0.3 * (-((x - 450.0) / 20.0).powi(2)).exp()
-                    - 0.4999 * (-((x - 600.0) / 20.0).powi(2)).exp()
-            })
-            .collect();
-        let p_at = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
-        // Layer = 0.8 × proxy at 400 and 500 nm (the proxy fits there), but
-        // a flat 0.1 at 600 nm where the proxy's band darkens it 5000-fold.
-        let values = [0.8 * p_at(400.0), 0.8 * p_at(500.0), 0.1];
-        let out = through_proxy(&wl, &values, &fine, &proxy);
-        let at = |x: f64| out[fine.iter().position(|&f| f == x).unwrap()];
-        for (w, v) in wl.iter().zip(values) {
-            assert!((at(*w) - v).abs() < 1e-15, "solved wavelengths are exact");
-        }
-        // 400–500 nm: constant ratio, so the band at 450 nm is reproduced.
-        assert!((at(450.0) - 0.8 * p_at(450.0)).abs() < 1e-12);
-        assert!(at(450.0) < 0.8 * 0.21, "the band is there");
-        // 500–600 nm: the ratio jumps far beyond the spread; linear values.
-        let lin = 0.5 * (values[1] + values[2]);
-        assert!((at(550.0) - lin).abs() < 1e-12, "{} vs {lin}", at(550.0));
-    }
 }

@@ -1,0 +1,1 @@
+from .result import Result, open_result

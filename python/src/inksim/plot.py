@@ -201,6 +201,7 @@ def plot_brdf(result: Result, wavelength: Optional[float] = None,
     ax.set_xlabel(axis_label("Viewing angle θ (+: specular side)", "deg"))
     ax.set_ylabel(axis_label(f"{which.upper()} f", units))
     ax.set_xlim(-90, 90)
+    ax.set_ylim(bottom=0.0)
     ax.set_xticks(np.arange(-90, 91, 30))
     ax.grid(True, alpha=0.3)
     ax.legend(title="illumination", fontsize="small")
@@ -210,21 +211,25 @@ def plot_brdf(result: Result, wavelength: Optional[float] = None,
     pax = fig.add_subplot(1, 2, 2, projection="polar")
     phi = np.radians(grid["phi_deg"].values)
     th = grid["theta_deg"].values
-    mesh = pax.pcolormesh(phi, th, grid.values, shading="auto", cmap="magma")
+    top = float(np.nanmax(grid.values)) if np.isfinite(grid.values).any() else 0.0
+    mesh = pax.pcolormesh(phi, th, grid.values, shading="auto", cmap="magma",
+                          vmin=0.0, vmax=top if top > 0 else 1.0)
+    if top <= 0:
+        pax.text(0.5, 0.3, "no diffuse orders\npropagate here", transform=pax.transAxes,
+                 ha="center", va="center", color="w", fontsize="small")
     pax.set_theta_zero_location("E")
     pax.set_rlim(0, float(th[-1]))
     ticks = [t for t in (30, 60, 80) if t <= th[-1]]
     pax.set_rticks(ticks)
     pax.set_yticklabels([f"{t}°" for t in ticks], color="w", fontsize="small")
     pax.set_xlabel(axis_label("Azimuth φ", "deg") + "; radius: polar angle θ (°)")
-    pax.set_ylabel(axis_label("θ", "deg"), labelpad=24)
     ia = grid.attrs["illumination_deg"]
     if which == "brdf":
         azd = float(result.appearance.attrs.get("azimuth_deg", 0.0))
         pax.plot([np.radians(azd)], [ia], marker="+", color="c", ms=12, mew=2, ls="none",
                  label="specular")
         pax.legend(loc="upper left", bbox_to_anchor=(-0.2, 1.05), fontsize="small")
-    cb = fig.colorbar(mesh, ax=pax, pad=0.1, shrink=0.9)
+    cb = fig.colorbar(mesh, ax=pax, pad=0.06, shrink=0.9)
     cb.set_label(axis_label(f"{which.upper()} f", units))
     pax.set_title(f"Hemisphere, λ = {lam:g} nm, θᵢ = {ia:g}°", fontsize="medium")
     fig.suptitle(f"{_name(result)}: diffuse {which.upper()}")

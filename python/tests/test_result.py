@@ -17,7 +17,7 @@ def test_identity(tiny, tiny_run):
     assert tiny.format_version == 1
     assert isinstance(tiny.version, str) and tiny.version
     assert tiny.config == TINY_SCENE  # the exact text, byte for byte
-    assert "geometry:" in tiny.plan and "BRDF table" in tiny.plan
+    assert len(tiny.plan.strip().splitlines()) > 3  # one line per decision
     assert len(tiny.input_hash) == 64
     assert tiny.seed == 3
     assert tiny.grid == (8, 8, 4)

@@ -30,6 +30,8 @@ def test_table(study):
     assert list(t["pigment"].values) == ["red", "red", "yellow", "yellow"]
     assert list(t["d"].values) == ["d100", "d150", "d100", "d150"]
     assert study.axes == {"d": ["d100", "d150"], "pigment": ["red", "yellow"]}
+    if study.table.get("d_value") is not None:  # sweep file read: its axis order
+        assert list(study.axes) == ["pigment", "d"]
     r, tr, a = (t[k].values for k in ("mean_reflectance", "mean_transmittance", "mean_absorption"))
     for x in (r, tr, a):
         assert np.all(np.isfinite(x)) and np.all((x >= 0) & (x <= 1))

@@ -169,6 +169,9 @@ class Study:
         values = _axis_values(str(self.attrs.get("sweep_file", "")),
                               [self.dir, os.path.dirname(self.dir), os.path.dirname(os.path.dirname(self.dir))]) \
             if self.attrs.get("sweep_file") else {}
+        if values:  # axes in sweep-file order (HDF5 lists the labels group by name)
+            order = [a for a in values if a in self.axes] + [a for a in self.axes if a not in values]
+            self.axes = {a: self.axes[a] for a in order}
         for a, mapping in values.items():
             if a not in coords:
                 continue

@@ -592,3 +592,95 @@ fn colour_standard_errors_agree_with_batch_means() {
     let one = run_text(dir.path(), &grains_scene(dir.path(), 1, ""));
     assert!(one.appearance.unwrap().colours.unwrap().spread.is_none());
 }
+
+/// Reassemble a run's solves with every measurement geometry and `obs`.
+fn measured(
+    rep: &RunReport,
+    obs: &inksim::optics::colour::Observer,
+) -> Vec<inksim::optics::appearance::MeasuredColour> {
+    use inksim::optics::appearance::{assemble, Measurement};
+    let mut spec = rep.appearance.as_ref().unwrap().spec.clone();
+    spec.measurements = Measurement::ALL.to_vec();
+    assemble(&spec, &rep.entries, obs).unwrap().measured
+}
+
+/// Bare paper (a vacuum layer) under every geometry, illuminant and observer:
+/// reflectance factor exactly the albedo 0.9 at every wavelength, and its
+/// colour the neutral L* = 116 · 0.9^(1/3) − 16, a* = b* = 0.
+#[test]
+fn bare_paper_measures_its_albedo_in_every_geometry_and_illuminant() {
+    use inksim::optics::colour::{Illuminant, Observer, StandardObserver};
+    let dir = tempfile::tempdir().unwrap();
+    let text = slab_scene(dir.path(), 1.0, 6).replace(
+        "polar_deg = [0.0, 20.0, 40.0, 60.0]",
+        "polar_deg = [0.0, 8.0, 45.0]",
+    );
+    let rep = run_text(dir.path(), &text);
+    let l_star = 116.0 * 0.9f64.cbrt() - 16.0;
+    for ill in Illuminant::ALL {
+        for so in StandardObserver::ALL {
+            let m = measured(&rep, &Observer::standard(ill, so));
+            assert_eq!(m.len(), 3);
+            for c in &m {
+                for v in &c.reflectance.mean {
+                    assert!((v - 0.9).abs() < 1e-12, "{}: {v}", c.geometry);
+                }
+                assert!(
+                    (c.lab[0] - l_star).abs() < 1e-9,
+                    "{} {ill}: {:?}",
+                    c.geometry,
+                    c.lab
+                );
+                assert!(
+                    c.lab[1].abs() < 1e-9 && c.lab[2].abs() < 1e-9,
+                    "{:?}",
+                    c.lab
+                );
+                assert_eq!(c.lch[0], c.lab[0]);
+                assert!(c.lch[1] < 1e-9);
+            }
+        }
+    }
+}
+
+/// A clear binder slab on paper against its closed form: 45°/0° is
+/// `ρ T(45°) T(0°) / (1 − ρ R_dd↑)`, d/8° SCI `R(8°) + ρ T_d T(8°) / (1 − ρ R_dd↑)`
+/// and SCE the same without the slab's mirror reflection `R(8°)`; Airy R, T
+/// and Simpson R_dd↑ as above, with 32 Gauss–Legendre nodes (1e-9). The
+/// slab's colour is the same whether the spectral proxy carries it or not.
+#[test]
+fn clear_binder_on_paper_measures_as_the_closed_form() {
+    use inksim::optics::appearance::Measurement;
+    use inksim::optics::colour::Observer;
+    let dir = tempfile::tempdir().unwrap();
+    let eps = 1.558f64.powi(2);
+    let text = slab_scene(dir.path(), 1.558, 32).replace(
+        "polar_deg = [0.0, 20.0, 40.0, 60.0]",
+        "polar_deg = [0.0, 8.0, 45.0]",
+    );
+    let rep = run_text(dir.path(), &text);
+    let m = measured(&rep, &Observer::cie1931_d65());
+    let wls = &rep.appearance.as_ref().unwrap().spec.wavelengths_nm;
+    for c in &m {
+        for (l, &wl) in wls.iter().enumerate() {
+            let rdd = hemispherical(|mu| airy_rt(eps, 1000.0, wl, mu.acos().to_degrees()).0);
+            let denom = 1.0 - 0.9 * rdd;
+            let at = |polar| airy_rt(eps, 1000.0, wl, polar);
+            let expect = match c.geometry {
+                Measurement::FortyFiveZero => 0.9 * at(45.0).1 * at(0.0).1 / denom,
+                Measurement::DiffuseEightSci => at(8.0).0 + 0.9 * (1.0 - rdd) * at(8.0).1 / denom,
+                Measurement::DiffuseEightSce => 0.9 * (1.0 - rdd) * at(8.0).1 / denom,
+            };
+            let got = c.reflectance.mean[l];
+            assert!(
+                (got - expect).abs() < 1e-9 * expect,
+                "{} at {wl} nm: {got} vs {expect}",
+                c.geometry
+            );
+        }
+        assert!(c.lab.iter().all(|v| v.is_finite()));
+        assert_eq!(c.spectrum.len(), c.spectrum_wavelengths_nm.len());
+    }
+    // SCI ≥ SCE: the slab's mirror reflection is what the trap removes.
+    assert!(m[1].lab[0] > m[2].lab[0]);
+}

@@ -817,6 +817,7 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         btdf: scene.appearance.products.btdf,
         tile: scene.appearance.products.tile,
         proxy: spectral_proxy(scene),
+        measurements: Vec::new(),
     }
 }
 

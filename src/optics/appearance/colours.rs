@@ -55,11 +55,8 @@ impl ColourSpread {
         for o in 0..nv {
             for c in 0..nc {
                 let at = |a: &Array3<f64>| [a[[o, c, 0]], a[[o, c, 1]], a[[o, c, 2]]];
-                let sq: f64 = labs
-                    .iter()
-                    .map(|l| colour::delta_e2000(at(l), at(lab)).powi(2))
-                    .sum();
-                de00_se[[o, c]] = (sq / (r as f64 - 1.0) / r as f64).sqrt();
+                let cell: Vec<[f64; 3]> = labs.iter().map(at).collect();
+                de00_se[[o, c]] = de00_standard_error(&cell, at(lab));
             }
         }
         let mut realisation_lab = Array4::zeros((r, nv, nc, 3));
@@ -141,6 +138,18 @@ pub(super) fn colours_of(
         natural_lab,
         spread: None,
     })
+}
+
+/// Standard error in ΔE00 of the colour `center` reported for realisations
+/// whose colours are `labs` (R ≥ 2): the root mean square ΔE00 of each to
+/// `center` with R − 1 degrees of freedom, divided by √R.
+pub(super) fn de00_standard_error(labs: &[[f64; 3]], center: [f64; 3]) -> f64 {
+    let r = labs.len() as f64;
+    let sq: f64 = labs
+        .iter()
+        .map(|l| colour::delta_e2000(*l, center).powi(2))
+        .sum();
+    (sq / (r - 1.0) / r).sqrt()
 }
 
 /// BRDF of layer + substrate `(wavelength, illumination, viewing)` and the

@@ -24,9 +24,11 @@
 //! describes the layer by its mean scattering functions.
 
 mod colours;
+mod measure;
 mod proxy;
 
 pub use colours::{ColourSpread, Colours};
+pub use measure::{MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
 use crate::optics::colour::{ColourError, Observer};
@@ -60,6 +62,9 @@ pub struct AppearanceSpec {
     pub tile: bool,
     /// Spectral proxy for colour (with paper): see [`SpectralProxy`].
     pub proxy: Option<SpectralProxy>,
+    /// Colorimetric measurement geometries to report (their angles must be
+    /// in `above_deg`); see [`Measurement`].
+    pub measurements: Vec<Measurement>,
 }
 
 /// A mean over realisations and its standard error (None when R = 1).
@@ -105,6 +110,8 @@ pub struct Appearance {
     /// Radiance factor under a uniform white sky, (wavelength, viewing).
     pub natural: Option<Array2<f64>>,
     pub colours: Option<Colours>,
+    /// Colour in each of `spec.measurements`, in that order.
+    pub measured: Vec<MeasuredColour>,
 }
 
 /// Why the appearance cannot be assembled.
@@ -332,6 +339,17 @@ pub fn assemble(
         natural = Some(sky);
     }
 
+    let measured = measure::measure(
+        spec,
+        entries,
+        paper.as_ref().map(|p| measure::PaperPerRealisation {
+            albedo: p.albedo,
+            r_dd_up: &s_rdd,
+            t_d: &s_td,
+        }),
+        observer,
+    )?;
+
     Ok(Appearance {
         spec: spec.clone(),
         reflectance,
@@ -349,5 +367,6 @@ pub fn assemble(
         brdf_total,
         natural,
         colours,
+        measured,
     })
 }

@@ -526,6 +526,17 @@ pub fn reflectance_to_srgb8(
     ))
 }
 
+/// CIELAB → CIE LCh(ab): lightness, chroma `C*ab = √(a*² + b*²)` and hue
+/// angle `h_ab` in degrees, in [0, 360).
+pub fn lab_to_lch(lab: [f64; 3]) -> [f64; 3] {
+    let h = lab[2].atan2(lab[1]).to_degrees();
+    [
+        lab[0],
+        lab[1].hypot(lab[2]),
+        if h < 0.0 { h + 360.0 } else { h },
+    ]
+}
+
 /// Reflectance of a Lambertian surface with BRDF `f_r` (sr⁻¹): `π f_r`.
 /// A perfect Lambertian reflector of albedo 1 (`f_r = 1/π`) gives 1.
 pub fn lambertian_reflectance(f_r: f64) -> f64 {

@@ -1,0 +1,270 @@
+//! Colour as an instrument measures it: the CIE/ISO measurement geometries.
+//!
+//! A colorimeter does not look at a tile under a white sky; it lights and
+//! views the sample in a standard geometry (CIE 15, ISO 13655):
+//! - **45°/0°** (ISO 13655's geometry for print; by reciprocity the same as
+//!   0°/45°): light at 45°, viewed along the normal. The specular reflection
+//!   leaves at 45° and is not seen. Reflectance factor `π f(45° → 0°)` with `f`
+//!   the diffuse BRDF of layer + paper: `f_layer(45→0) + ρ T(45°) T(0°) /
+//!   (π (1 − ρ R_dd↑))`. The BRDF is read in the plane of incidence; an
+//!   isotropic layer looks the same from every azimuth, so a ring-lit (45°a)
+//!   instrument gives the same mean.
+//! - **d/8° SCI** (specular component included, paints and CIE 15's
+//!   integrating sphere): uniform diffuse light, viewed at 8°. By reciprocity
+//!   the reflectance factor is the total directional-hemispherical reflectance
+//!   at 8°, `R(8°) + ρ T_d T(8°) / (1 − ρ R_dd↑)`, the white-sky formula.
+//! - **d/8° SCE** (specular component excluded, a gloss trap): the same minus
+//!   the power of the mirror reflection, the (0,0) order at 8°, mean `|r00|²`
+//!   (coherent and incoherent parts). The model's mirror reflection is a
+//!   single direction; a real trap removes a cone of a few degrees, which for
+//!   a layer whose diffuse BRDF is smooth there changes the result by that
+//!   cone's share of the diffuse light (well below 1 %).
+//!
+//! Each geometry needs solves from above at its angles ([`Measurement::above_deg`]).
+//! Colour follows the scene's observer and illuminant (D50, 2° is ISO 13655's);
+//! with R ≥ 2 realisations every colour carries the standard errors of L*, a*,
+//! b* and of ΔE00, as the tile's do ([`super::ColourSpread`]).
+
+use std::fmt;
+
+use super::colours::de00_standard_error;
+use super::proxy::{through_proxy, SpectralProxy};
+use super::{reduce, AppearanceError, AppearanceSpec, Estimate};
+use crate::optics::colour::{self, Observer};
+use crate::optics::farfield::table::{self, Part};
+use crate::optics::farfield::{Side, SolveEntry};
+use crate::solver::airy;
+use ndarray::{Array1, Ix1};
+use std::f64::consts::PI;
+
+/// A colorimetric measurement geometry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Measurement {
+    /// 45°/0°: directional light at 45°, viewed at 0° (ISO 13655, print).
+    FortyFiveZero,
+    /// d/8° with the specular component included (SCI).
+    DiffuseEightSci,
+    /// d/8° with the specular component excluded (SCE).
+    DiffuseEightSce,
+}
+
+impl Measurement {
+    /// Every geometry, in the order results list them.
+    pub const ALL: [Measurement; 3] = [
+        Measurement::FortyFiveZero,
+        Measurement::DiffuseEightSci,
+        Measurement::DiffuseEightSce,
+    ];
+
+    /// The name configs and result files use: `45/0`, `d/8 SCI`, `d/8 SCE`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Measurement::FortyFiveZero => "45/0",
+            Measurement::DiffuseEightSci => "d/8 SCI",
+            Measurement::DiffuseEightSce => "d/8 SCE",
+        }
+    }
+
+    /// The geometry named `name` (case-insensitive), if there is one.
+    pub fn from_name(name: &str) -> Option<Measurement> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(name))
+    }
+
+    /// Polar angles (deg) that must be solved from above.
+    pub fn above_deg(self) -> &'static [f64] {
+        match self {
+            Measurement::FortyFiveZero => &[45.0, 0.0],
+            Measurement::DiffuseEightSci | Measurement::DiffuseEightSce => &[8.0],
+        }
+    }
+}
+
+impl fmt::Display for Measurement {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The colour of the sample in one measurement geometry.
+#[derive(Debug, Clone)]
+pub struct MeasuredColour {
+    pub geometry: Measurement,
+    /// Reflectance factor at the solved wavelengths: mean and standard error.
+    pub reflectance: Estimate<Ix1>,
+    /// The spectrum the colour is integrated from (the spectral proxy's fine
+    /// grid where there is one, else the solved wavelengths), nm.
+    pub spectrum_wavelengths_nm: Vec<f64>,
+    pub spectrum: Vec<f64>,
+    /// CIE XYZ (white Y = 100), CIELAB and CIE LCh(ab) (h in degrees).
+    pub xyz: [f64; 3],
+    pub lab: [f64; 3],
+    pub lch: [f64; 3],
+    /// Standard errors of L*, a*, b* and of the colour in ΔE00 (R ≥ 2).
+    pub lab_se: Option<[f64; 3]>,
+    pub de00_se: Option<f64>,
+}
+
+/// The per-realisation quantities a measurement reads, besides the solves.
+pub(super) struct PaperPerRealisation<'a> {
+    pub albedo: f64,
+    pub r_dd_up: &'a [Array1<f64>],
+    pub t_d: &'a [Array1<f64>],
+}
+
+/// Reflectance factor of geometry `m` at wavelength index `l` for realisation
+/// `r`; `at(polar)` gives that realisation's solve from above at `polar`,
+/// `paper` its (albedo, `R_dd↑`, `T_d`) at that wavelength.
+fn reflectance_factor<'e>(
+    m: Measurement,
+    spec: &AppearanceSpec,
+    at: &dyn Fn(f64) -> Result<&'e SolveEntry, AppearanceError>,
+    paper: Option<(f64, f64, f64)>,
+) -> Result<f64, AppearanceError> {
+    let t = |polar: f64| -> Result<f64, AppearanceError> {
+        Ok(at(polar)?.efficiencies.total_transmittance)
+    };
+    Ok(match m {
+        Measurement::FortyFiveZero => {
+            let e = &at(45.0)?.efficiencies;
+            let f_layer = table::spread(e, Part::DiffuseReflection, spec.table)
+                .value_at(0.0, spec.azimuth_deg);
+            let f_paper = match paper {
+                Some((albedo, rdd, _)) => albedo * t(45.0)? * t(0.0)? / (PI * (1.0 - albedo * rdd)),
+                None => 0.0,
+            };
+            colour::lambertian_reflectance(f_layer + f_paper)
+        }
+        Measurement::DiffuseEightSci | Measurement::DiffuseEightSce => {
+            let e = &at(8.0)?.efficiencies;
+            let mut v = e.total_reflectance;
+            if let Some((albedo, rdd, td)) = paper {
+                v += albedo * td * e.total_transmittance / (1.0 - albedo * rdd);
+            }
+            if m == Measurement::DiffuseEightSce {
+                v -= e.r00.norm_sqr();
+            }
+            v
+        }
+    })
+}
+
+/// The same reflectance factor for the spectral proxy (the homogeneous slab
+/// on the same paper, whose reflection is all specular), on its fine grid.
+fn proxy_factor(m: Measurement, p: &SpectralProxy, albedo: f64, spec: &AppearanceSpec) -> Vec<f64> {
+    let h = spec
+        .below
+        .as_ref()
+        .expect("a proxy comes with paper and its quadrature");
+    p.wavelengths_nm
+        .iter()
+        .zip(&p.eps)
+        .map(|(&wl, &eps)| {
+            let rt = |polar: f64| {
+                let s = airy::slab(eps, p.thickness_nm, wl, polar);
+                (s.r.norm_sqr(), s.t.norm_sqr())
+            };
+            let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(rt).collect();
+            let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
+            let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
+            let denom = 1.0 - albedo * rdd;
+            match m {
+                Measurement::FortyFiveZero => albedo * rt(45.0).1 * rt(0.0).1 / denom,
+                Measurement::DiffuseEightSci => rt(8.0).0 + albedo * td * rt(8.0).1 / denom,
+                Measurement::DiffuseEightSce => albedo * td * rt(8.0).1 / denom,
+            }
+        })
+        .collect()
+}
+
+/// Colours of every geometry in `spec.measurements` from the solves.
+pub(super) fn measure(
+    spec: &AppearanceSpec,
+    entries: &[SolveEntry],
+    paper: Option<PaperPerRealisation<'_>>,
+    observer: &Observer,
+) -> Result<Vec<MeasuredColour>, AppearanceError> {
+    let rr = spec.realisations;
+    let wl = &spec.wavelengths_nm;
+    let mut out = Vec::with_capacity(spec.measurements.len());
+    for &m in &spec.measurements {
+        for &polar in m.above_deg() {
+            if !spec.above_deg.contains(&polar) {
+                return Err(AppearanceError::NotSolved(polar));
+            }
+        }
+        let mut samples = Vec::with_capacity(rr);
+        for r in 0..rr {
+            let mut v = Array1::zeros(wl.len());
+            for (l, &w) in wl.iter().enumerate() {
+                let at = |polar: f64| {
+                    entries
+                        .iter()
+                        .find(|e| {
+                            e.side == Side::Above
+                                && e.realisation == r
+                                && e.wavelength_nm == w
+                                && e.incidence.polar_deg == polar
+                        })
+                        .ok_or(AppearanceError::Missing {
+                            side: Side::Above,
+                            realisation: r,
+                            wavelength_nm: w,
+                            polar_deg: polar,
+                        })
+                };
+                let p = paper
+                    .as_ref()
+                    .map(|p| (p.albedo, p.r_dd_up[r][l], p.t_d[r][l]));
+                v[l] = reflectance_factor(m, spec, &at, p)?;
+            }
+            samples.push(v);
+        }
+        let proxy = match (&spec.proxy, &paper) {
+            (Some(p), Some(pp)) => Some((p, proxy_factor(m, p, pp.albedo, spec))),
+            _ => None,
+        };
+        let spectrum_of = |values: &Array1<f64>| -> (Vec<f64>, Vec<f64>) {
+            match &proxy {
+                Some((p, fine)) => (
+                    p.wavelengths_nm.clone(),
+                    through_proxy(wl, values.as_slice().unwrap(), &p.wavelengths_nm, fine),
+                ),
+                None => (wl.clone(), values.to_vec()),
+            }
+        };
+        let lab_of = |values: &Array1<f64>| -> Result<([f64; 3], [f64; 3]), AppearanceError> {
+            let (w, s) = spectrum_of(values);
+            let xyz = colour::xyz_from_reflectance(observer, &w, &s)?;
+            Ok((xyz, colour::xyz_to_lab(xyz, observer.white_xyz())))
+        };
+        let reflectance = reduce(&samples);
+        let (spectrum_wavelengths_nm, spectrum) = spectrum_of(&reflectance.mean);
+        let (xyz, lab) = lab_of(&reflectance.mean)?;
+        let (mut lab_se, mut de00_se) = (None, None);
+        if rr >= 2 {
+            let labs: Vec<[f64; 3]> = samples
+                .iter()
+                .map(|s| lab_of(s).map(|x| x.1))
+                .collect::<Result<_, _>>()?;
+            let as_arrays: Vec<Array1<f64>> =
+                labs.iter().map(|l| Array1::from(l.to_vec())).collect();
+            let se = reduce(&as_arrays).se.expect("two or more realisations");
+            lab_se = Some([se[0], se[1], se[2]]);
+            de00_se = Some(de00_standard_error(&labs, lab));
+        }
+        out.push(MeasuredColour {
+            geometry: m,
+            reflectance,
+            spectrum_wavelengths_nm,
+            spectrum,
+            xyz,
+            lab,
+            lch: colour::lab_to_lch(lab),
+            lab_se,
+            de00_se,
+        });
+    }
+    Ok(out)
+}

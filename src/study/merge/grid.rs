@@ -1,0 +1,207 @@
+//! The comparison grids: for one grid declaration, one picture per
+//! combination of the labels of the axes that are neither rows, columns nor
+//! fixed by `where`, each cell the variant's tile shrunk to at most
+//! [`CELL_PX`] pixels.
+
+use crate::output::h5;
+use crate::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
+use crate::study::run;
+use crate::study::sweep::{sanitise, Expansion, GridDecl, Study, Variant};
+use crate::study::StudyError;
+
+/// Largest side of a tile in a comparison grid, pixels.
+pub const CELL_PX: usize = 200;
+const PAD: usize = 8;
+const BG: [u8; 3] = [255, 255, 255];
+const INK: [u8; 3] = [20, 20, 20];
+const EMPTY: [u8; 3] = [215, 215, 215];
+
+/// Labels of `axis` in axis order, restricted to `only` when given.
+fn axis_labels(study: &Study, axis: &str, only: &Option<Vec<String>>) -> Vec<String> {
+    match only {
+        Some(l) => l.clone(),
+        None => study
+            .axes
+            .iter()
+            .find(|a| a.name == axis)
+            .map(|a| a.values.iter().map(|v| v.label.clone()).collect())
+            .unwrap_or_default(),
+    }
+}
+
+/// The pictures of one grid declaration: (file name, title, canvas).
+pub(super) fn draw_grid(
+    study: &Study,
+    exp: &Expansion,
+    g: &GridDecl,
+) -> Result<Vec<(String, String, Canvas)>, StudyError> {
+    let split: Vec<&str> = study
+        .axes
+        .iter()
+        .map(|a| a.name.as_str())
+        .filter(|a| *a != g.rows && *a != g.cols && !g.where_.contains_key(*a))
+        .collect();
+    let rows = axis_labels(study, &g.rows, &g.row_labels);
+    let cols = axis_labels(study, &g.cols, &g.col_labels);
+    let fits = |v: &Variant| {
+        g.where_.iter().all(|(a, l)| v.label(a) == Some(l))
+            && v.label(&g.rows)
+                .is_some_and(|l| rows.iter().any(|x| x == l))
+            && v.label(&g.cols)
+                .is_some_and(|l| cols.iter().any(|x| x == l))
+    };
+    // Distinct combinations of the split axes among the fitting variants, in
+    // expansion order.
+    let mut combos: Vec<Vec<Option<String>>> = vec![];
+    for v in exp.variants.iter().filter(|v| fits(v)) {
+        let c: Vec<Option<String>> = split
+            .iter()
+            .map(|a| v.label(a).map(str::to_string))
+            .collect();
+        if !combos.contains(&c) {
+            combos.push(c);
+        }
+    }
+    let mut out = vec![];
+    for combo in combos {
+        let cell = |r: &str, c: &str| {
+            exp.variants.iter().find(|v| {
+                fits(v)
+                    && v.label(&g.rows) == Some(r)
+                    && v.label(&g.cols) == Some(c)
+                    && split
+                        .iter()
+                        .zip(&combo)
+                        .all(|(a, l)| v.label(a) == l.as_deref())
+            })
+        };
+        let mut tiles: Vec<Vec<Option<Canvas>>> = vec![];
+        for r in &rows {
+            let mut line = vec![];
+            for c in &cols {
+                line.push(match cell(r, c) {
+                    Some(v) => {
+                        let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
+                            StudyError::Io(h5::IoError::File {
+                                path: run::paths(v).1,
+                                source,
+                            })
+                        })?;
+                        Some(shrink(&Canvas::decode_png(&bytes)?, CELL_PX))
+                    }
+                    None => None,
+                });
+            }
+            tiles.push(line);
+        }
+        let mut fixed: Vec<String> = g.where_.iter().map(|(a, l)| format!("{a} {l}")).collect();
+        let mut suffix = String::new();
+        for (a, l) in split.iter().zip(&combo) {
+            let l = l.as_deref().unwrap_or("none");
+            fixed.push(format!("{a} {l}"));
+            suffix += &format!("__{}-{}", sanitise(a), sanitise(l));
+        }
+        let title = format!(
+            "{} {}: {}{}",
+            study.name,
+            exp.profile.as_deref().unwrap_or(""),
+            g.name,
+            if fixed.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", fixed.join(", "))
+            }
+        );
+        let subtitle = format!("rows: {}, columns: {}", g.rows, g.cols);
+        let canvas = compose(&title, &subtitle, &rows, &cols, &tiles);
+        out.push((format!("{}{suffix}.png", g.name), title, canvas));
+    }
+    Ok(out)
+}
+
+/// Shrink by the smallest integer factor that brings both sides to ≤ `max`
+/// (box average).
+pub fn shrink(src: &Canvas, max: usize) -> Canvas {
+    let f = src.w.div_ceil(max).max(src.h.div_ceil(max)).max(1);
+    if f == 1 {
+        return Canvas {
+            w: src.w,
+            h: src.h,
+            px: src.px.clone(),
+        };
+    }
+    let (w, h) = (src.w / f, src.h / f);
+    let mut out = Canvas::new(w.max(1), h.max(1), BG);
+    for y in 0..h {
+        for x in 0..w {
+            let mut acc = [0usize; 3];
+            for dy in 0..f {
+                for dx in 0..f {
+                    let i = ((y * f + dy) * src.w + x * f + dx) * 3;
+                    for (a, &p) in acc.iter_mut().zip(&src.px[i..i + 3]) {
+                        *a += p as usize;
+                    }
+                }
+            }
+            let n = f * f;
+            let o = (y * w + x) * 3;
+            for (p, a) in out.px[o..o + 3].iter_mut().zip(acc) {
+                *p = ((a + n / 2) / n) as u8;
+            }
+        }
+    }
+    out
+}
+
+/// Lay out a labelled grid of tiles.
+fn compose(
+    title: &str,
+    subtitle: &str,
+    rows: &[String],
+    cols: &[String],
+    tiles: &[Vec<Option<Canvas>>],
+) -> Canvas {
+    let all = tiles.iter().flatten().flatten();
+    let tw = all.clone().map(|c| c.w).max().unwrap_or(CELL_PX / 2);
+    let th = all.map(|c| c.h).max().unwrap_or(CELL_PX / 2);
+    let cw = tw.max(cols.iter().map(|c| text_width(c)).max().unwrap_or(0)) + PAD;
+    let ch = th + PAD;
+    let lw = rows.iter().map(|r| text_width(r)).max().unwrap_or(0) + 2 * PAD;
+    let head = 3 * (GLYPH_HEIGHT + PAD) + PAD;
+    let w = (lw + cols.len() * cw + PAD).max(text_width(title).max(text_width(subtitle)) + 2 * PAD);
+    let h = head + rows.len() * ch + PAD;
+    let mut c = Canvas::new(w, h, BG);
+    c.text(PAD, PAD, title, INK);
+    c.text(PAD, 2 * PAD + GLYPH_HEIGHT, subtitle, INK);
+    let y0 = head;
+    for (j, col) in cols.iter().enumerate() {
+        let x = lw + j * cw + (cw - text_width(col)) / 2;
+        c.text(x, y0 - GLYPH_HEIGHT - PAD / 2, col, INK);
+    }
+    for (i, row) in rows.iter().enumerate() {
+        let y = y0 + i * ch;
+        c.text(PAD, y + (ch - GLYPH_HEIGHT) / 2, row, INK);
+        for (j, tile) in tiles[i].iter().enumerate().take(cols.len()) {
+            let x = lw + j * cw;
+            match tile {
+                Some(t) => c.blit(t, (x + (cw - t.w) / 2) as i64, (y + (ch - t.h) / 2) as i64),
+                None => {
+                    c.rect(
+                        (x + PAD / 2) as i64,
+                        (y + PAD / 2) as i64,
+                        cw - PAD,
+                        th,
+                        EMPTY,
+                    );
+                    c.text(
+                        x + (cw - text_width("-")) / 2,
+                        y + (ch - GLYPH_HEIGHT) / 2,
+                        "-",
+                        INK,
+                    );
+                }
+            }
+        }
+    }
+    c
+}

@@ -1,12 +1,20 @@
-//! The study driver: a sweep of scene variants run resumably on one machine
-//! or sharded over a cluster (issue #5). The last stage: it reads sweep
-//! files, builds scene variants through `config`, runs them through
-//! [`pipeline::run`](crate::pipeline::run), reads results back through `io`
-//! and draws comparison grids with `render`.
+//! The study driver: a sweep of scene variants, run resumably on one machine
+//! or sharded over a cluster. The last stage.
 //!
-//! - [`sweep`]: the sweep file (base scene, profiles, axes, zips, explicit
-//!   variants, exclusions, grids) expanded into named, seeded, validated
-//!   variants — every error is found before any work starts.
+//! Takes a sweep file (a base scene, profiles, axes, zips, exclusions,
+//! explicit variants, grids). Gives, before any work starts, every variant
+//! as a named, seeded scene checked by [`config`](crate::config); then runs
+//! the variants through [`pipeline::run`](crate::pipeline::run) (each result
+//! file written atomically, finished ones skipped by their input hash), and
+//! merges the finished results, read back through
+//! [`output::h5`](crate::output::h5), into a summary file, a summary page
+//! and comparison grids drawn with [`output::render`](crate::output::render).
+//! It owns the sweep format, the variant naming and seeding, sharding, the
+//! cost model of `plan` and the sbatch script; errors are [`StudyError`]s
+//! naming the file and what is allowed.
+//!
+//! - [`sweep`]: the sweep file, checked into a [`Study`] and expanded per
+//!   profile into [`Variant`]s — every error is found before any work.
 //! - [`plan`]: the work and the estimated time and memory of each variant.
 //! - [`run`]: runs the variants (in parallel, sharded, resumable).
 //! - [`merge`]: the summary HDF5, the comparison grids and the summary page.

@@ -1,0 +1,92 @@
+//! The command bodies of the `inksim` binary. `main.rs` holds the clap
+//! definitions and the dispatch; each module here takes the parsed flags of
+//! its commands, loads the scene or study through the library, runs it and
+//! prints what it did.
+//!
+//! - [`scene`]: `run`, `geometry` and `check` of one scene.
+//! - [`study`]: `run`, `check` and `merge` of a study.
+//! - [`plan`]: `plan`, the variants with their work and estimated time and
+//!   memory.
+//! - [`slurm`]: `slurm`, the sbatch job-array script.
+//!
+//! Shared here: how an error is printed, a broken pipe ends quietly, which
+//! files are studies, the thread count and the shard.
+
+pub mod plan;
+pub mod scene;
+pub mod slurm;
+pub mod study;
+
+use anyhow::Result;
+use inksim::study::run::Shard;
+use inksim::study::Study;
+use std::path::{Path, PathBuf};
+
+/// Output piped into a reader that stops early (`inksim plan … | head`):
+/// end quietly, as ripgrep does, instead of a panic message.
+pub fn exit_quietly_on_broken_pipe() {
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let msg = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("Broken pipe") {
+            std::process::exit(0);
+        }
+        default_hook(info)
+    }));
+}
+
+/// The error and its causes, `: `-joined; a cause whose text its parent's
+/// message already contains (library errors that name their source) is not
+/// repeated.
+pub fn chain(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let msg = cause.to_string();
+        if !out.contains(&msg) {
+            if !out.is_empty() {
+                out.push_str(": ");
+            }
+            out.push_str(&msg);
+        }
+    }
+    out
+}
+
+/// Whether `path` is a study file (has a [study] table); unreadable files
+/// are left to the scene loader, which names them.
+pub fn is_study(path: &Path) -> bool {
+    std::fs::read_to_string(path)
+        .map(|t| inksim::study::is_study_text(&t))
+        .unwrap_or(false)
+}
+
+/// Read and check a study; `output_dir` (from `--output-dir`) replaces its
+/// `study.output_dir`.
+pub fn load_study(path: &Path, output_dir: Option<PathBuf>) -> Result<Study> {
+    let mut study = Study::load(path)?;
+    if let Some(d) = output_dir {
+        study.output_dir = d;
+    }
+    Ok(study)
+}
+
+/// The worker threads: `--threads`, else all cores.
+pub fn threads(cli: Option<usize>) -> usize {
+    cli.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// The shard to run: `--shard I/N`, else from the Slurm array variables,
+/// else the whole study.
+pub fn shard_of(flag: Option<&str>) -> Result<Shard> {
+    match flag {
+        Some(s) => Shard::parse(s).map_err(anyhow::Error::msg),
+        None => Ok(Shard::from_env(|k| std::env::var(k).ok())
+            .map_err(anyhow::Error::msg)?
+            .unwrap_or(Shard::ALL)),
+    }
+}

@@ -1,0 +1,80 @@
+//! The commands on one scene: `run`, `geometry` and `check`.
+
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+
+/// `inksim run SCENE`: the whole pipeline; prints where the results went and
+/// the worst energy balance.
+pub fn run(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
+    let mut scene = inksim::config::load_scene(config)?;
+    if let Some(d) = output_dir {
+        scene.output.dir = d;
+    }
+    let report = inksim::pipeline::run(&scene)?;
+    let worst = report
+        .entries
+        .iter()
+        .map(|e| e.efficiencies.energy_balance.abs())
+        .fold(0.0, f64::max);
+    println!("results: {}", report.result_path.display());
+    println!("picture: {}", report.picture_path.display());
+    println!(
+        "{} solves, worst energy balance |ΣR+ΣT+A−1| = {worst:.1e}",
+        report.entries.len()
+    );
+    Ok(())
+}
+
+/// `inksim geometry SCENE`: the layer only.
+pub fn geometry(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
+    let mut scene = inksim::config::load_scene(config)?;
+    if let Some(d) = output_dir {
+        scene.output.dir = d;
+    }
+    let report = inksim::pipeline::run_geometry(&scene)?;
+    for l in &report.lines {
+        println!("{l}");
+    }
+    println!("geometry: {}", report.result_path.display());
+    println!("picture: {}", report.picture_path.display());
+    Ok(())
+}
+
+/// `inksim check SCENE`: validate and print what a run would compute.
+pub fn check(config: &Path) -> Result<()> {
+    let scene = inksim::config::load_scene(config)?;
+    let g = scene.grid;
+    println!("{}: valid", config.display());
+    println!(
+        "layer {} nm on a {} × {} nm fragment; grid {} × {} × {} = {} voxels",
+        scene.layer.thickness_nm,
+        scene.layer.fragment_x_nm,
+        scene.layer.fragment_y_nm,
+        g.nx,
+        g.ny,
+        g.nz,
+        g.nx * g.ny * g.nz
+    );
+    let run_plan = inksim::pipeline::RunPlan::of(&scene);
+    println!(
+        "{} solves ({} wavelengths × {} realisations × {} incidences), method {:?}, \
+         tolerance {:.0e}",
+        run_plan.solves(&scene),
+        scene.wavelengths_nm.len(),
+        run_plan.realisations,
+        run_plan.solves_per_wavelength(),
+        scene.solver.method,
+        scene.solver.tolerance
+    );
+    println!("plan:");
+    for line in &run_plan.lines {
+        println!("  {line}");
+    }
+    println!("expected error of these settings:");
+    for line in inksim::pipeline::accuracy::expected_error(&scene) {
+        println!("  {line}");
+    }
+    let (h5, png) = inksim::pipeline::result_paths(&scene);
+    println!("would write {} and {}", h5.display(), png.display());
+    Ok(())
+}

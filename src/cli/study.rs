@@ -1,0 +1,122 @@
+//! The commands on a study: `run`, `check` and `merge`.
+
+use anyhow::{bail, Result};
+use inksim::study::plan;
+use inksim::study::run::{self as srun, RunOptions, State};
+use inksim::study::sweep::Expansion;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// `inksim run STUDY`: every unfinished variant (of the shard); the exit
+/// code says whether any failed.
+pub fn run(
+    config: &Path,
+    output_dir: Option<PathBuf>,
+    profile: Option<&str>,
+    shard: Option<&str>,
+    jobs: Option<usize>,
+    nthreads: usize,
+) -> Result<ExitCode> {
+    let study = super::load_study(config, output_dir)?;
+    let shard = super::shard_of(shard)?;
+    let exp = study.expand(profile)?;
+    let to_run = exp
+        .variants
+        .iter()
+        .filter(|v| shard.contains(v.index))
+        .count();
+    let jobs = match jobs {
+        Some(0) => bail!("--jobs must be at least 1"),
+        Some(j) => j,
+        None => srun::default_jobs(nthreads, peak_bytes(&exp), to_run),
+    };
+    eprintln!(
+        "[inksim] study {} profile {}: {} variants ({} in shard {}/{}), results in {}",
+        study.name,
+        exp.profile.as_deref().unwrap_or("(none)"),
+        exp.variants.len(),
+        to_run,
+        shard.index,
+        shard.count,
+        exp.study_dir.join("variants").display()
+    );
+    let report = srun::run_variants(
+        &exp.variants,
+        &RunOptions {
+            jobs,
+            shard,
+            quiet: false,
+        },
+    );
+    print!("{}", report.text());
+    let all_done = exp.variants.iter().all(|v| srun::state(v) == State::Done);
+    if all_done {
+        println!(
+            "all {} variants finished; next: inksim merge {}{}",
+            exp.variants.len(),
+            config.display(),
+            exp.profile
+                .as_deref()
+                .map(|p| format!(" --profile {p}"))
+                .unwrap_or_default()
+        );
+    }
+    Ok(if report.failed().next().is_some() {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// `inksim check STUDY`: expand every profile (which validates every
+/// variant's scene) and say how many variants each has.
+pub fn check(config: &Path) -> Result<()> {
+    let study = super::load_study(config, None)?;
+    let profiles: Vec<Option<String>> = if study.profiles.is_empty() {
+        vec![None]
+    } else {
+        study.profiles.keys().cloned().map(Some).collect()
+    };
+    println!("{}: valid study `{}`", config.display(), study.name);
+    for p in profiles {
+        let exp = study.expand(p.as_deref())?;
+        println!(
+            "profile {}: {} variants, all valid scenes; results in {}",
+            p.as_deref().unwrap_or("(none)"),
+            exp.variants.len(),
+            exp.study_dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// `inksim merge STUDY`: the summary file, page and grids of a finished
+/// study.
+pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) -> Result<()> {
+    let study = super::load_study(config, output_dir)?;
+    let exp = study.expand(profile)?;
+    let r = inksim::study::merge::merge(&study, &exp)?;
+    println!("summary: {}", r.summary_h5.display());
+    println!(
+        "page: {} and {}",
+        r.summary_md.display(),
+        r.summary_html.display()
+    );
+    for g in &r.grids {
+        println!("grid: {}", g.display());
+    }
+    Ok(())
+}
+
+/// Largest memory estimate over the variants (bytes).
+fn peak_bytes(exp: &Expansion) -> f64 {
+    let cal = plan::Calibration {
+        grids: Default::default(),
+        applications: plan::DEFAULT_APPLICATIONS,
+        applications_source: String::new(),
+    };
+    exp.variants
+        .iter()
+        .map(|v| plan::estimate(&v.scene, &cal).bytes)
+        .fold(0.0, f64::max)
+}

@@ -225,7 +225,9 @@ impl Study {
         })?;
         Study::parse(path, &text)
     }
-    /// Parse sweep `text` read from `path`.
+
+    /// Parse sweep `text` read from `path`: the TOML into the raw structs,
+    /// then the checks.
     pub fn parse(path: &Path, text: &str) -> Result<Study, StudyError> {
         let raw: RawSweep = toml::from_str(text).map_err(|e| {
             sweep_error(
@@ -287,6 +289,7 @@ fn sweep_error(file: &Path, message: String) -> StudyError {
     }
 }
 
+/// The names, `, `-joined, or `(none)`.
 fn list_or_none<'a>(it: impl Iterator<Item = &'a String>) -> String {
     let v: Vec<&str> = it.map(String::as_str).collect();
     if v.is_empty() {

@@ -31,21 +31,12 @@
 //! kept in a periodic (x, y) cell grid with cells at least one sphere
 //! diameter wide, so a move costs O(1).
 
-use super::cells::near_image;
+use super::cells::{CellGrid, LinkedCells};
+use super::periodic::{near_image, wrap};
 use super::shapes::union_volume;
 use super::Particle;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-
-/// `x` wrapped into `[0, l)`.
-fn wrap(x: f64, l: f64) -> f64 {
-    let w = x.rem_euclid(l);
-    if w >= l {
-        0.0
-    } else {
-        w
-    }
-}
 
 /// Contact gap of sticking mates, in units of the smallest sphere radius
 /// (the default contact gap of the cluster statistics).
@@ -82,53 +73,6 @@ fn effective_diameter(size: &[f64; 3], p: &Particle) -> f64 {
         })
         .collect();
     (6.0 * union_volume(&axial) / std::f64::consts::PI).cbrt()
-}
-
-struct Cells {
-    n: [usize; 3],
-    w: [f64; 3],
-    z0: f64,
-    list: Vec<Vec<u32>>,
-}
-
-impl Cells {
-    fn index(&self, c: &[f64; 3]) -> usize {
-        let i = ((c[0] / self.w[0]).floor() as isize).rem_euclid(self.n[0] as isize) as usize;
-        let j = ((c[1] / self.w[1]).floor() as isize).rem_euclid(self.n[1] as isize) as usize;
-        let k = (((c[2] - self.z0) / self.w[2]).floor().max(0.0) as usize).min(self.n[2] - 1);
-        (k * self.n[1] + j) * self.n[0] + i
-    }
-
-    fn coords(&self, f: usize) -> [usize; 3] {
-        [
-            f % self.n[0],
-            (f / self.n[0]) % self.n[1],
-            f / (self.n[0] * self.n[1]),
-        ]
-    }
-
-    fn range(&self, a: usize, c: usize) -> (isize, isize) {
-        super::cells::stencil(self.n[a], c, a < 2)
-    }
-
-    /// Flat indices of the cells around the one holding `t`, each once
-    /// (periodic in x and y, clipped in z).
-    fn around(&self, t: &[f64; 3]) -> impl Iterator<Item = usize> + '_ {
-        let cc = self.coords(self.index(t));
-        let (z0, z1) = self.range(2, cc[2]);
-        let (y0, y1) = self.range(1, cc[1]);
-        let (x0, x1) = self.range(0, cc[0]);
-        let n = self.n;
-        (z0..=z1).flat_map(move |cz| {
-            (y0..=y1).flat_map(move |cy| {
-                let wy = cy.rem_euclid(n[1] as isize) as usize;
-                (x0..=x1).map(move |cx| {
-                    let wx = cx.rem_euclid(n[0] as isize) as usize;
-                    (cz as usize * n[1] + wy) * n[0] + wx
-                })
-            })
-        })
-    }
 }
 
 /// Equilibrates `particles` in the fragment `size` by `sweeps` Monte Carlo
@@ -189,18 +133,9 @@ pub fn equilibrate(
             0.0
         };
     let span = [size[0], size[1], size[2] - z_lo + allow_nm.max(0.0)];
-    let cn = [0, 1, 2].map(|a| ((span[a] / width).floor() as usize).max(1));
-    let mut cells = Cells {
-        n: cn,
-        w: [0, 1, 2].map(|a| span[a] / cn[a] as f64),
-        z0: z_lo,
-        list: vec![Vec::new(); cn[0] * cn[1] * cn[2]],
-    };
-    let mut cell_of: Vec<u32> = Vec::with_capacity(pos.len());
-    for (q, c) in pos.iter().enumerate() {
-        let f = cells.index(c);
-        cells.list[f].push(q as u32);
-        cell_of.push(f as u32);
+    let mut cells = LinkedCells::new(CellGrid::shifted(z_lo, span, width, pos.len()), pos.len());
+    for c in &pos {
+        cells.push(c);
     }
 
     // Members of every seeded agglomerate of two or more particles.
@@ -238,14 +173,9 @@ pub fn equilibrate(
             for q in start[p]..start[p + 1] {
                 let c = pos[q];
                 let t = [
-                    (c[0] + dv[0]).rem_euclid(size[0]),
-                    (c[1] + dv[1]).rem_euclid(size[1]),
+                    wrap(c[0] + dv[0], size[0]),
+                    wrap(c[1] + dv[1], size[1]),
                     c[2] + dv[2],
-                ];
-                let t = [
-                    if t[0] >= size[0] { 0.0 } else { t[0] },
-                    if t[1] >= size[1] { 0.0 } else { t[1] },
-                    t[2],
                 ];
                 if t[2] - rad[q] < z_min[p] || t[2] + rad[q] > h + allow_nm {
                     ok = false;
@@ -254,40 +184,40 @@ pub fn equilibrate(
                 trial.push(t);
             }
             if ok {
-                'spheres: for (k, t) in trial.iter().enumerate() {
+                let g = groups.get(p).copied().unwrap_or(u32::MAX);
+                for (k, t) in trial.iter().enumerate() {
                     let r = rad[start[p] + k];
-                    for f in cells.around(t) {
-                        for &o in &cells.list[f] {
-                            let o = o as usize;
-                            if owner[o] as usize == p {
-                                continue;
-                            }
-                            let b = pos[o];
-                            let dx = near_image(t[0] - b[0], size[0]);
-                            let dy = near_image(t[1] - b[1], size[1]);
-                            let dz = t[2] - b[2];
-                            let reach = r + rad[o] - allow_nm;
-                            let d2 = dx * dx + dy * dy + dz * dz;
-                            if reach > 0.0 && d2 < reach * reach {
-                                ok = false;
-                                break 'spheres;
-                            }
-                            let g = groups.get(p).copied().unwrap_or(u32::MAX);
-                            if sticky && g != u32::MAX && groups[owner[o] as usize] == g {
-                                let touch = r + rad[o] + contact_nm;
-                                let a = pos[start[p] + k];
-                                let old = [
-                                    near_image(a[0] - b[0], size[0]),
-                                    near_image(a[1] - b[1], size[1]),
-                                    a[2] - b[2],
-                                ];
-                                let o2 = old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
-                                if o2 <= touch * touch && d2 > touch * touch {
-                                    ok = false;
-                                    break 'spheres;
-                                }
+                    let clash = cells.any_near(t, |o| {
+                        if owner[o] as usize == p {
+                            return false;
+                        }
+                        let b = pos[o];
+                        let dx = near_image(t[0] - b[0], size[0]);
+                        let dy = near_image(t[1] - b[1], size[1]);
+                        let dz = t[2] - b[2];
+                        let reach = r + rad[o] - allow_nm;
+                        let d2 = dx * dx + dy * dy + dz * dz;
+                        if reach > 0.0 && d2 < reach * reach {
+                            return true;
+                        }
+                        if sticky && g != u32::MAX && groups[owner[o] as usize] == g {
+                            let touch = r + rad[o] + contact_nm;
+                            let a = pos[start[p] + k];
+                            let old = [
+                                near_image(a[0] - b[0], size[0]),
+                                near_image(a[1] - b[1], size[1]),
+                                a[2] - b[2],
+                            ];
+                            let o2 = old[0] * old[0] + old[1] * old[1] + old[2] * old[2];
+                            if o2 <= touch * touch && d2 > touch * touch {
+                                return true;
                             }
                         }
+                        false
+                    });
+                    if clash {
+                        ok = false;
+                        break;
                     }
                 }
             }
@@ -298,15 +228,7 @@ pub fn equilibrate(
             for (k, t) in trial.iter().enumerate() {
                 let q = start[p] + k;
                 pos[q] = *t;
-                let f = cells.index(t);
-                let old = cell_of[q] as usize;
-                if f != old {
-                    let v = &mut cells.list[old];
-                    let at = v.iter().position(|&x| x as usize == q).unwrap_or(0);
-                    v.swap_remove(at);
-                    cells.list[f].push(q as u32);
-                    cell_of[q] = f as u32;
-                }
+                cells.update(q, t);
             }
         }
         // One rigid move per agglomerate, so that agglomerates left touching
@@ -332,22 +254,20 @@ pub fn equilibrate(
                         ok = false;
                         break 'members;
                     }
-                    for f in cells.around(&t) {
-                        for &o in &cells.list[f] {
-                            let o = o as usize;
-                            if groups[owner[o] as usize] == g {
-                                continue;
-                            }
-                            let b = pos[o];
-                            let dx = near_image(t[0] - b[0], size[0]);
-                            let dy = near_image(t[1] - b[1], size[1]);
-                            let dz = t[2] - b[2];
-                            let reach = rad[q] + rad[o] - allow_nm;
-                            if reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach {
-                                ok = false;
-                                break 'members;
-                            }
+                    let clash = cells.any_near(&t, |o| {
+                        if groups[owner[o] as usize] == g {
+                            return false;
                         }
+                        let b = pos[o];
+                        let dx = near_image(t[0] - b[0], size[0]);
+                        let dy = near_image(t[1] - b[1], size[1]);
+                        let dz = t[2] - b[2];
+                        let reach = rad[q] + rad[o] - allow_nm;
+                        reach > 0.0 && dx * dx + dy * dy + dz * dz < reach * reach
+                    });
+                    if clash {
+                        ok = false;
+                        break 'members;
                     }
                     trial.push(t);
                 }
@@ -355,21 +275,11 @@ pub fn equilibrate(
             if !ok {
                 continue;
             }
-            let mut k = 0;
+            let mut moved = trial.iter();
             for &p in members {
-                for q in start[p]..start[p + 1] {
-                    let t = trial[k];
-                    k += 1;
-                    pos[q] = t;
-                    let f = cells.index(&t);
-                    let old = cell_of[q] as usize;
-                    if f != old {
-                        let v = &mut cells.list[old];
-                        let at = v.iter().position(|&x| x as usize == q).unwrap_or(0);
-                        v.swap_remove(at);
-                        cells.list[f].push(q as u32);
-                        cell_of[q] = f as u32;
-                    }
+                for (q, t) in (start[p]..start[p + 1]).zip(&mut moved) {
+                    pos[q] = *t;
+                    cells.update(q, t);
                 }
             }
         }

@@ -19,13 +19,19 @@
 //!   bulk, lower next to walls); it runs to saturation (sampling only the
 //!   uncovered space once plain draws fail) and reports
 //!   [`GeometryError::NotReached`] with the exact saturation density.
+//!
+//! Shared by the packers and the statistics: `cells` (the one cell grid and
+//! its storages), `periodic` (wrapping and nearest periodic images) and
+//! `vec3` (3-vector helpers).
 
 mod cells;
 mod dynamics;
 pub mod mc;
+mod periodic;
 mod rsa;
 mod shapes;
 pub mod stats;
+mod vec3;
 
 pub use dynamics::{
     pack_dynamics, particle_axis, DynParams, DynSpecies, DynamicsPacker, PARALLEL_MIN_PARTICLES,
@@ -36,7 +42,8 @@ pub use shapes::{
 };
 pub use stats::{analyse, Statistics, StatsParams};
 
-use cells::{dist2, CellList};
+use cells::CellList;
+use periodic::dist2;
 use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 

@@ -33,7 +33,8 @@
 //! new group. One RNG stream (`Xoshiro256PlusPlus`), consumed sequentially:
 //! the result depends on the seed only.
 
-use super::cells::{min_image, CellList};
+use super::cells::CellList;
+use super::periodic::{min_image, wrap};
 use super::shapes::{axis_from_uniforms, Orientation};
 use super::{sphere_volume, GeometryError, PackParams, Particle, SpeciesOptions, Sphere};
 use rand::{Rng, SeedableRng};
@@ -200,17 +201,6 @@ fn draw_periodic(rng: &mut Xoshiro256PlusPlus, l: f64) -> f64 {
         0.0
     } else {
         x
-    }
-}
-
-/// `x` wrapped into `[0, l)`.
-#[inline]
-fn wrap(x: f64, l: f64) -> f64 {
-    let w = x.rem_euclid(l);
-    if w >= l {
-        0.0
-    } else {
-        w
     }
 }
 

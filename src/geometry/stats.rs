@@ -33,7 +33,9 @@
 //! The parallel parts (profile) sum per fixed chunk of particles and then in
 //! chunk order, so results do not depend on the thread count.
 
-use super::cells::{dist2, min_image, CellList};
+use super::cells::CellList;
+use super::periodic::{dist2, min_image};
+use super::vec3::norm;
 use super::shapes::{order_parameter, union_volume};
 use super::{min_gap_nm, sphere_volume, Geometry, Particle, Sphere};
 use rayon::prelude::*;
@@ -211,7 +213,7 @@ fn frame(size: [f64; 3], p: &Particle) -> Option<Frame> {
         .collect();
     let last = centers[centers.len() - 1];
     let d = [last[0] - o[0], last[1] - o[1], last[2] - o[2]];
-    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let n = norm(&d);
     let axis = (n > 0.0).then(|| [d[0] / n, d[1] / n, d[2] / n]);
     let mut collinear = true;
     let spheres = p
@@ -223,7 +225,7 @@ fn frame(size: [f64; 3], p: &Particle) -> Option<Frame> {
             let t = axis.map_or(0.0, |a| v[0] * a[0] + v[1] * a[1] + v[2] * a[2]);
             let a = axis.unwrap_or([0.0; 3]);
             let perp = [v[0] - t * a[0], v[1] - t * a[1], v[2] - t * a[2]];
-            let off = (perp[0] * perp[0] + perp[1] * perp[1] + perp[2] * perp[2]).sqrt();
+            let off = norm(&perp);
             if off > 1e-6 * s.radius.max(1e-300) {
                 collinear = false;
             }

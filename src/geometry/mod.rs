@@ -1,4 +1,4 @@
-//! Stage 1 — geometry of the fragment (METHOD §2).
+//! Geometry — the particles of the fragment (METHOD §2).
 //!
 //! Owns the particle list of one random fragment `[0,Lx) × [0,Ly) × [0,H]`,
 //! periodic in x and y with walls at `z = 0` and `z = H`, and the packers that

@@ -150,6 +150,25 @@ fn raw_spheres(shape: Shape) -> Result<Vec<(f64, f64)>, String> {
 /// Exact volume of the union of spheres centred on one axis, given as
 /// `(axial offset, radius)` (see the module docs).
 pub fn union_volume(spheres: &[(f64, f64)]) -> f64 {
+    let cuts = breakpoints(spheres);
+    let rho2 = |s: f64| {
+        spheres
+            .iter()
+            .map(|&(c, r)| r * r - (s - c) * (s - c))
+            .fold(0.0, f64::max)
+    };
+    cuts.windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            PI * (b - a) / 6.0 * (rho2(a) + 4.0 * rho2(0.5 * (a + b)) + rho2(b))
+        })
+        .sum()
+}
+
+/// Axial breakpoints of the union of spheres on one axis, `(axial offset,
+/// radius)`, ascending and distinct: the sphere ends and the pairwise
+/// crossings of the parabolas `r_i² − (s − s_i)²` (see the module docs).
+pub(crate) fn breakpoints(spheres: &[(f64, f64)]) -> Vec<f64> {
     let mut cuts: Vec<f64> = Vec::with_capacity(2 * spheres.len() + spheres.len().pow(2));
     for (i, &(si, ri)) in spheres.iter().enumerate() {
         cuts.push(si - ri);
@@ -164,18 +183,7 @@ pub fn union_volume(spheres: &[(f64, f64)]) -> f64 {
     cuts.retain(|c| c.is_finite());
     cuts.sort_by(f64::total_cmp);
     cuts.dedup();
-    let rho2 = |s: f64| {
-        spheres
-            .iter()
-            .map(|&(c, r)| r * r - (s - c) * (s - c))
-            .fold(0.0, f64::max)
-    };
-    cuts.windows(2)
-        .map(|w| {
-            let (a, b) = (w[0], w[1]);
-            PI * (b - a) / 6.0 * (rho2(a) + 4.0 * rho2(0.5 * (a + b)) + rho2(b))
-        })
-        .sum()
+    cuts
 }
 
 /// Draws a unit axis for `mode` from two uniform numbers in `[0, 1)`.

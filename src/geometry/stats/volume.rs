@@ -3,7 +3,7 @@
 //! exact union volume, and the cap / disc integrals of the profile.
 
 use crate::geometry::periodic::min_image;
-use crate::geometry::shapes::union_volume;
+use crate::geometry::shapes::{breakpoints, union_volume};
 use crate::geometry::vec3::norm;
 use crate::geometry::{sphere_volume, Particle};
 use std::f64::consts::PI;
@@ -140,19 +140,7 @@ pub(super) fn add_profile(f: &Frame, z0: f64, dz: f64, out: &mut [f64]) {
     let a = f.axis.unwrap_or([0.0, 0.0, 1.0]);
     let st = (1.0 - a[2] * a[2]).max(0.0).sqrt();
     let sp = &f.spheres;
-    let mut cuts: Vec<f64> = Vec::with_capacity(2 * sp.len() + sp.len() * sp.len());
-    for (i, &(si, ri)) in sp.iter().enumerate() {
-        cuts.push(si - ri);
-        cuts.push(si + ri);
-        for &(sj, rj) in &sp[i + 1..] {
-            if (si - sj).abs() > 0.0 {
-                cuts.push((rj * rj - ri * ri + si * si - sj * sj) / (2.0 * (si - sj)));
-            }
-        }
-    }
-    cuts.retain(|c| c.is_finite());
-    cuts.sort_by(f64::total_cmp);
-    cuts.dedup();
+    let cuts = breakpoints(sp);
     let lo_cut = sp.iter().map(|s| s.0 - s.1).fold(f64::INFINITY, f64::min);
     let hi_cut = sp
         .iter()

@@ -5,7 +5,7 @@
 //! two O(Nz) sweeps (down, then up with the assembly) that apply the exact
 //! Galerkin matrix of [`green`](super::green), and the inverse 2-D FFT. The
 //! sweeps run on blocks of `W` = 8 harmonics of one spectral row at a time
-//! (vectorised, see `shift::simd`), on a contiguous copy of the row. Fields
+//! (vectorised, see [`simd`](super::simd)), on a contiguous copy of the row. Fields
 //! hold the periodic part `v` of the Bloch field `u = v e^{iq·ρ}`, as z-cell
 //! averages, stored `(nz, ny, nx)`.
 //!
@@ -15,67 +15,15 @@
 //! [`Workspace`], owned by the caller, so applications never allocate.
 
 use super::fft::{Fft2, FftScratch};
-use super::green::{self, Slab};
-use super::shift::simd::{self, Cx, W};
-use super::shift::AHEAD;
+use super::green;
+use super::lattice::Lattice;
 use super::shift::{BandScratch, RowScratch, ShiftTable};
+use super::simd::{self, Cx, RowCells, W};
 use ndarray::{Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
-
-/// The Bloch–Fourier lattice of one problem.
-#[derive(Debug, Clone, Copy)]
-pub struct Lattice {
-    pub nx: usize,
-    pub ny: usize,
-    pub nz: usize,
-    /// Period Lx, Ly and thickness H (nm).
-    pub size_nm: [f64; 3],
-    /// Free-space wavenumber (rad/nm).
-    pub k0: f64,
-    /// Lateral wave vector of the incident wave (rad/nm).
-    pub q: [f64; 2],
-}
-
-impl Lattice {
-    /// Diffraction order of FFT index `i` on an axis of `n` points.
-    pub fn order(i: usize, n: usize) -> i32 {
-        if i < n.div_ceil(2) {
-            i as i32
-        } else {
-            i as i32 - n as i32
-        }
-    }
-
-    /// κ of the harmonic at FFT indices (ix, iy).
-    pub fn kappa(&self, ix: usize, iy: usize) -> [f64; 2] {
-        let tau = 2.0 * std::f64::consts::PI;
-        [
-            self.q[0] + tau * Self::order(ix, self.nx) as f64 / self.size_nm[0],
-            self.q[1] + tau * Self::order(iy, self.ny) as f64 / self.size_nm[1],
-        ]
-    }
-
-    /// β = sqrt(k0² − |κ|²) in vacuum (Im ≥ 0).
-    pub fn beta(&self, ix: usize, iy: usize) -> C64 {
-        let [kx, ky] = self.kappa(ix, iy);
-        green::sqrt_branch(C64::new(self.k0 * self.k0 - kx * kx - ky * ky, 0.0))
-    }
-
-    pub fn slab(&self) -> Slab {
-        Slab {
-            k0: self.k0,
-            thickness: self.size_nm[2],
-            nz: self.nz,
-        }
-    }
-
-    pub fn harmonics(&self) -> usize {
-        self.nx * self.ny
-    }
-}
 
 /// A harmonic near γ = 0, applied with a dense matrix.
 struct Special {
@@ -174,24 +122,8 @@ impl GreenTable {
             o.re = [1.0; W];
             o
         };
-        // The row's cells lie a power of two apart: copy them once to
-        // contiguous scratch, layout (block, cell), and back at the end.
-        let cells = &mut scr.cells[..nb * n];
-        for j in 0..n {
-            if j + AHEAD < n {
-                simd::prefetch(
-                    row.row(j + AHEAD)
-                        .as_slice()
-                        .expect("contiguous spectral row"),
-                );
-            }
-            let r = row.row(j);
-            let r = r.as_slice().expect("contiguous spectral row");
-            for b in 0..nb {
-                cells[b * n + j] = Cx::load(&r[b * W..ny.min((b + 1) * W)]);
-            }
-        }
-        for (k, s) in blocks.iter().zip(cells.chunks_exact_mut(n)) {
+        let cells = scr.cells.gather(row, |_, x| x);
+        for (k, s) in blocks.iter().zip(cells) {
             let (p, acc) = (&mut scr.pow, &mut scr.acc);
             p[0] = one;
             for m in 1..n {
@@ -216,20 +148,14 @@ impl GreenTable {
                 d = d + pm * sj;
             }
         }
-        for j in 0..n {
-            let mut r = row.row_mut(j);
-            let r = r.as_slice_mut().expect("contiguous spectral row");
-            for b in 0..nb {
-                cells[b * n + j].store(&mut r[b * W..ny.min((b + 1) * W)]);
-            }
-        }
+        scr.cells.scatter(row);
     }
 }
 
 /// Per-task scratch of the `G_b` row sweeps: a spectral row and, for one
 /// block of harmonics, `q^m` and the down sweep's partial results.
 struct GreenScratch {
-    cells: Vec<Cx>,
+    cells: RowCells,
     pow: Vec<Cx>,
     acc: Vec<Cx>,
 }
@@ -262,17 +188,17 @@ impl Operator {
 
     pub fn workspace(&self) -> Workspace {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
+        // Parallel chunks of spectral rows, each with its own row scratch.
+        let tasks = nx.min(4 * rayon::current_num_threads()).max(1);
         Workspace {
             spec: Array3::from_elem((nz, nx, ny), ZERO),
             fft: self.fft.scratch(nz),
             special_in: Vec::new(),
             bands: (0..nx).map(|_| BandScratch::new(nz)).collect(),
-            row_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
-                .map(|_| RowScratch::new(nz, ny))
-                .collect(),
-            green_scratch: (0..nx.min(4 * rayon::current_num_threads()).max(1))
+            row_scratch: (0..tasks).map(|_| RowScratch::new(nz, ny)).collect(),
+            green_scratch: (0..tasks)
                 .map(|_| GreenScratch {
-                    cells: vec![Cx::ZERO; nz * ny.div_ceil(W)],
+                    cells: RowCells::new(nz, ny),
                     pow: vec![Cx::ZERO; nz],
                     acc: vec![Cx::ZERO; nz],
                 })
@@ -310,17 +236,9 @@ impl Operator {
             table.shifted_green_column(h, scr);
             dense.extend_from_slice(scr.column());
         }
-        let rows_per = nx.div_ceil(ws.row_scratch.len());
-        ws.spec
-            .axis_chunks_iter_mut(Axis(1), rows_per)
-            .into_par_iter()
-            .zip(ws.row_scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(chunk, (mut block, scr))| {
-                for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
-                    table.shifted_green_row(chunk * rows_per + k, &mut row, scr, true);
-                }
-            });
+        for_each_row(&mut ws.spec, &mut ws.row_scratch, |ix, row, scr| {
+            table.shifted_green_row(ix, row, scr, true)
+        });
         for (k, h) in table.dense_indices().enumerate() {
             let (ix, iy) = (h / ny, h % ny);
             for j in 0..nz {
@@ -368,20 +286,12 @@ impl Operator {
                 ws.special_in.push(ws.spec[[j, ix, iy]]);
             }
         }
-        let rows_per = nx.div_ceil(ws.green_scratch.len());
-        ws.spec
-            .axis_chunks_iter_mut(Axis(1), rows_per)
-            .into_par_iter()
-            .zip(ws.green_scratch.par_iter_mut())
-            .enumerate()
-            .for_each(|(chunk, (mut block, scr))| {
-                for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
-                    simd::dispatch(
-                        #[inline(always)]
-                        || table.row_kernel(chunk * rows_per + k, &mut row, scr),
-                    );
-                }
-            });
+        for_each_row(&mut ws.spec, &mut ws.green_scratch, |ix, row, scr| {
+            simd::dispatch(
+                #[inline(always)]
+                || table.row_kernel(ix, row, scr),
+            )
+        });
         for (n, sp) in table.special.iter().enumerate() {
             let (ix, iy) = (sp.index / ny, sp.index % ny);
             let col = &ws.special_in[n * nz..(n + 1) * nz];
@@ -392,6 +302,25 @@ impl Operator {
             }
         }
     }
+}
+
+/// `f(ix, row, scratch)` for every spectral row `ix` of `spec` ((nz, nx, ny)),
+/// in parallel over chunks of consecutive rows, one scratch per chunk.
+fn for_each_row<T: Send>(
+    spec: &mut Array3<C64>,
+    scratch: &mut [T],
+    f: impl Fn(usize, &mut ArrayViewMut2<C64>, &mut T) + Sync,
+) {
+    let rows_per = spec.dim().1.div_ceil(scratch.len());
+    spec.axis_chunks_iter_mut(Axis(1), rows_per)
+        .into_par_iter()
+        .zip(scratch.par_iter_mut())
+        .enumerate()
+        .for_each(|(chunk, (mut block, scr))| {
+            for (k, mut row) in block.axis_iter_mut(Axis(1)).enumerate() {
+                f(chunk * rows_per + k, &mut row, scr);
+            }
+        });
 }
 
 #[cfg(test)]

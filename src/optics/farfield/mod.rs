@@ -107,8 +107,8 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
             tt += t;
             let s = (kx.hypot(ky) / lat.k0).min(1.0);
             orders.push(Order {
-                m: crate::solver::operator::Lattice::order(ix, lat.nx),
-                n: crate::solver::operator::Lattice::order(iy, lat.ny),
+                m: crate::solver::Lattice::order(ix, lat.nx),
+                n: crate::solver::Lattice::order(iy, lat.ny),
                 theta_deg: s.asin().to_degrees(),
                 phi_deg: ky.atan2(kx).to_degrees(),
                 reflectance: rr,

@@ -11,7 +11,8 @@ use inksim::config::{Method, Precision};
 use inksim::geometry::{pack_dynamics, DynParams, DynSpecies, Orientation, Shape};
 use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
-use inksim::solver::{self, Controls, IterativeMethod, Problem, System, SHIFT_MARGIN};
+use inksim::solver::methods::{bicgstab, gmres, marching};
+use inksim::solver::{self, Controls, Field, Problem, Solver, System, SHIFT_MARGIN};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -77,11 +78,11 @@ fn main() {
     }
     // (label, margin, method): plain CBS time-marching is Osnabrugge's
     // ε_s = max|ε − ε_r| (margin 1; 1.01 so the extreme voxels contract).
-    let tm = solver::marching::TimeMarching::default();
-    let g20 = solver::gmres::Gmres::default();
-    let g80 = solver::gmres::Gmres { restart: 80 };
-    let bi = solver::bicgstab::BiCgStab::default();
-    let runs: [(&str, f64, &dyn IterativeMethod<C64>); 10] = [
+    let tm = marching::TimeMarching::DEFAULT;
+    let g20 = gmres::Gmres::DEFAULT;
+    let g80 = gmres::Gmres { restart: 80 };
+    let bi = bicgstab::BiCgStab {};
+    let runs: [(&str, f64, &dyn Solver); 10] = [
         ("time-marching (plain CBS)", 1.01, &tm),
         ("time-marching (default)", SHIFT_MARGIN, &tm),
         ("time-marching", 1.2, &tm),
@@ -96,20 +97,21 @@ fn main() {
     let mut counts = Vec::new();
     for (label, margin, method) in runs {
         let mut sys = System::with_margin(&p, margin).expect("system");
-        let mut u = Array3::<C64>::zeros(eps.dim());
-        sys.set_background(&mut u);
+        let mut scr = sys.scratch();
+        let mut u = Field::F64(Array3::<C64>::zeros(eps.dim()));
+        sys.set_background_field(&mut u);
         let t = std::time::Instant::now();
-        match method.run(&mut sys, &mut u, &ctl) {
+        match method.run(&mut sys, &mut scr, &mut u, &ctl) {
             Ok(o) => {
                 let record = solver::SolveRecord {
-                    method: method.kind(),
+                    method: o.method,
                     iterations: o.iterations,
                     operator_applications: o.applications,
                     residual: o.residual,
                     seconds: t.elapsed().as_secs_f64(),
                     note: o.note,
                 };
-                let ff = efficiencies(&sys.into_solution(u, record));
+                let ff = efficiencies(&sys.into_solution(scr, u, record));
                 println!(
                     "| {label} | {margin} | {} | {} | {:.1} | {:.5} | {:.5} | {:.1e} |",
                     o.iterations,

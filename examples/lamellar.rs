@@ -30,17 +30,11 @@ const N_STRIPE: C64 = C64::new(2.0, 0.8);
 const ORDERS: std::ops::RangeInclusive<i32> = -3..=3;
 
 fn method_of(name: &str) -> Result<Method, String> {
-    Ok(match name {
-        "auto" => Method::Auto,
-        "gmres" => Method::Gmres,
-        "bicgstab" => Method::BiCgStab,
-        "born" => Method::Born,
-        "time-marching" => Method::TimeMarching,
-        _ => {
-            return Err(format!(
-                "--methods: `{name}` is not one of auto, gmres, bicgstab, born, time-marching"
-            ))
-        }
+    Method::from_config_name(name).ok_or_else(|| {
+        format!(
+            "--methods: `{name}` is not one of {}",
+            Method::config_names().join(", ")
+        )
     })
 }
 

@@ -40,13 +40,8 @@ fn main() {
         );
         std::process::exit(2);
     }
-    let method = match args[0].as_str() {
-        "born" => Method::Born,
-        "time-marching" => Method::TimeMarching,
-        "gmres" => Method::Gmres,
-        "bicgstab" => Method::BiCgStab,
-        m => panic!("unknown method {m}"),
-    };
+    let method =
+        Method::from_config_name(&args[0]).unwrap_or_else(|| panic!("unknown method {}", args[0]));
     let precision = match args[1].as_str() {
         "f64" => Precision::F64,
         "f32" => Precision::F32,

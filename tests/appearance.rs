@@ -5,9 +5,9 @@
 //! export.
 
 use inksim::config::parse_scene;
+use inksim::config::Method;
 use inksim::optics::farfield::Side;
 use inksim::pipeline::{self, RunPlan, RunReport};
-use inksim::solver::MethodUsed;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use std::path::Path;
@@ -85,10 +85,7 @@ fn bare_paper_renders_its_albedo_as_grey() {
     for v in a.brdf_total.unwrap().iter() {
         assert!((v - 0.9 / PI).abs() < 1e-12);
     }
-    assert!(rep
-        .entries
-        .iter()
-        .all(|e| e.record.method == MethodUsed::Airy));
+    assert!(rep.entries.iter().all(|e| e.record.method == Method::Airy));
 }
 
 /// Independent Airy power coefficients of a lossless slab in vacuum.

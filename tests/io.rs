@@ -6,10 +6,11 @@ use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
 use inksim::config::Incidence;
+use inksim::config::Method;
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::output::atomic::write_atomic;
 use inksim::output::h5::{read_summary, write_result, GeometrySummary, IoError, ResultSet};
-use inksim::solver::{MethodUsed, SolveRecord};
+use inksim::solver::SolveRecord;
 use num_complex::Complex64;
 
 const CONFIG: &str = "# Grün ink — π ≈ 3.14159, 日本語, emoji 🎨\n\
@@ -50,7 +51,7 @@ fn entries() -> Vec<SolveEntry> {
                 energy_balance: -2.220_446_049_250_313e-16,
             },
             record: SolveRecord {
-                method: MethodUsed::Born,
+                method: Method::Born,
                 iterations: 17,
                 operator_applications: 18,
                 residual: 3.2e-9,
@@ -76,7 +77,7 @@ fn entries() -> Vec<SolveEntry> {
                 energy_balance: 0.0,
             },
             record: SolveRecord {
-                method: MethodUsed::TimeMarching,
+                method: Method::TimeMarching,
                 iterations: 1234,
                 operator_applications: 2469,
                 residual: 9.9e-7,
@@ -102,7 +103,7 @@ fn entries() -> Vec<SolveEntry> {
                 energy_balance: 1.0e-3,
             },
             record: SolveRecord {
-                method: MethodUsed::TimeMarching,
+                method: Method::TimeMarching,
                 iterations: 0,
                 operator_applications: 0,
                 residual: f64::MIN_POSITIVE,

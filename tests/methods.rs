@@ -5,9 +5,8 @@
 //! answer. Each case runs with f64 and with f32 field storage.
 use inksim::config::{Method, Precision};
 use inksim::optics::farfield::efficiencies;
-use inksim::solver::{
-    self, born::Born, green, Controls, IterativeMethod, Problem, SolveError, System, Validity,
-};
+use inksim::solver::methods::born::Born;
+use inksim::solver::{self, green, Controls, Problem, SolveError, Solver, System, Validity};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -72,9 +71,10 @@ fn solve_or_declared_failure(
                 "{e}"
             );
             let mut sys = System::new(p).unwrap();
+            let mut scr = sys.scratch();
             assert!(
                 matches!(
-                    IterativeMethod::<C64>::validity(&Born, &mut sys),
+                    Born.validity(&mut sys, &mut scr, Precision::F64),
                     Validity::Unlikely(_)
                 ),
                 "Born failed where it claimed validity: {e}"

@@ -2,11 +2,12 @@
 //! the orders where their directions say.
 
 use inksim::config::Incidence;
+use inksim::config::Method;
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::output::render::{
     diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX,
 };
-use inksim::solver::{MethodUsed, SolveRecord};
+use inksim::solver::SolveRecord;
 use num_complex::Complex64;
 
 const PERIOD_NM: f64 = 2000.0;
@@ -68,7 +69,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
             energy_balance: 0.0,
         },
         record: SolveRecord {
-            method: MethodUsed::Born,
+            method: Method::Born,
             iterations: 3,
             operator_applications: 4,
             residual: 1e-8,

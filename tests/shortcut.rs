@@ -10,7 +10,7 @@ use inksim::optics::farfield::efficiencies;
 use inksim::pipeline::{self, RunPlan, RunReport};
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::airy::{self, GrainTerm};
-use inksim::solver::{self, Controls, MethodUsed, Problem};
+use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::path::Path;
@@ -95,7 +95,7 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
     assert!(short
         .entries
         .iter()
-        .all(|e| e.record.method == MethodUsed::Airy && e.record.iterations == 0));
+        .all(|e| e.record.method == Method::Airy && e.record.iterations == 0));
     let stored = inksim::output::h5::read_summary(&dir.path().join("grains.h5"))
         .unwrap()
         .plan;
@@ -117,7 +117,7 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
     for (a, b) in short.entries.iter().zip(&full.entries) {
         assert_eq!((a.wavelength_nm, a.side), (b.wavelength_nm, b.side));
         assert_eq!(a.incidence.polar_deg, b.incidence.polar_deg);
-        assert!(b.record.method != MethodUsed::Airy && b.record.iterations > 0);
+        assert!(b.record.method != Method::Airy && b.record.iterations > 0);
         let (x, y) = (&a.efficiencies, &b.efficiencies);
         for d in [
             x.total_reflectance - y.total_reflectance,
@@ -196,7 +196,7 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
     assert!(rep.geometry.is_some());
     assert_eq!(rep.entries.len(), 1);
     let e = &rep.entries[0];
-    assert!(e.record.method != MethodUsed::Airy && e.record.iterations > 0);
+    assert!(e.record.method != Method::Airy && e.record.iterations > 0);
     assert!(e.efficiencies.energy_balance.abs() < 1e-5);
 
     // Fine grains, but something the slab cannot represent: refused, and why.

@@ -5,14 +5,18 @@
 //! into the checked [`Scene`] that every later stage consumes. Validation
 //! errors name the file, the key and the allowed range. Pigment optical data
 //! (built-in stand-in spectra and user CSV tables) live in [`materials`].
+//! The solution methods' names (and whether a scene may use them) are
+//! [`Method`]'s; the solver's registry gives each its implementation.
 
 pub mod materials;
+mod method;
 mod raw;
 mod validate;
 
 use std::path::{Path, PathBuf};
 
 pub use materials::{Material, MaterialError, MaterialSource};
+pub use method::Method;
 pub use validate::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
@@ -166,22 +170,6 @@ pub struct GridSpec {
     pub nz: usize,
 }
 
-/// Which iterative method solves the scattering problem.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// Plain Born series; stops and reports divergence.
-    Born,
-    /// Pseudo-time marching with the convergent-Born-series preconditioner.
-    TimeMarching,
-    /// Restarted GMRES on the same CBS-preconditioned equation.
-    Gmres,
-    /// BiCGStab on the same CBS-preconditioned equation.
-    BiCgStab,
-    /// Born where a cheap estimate says it converges, BiCGStab otherwise or
-    /// when Born diverges; time-marching if BiCGStab fails.
-    Auto,
-}
-
 /// How the solver stores its fields.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Precision {
@@ -191,6 +179,16 @@ pub enum Precision {
     /// Fields stored as complex f32 (half the memory); every operator
     /// application, inner product and norm runs in f64.
     F32,
+}
+
+impl Precision {
+    /// `if_f64` or `if_f32`, by storage.
+    pub fn select<T>(self, if_f64: T, if_f32: T) -> T {
+        match self {
+            Precision::F64 => if_f64,
+            Precision::F32 => if_f32,
+        }
+    }
 }
 
 impl std::fmt::Display for Precision {

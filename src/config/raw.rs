@@ -6,6 +6,8 @@
 //! `validate` and get a message with the allowed range); `validate` turns this
 //! into the checked [`Scene`](super::Scene).
 
+use super::Method;
+use serde::de::{self, Deserializer, EnumAccess, VariantAccess, Visitor};
 use serde::Deserialize;
 
 #[derive(Debug, Deserialize)]
@@ -206,14 +208,30 @@ pub enum RawPrecision {
     F32,
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum RawMethod {
-    Born,
-    TimeMarching,
-    Gmres,
-    Bicgstab,
-    Auto,
+/// A method name, looked up in the solver's registry as it is read (an
+/// unknown name is a parse error listing the allowed ones, as for the enums
+/// here).
+#[derive(Debug, Clone, Copy)]
+pub struct RawMethod(pub Method);
+
+impl<'de> Deserialize<'de> for RawMethod {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Name;
+        impl<'de> Visitor<'de> for Name {
+            type Value = RawMethod;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a method name")
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<RawMethod, A::Error> {
+                let (name, variant): (String, _) = data.variant()?;
+                let method = Method::from_config_name(&name)
+                    .ok_or_else(|| de::Error::unknown_variant(&name, Method::config_names()))?;
+                variant.unit_variant()?;
+                Ok(RawMethod(method))
+            }
+        }
+        d.deserialize_enum("RawMethod", Method::config_names(), Name)
+    }
 }
 
 #[derive(Debug, Deserialize)]

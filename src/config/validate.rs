@@ -1032,13 +1032,9 @@ impl Checker<'_> {
     }
 
     fn solver(&self, raw: Option<&RawSolver>) -> Result<SolverSpec, ConfigError> {
-        let method = match raw.and_then(|s| s.method) {
-            Some(RawMethod::Born) => Method::Born,
-            Some(RawMethod::TimeMarching) => Method::TimeMarching,
-            Some(RawMethod::Gmres) => Method::Gmres,
-            Some(RawMethod::Bicgstab) => Method::BiCgStab,
-            Some(RawMethod::Auto) | None => Method::Auto,
-        };
+        let method = raw
+            .and_then(|s| s.method)
+            .map_or(Method::Auto, |RawMethod(m)| m);
         let t = raw.and_then(|s| s.tolerance).unwrap_or(DEFAULT_TOLERANCE);
         let tolerance = self.range(
             "solver.tolerance",

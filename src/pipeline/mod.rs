@@ -9,10 +9,10 @@
 
 pub mod accuracy;
 
-use crate::config::Material;
 use crate::config::{
     GrainOrientation, GrainShape, GrainSize, Incidence, Scene, Structure, Substrate,
 };
+use crate::config::{Material, Method};
 use crate::geometry::{
     self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SizeDistribution,
     SpeciesOptions, SpeciesParams, StatsParams,
@@ -29,7 +29,7 @@ use crate::output::progress::Progress;
 use crate::output::render;
 use crate::raster::structure::{self, EpsGrid};
 use crate::raster::{self, Grid, Raster};
-use crate::solver::{self, airy, Controls, MethodUsed, Problem, SolveRecord};
+use crate::solver::{self, airy, Controls, Problem};
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 use std::path::{Path, PathBuf};
@@ -690,11 +690,7 @@ pub fn solve_layer(
         LayerEps::Grid(_, g) => g,
     };
     let eps_b = scene.layer.binder_index.powi(2);
-    let ctl = Controls {
-        tolerance: scene.solver.tolerance,
-        max_iterations: scene.solver.max_iterations,
-        precision: scene.solver.precision,
-    };
+    let ctl = controls(scene);
     let incs = incidences(scene, plan);
     let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
     let mut flipped = plan
@@ -752,45 +748,58 @@ pub fn solve_layer(
     Ok(entries)
 }
 
+/// The solver's iteration controls of a scene.
+fn controls(scene: &Scene) -> Controls {
+    Controls {
+        tolerance: scene.solver.tolerance,
+        max_iterations: scene.solver.max_iterations,
+        precision: scene.solver.precision,
+    }
+}
+
 /// The homogeneous slab of a molecular mixture (or of grains fine enough for
 /// the effective-medium shortcut), `⟨ε⟩ = Σ f ε_s + (1 − Σ f) ε_b`, in closed
-/// form for every (wavelength, incidence, side).
+/// form (the `airy` method) for every (wavelength, incidence, side).
 pub fn solve_analytic(
     scene: &Scene,
     plan: &RunPlan,
     progress: &Progress,
 ) -> Result<Vec<SolveEntry>, PipelineError> {
     let incs = incidences(scene, plan);
+    let ctl = controls(scene);
+    let eps_b = scene.layer.binder_index.powi(2);
+    let why = if scene.is_molecular() {
+        "molecular mixture"
+    } else {
+        "effective-medium shortcut (grains fine against λ)"
+    };
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
-        let mean = mean_eps(scene, lambda)?;
+        let mean = Array3::from_elem((1, 1, 1), mean_eps(scene, lambda)?);
         for (side, inc) in &incs {
-            let start = std::time::Instant::now();
-            // A homogeneous slab is symmetric: from below = from above.
-            let resp = airy::slab(mean, scene.layer.thickness_nm, lambda, inc.polar_deg);
+            // A homogeneous slab is symmetric (from below = from above) and
+            // the same at every azimuth: one cell, lit at azimuth 0.
+            let size = [1.0, 1.0, scene.layer.thickness_nm];
+            let lattice = Problem::lattice([1, 1, 1], size, lambda, inc.polar_deg, 0.0);
+            let p = Problem {
+                lattice,
+                eps: &mean,
+                eps_binder: eps_b,
+            };
+            let mut sol =
+                solver::solve(&p, Method::Airy, &ctl).map_err(|source| PipelineError::Solve {
+                    wavelength_nm: lambda,
+                    polar_deg: inc.polar_deg,
+                    source,
+                })?;
+            sol.record.note = format!("{why}: {}", sol.record.note);
             let entry = SolveEntry {
                 wavelength_nm: lambda,
                 incidence: *inc,
                 side: *side,
                 realisation: 0,
-                efficiencies: farfield::slab_efficiencies(&resp, inc),
-                record: SolveRecord {
-                    method: MethodUsed::Airy,
-                    iterations: 0,
-                    operator_applications: 0,
-                    residual: 0.0,
-                    seconds: start.elapsed().as_secs_f64(),
-                    note: format!(
-                        "{}: homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form",
-                        if scene.is_molecular() {
-                            "molecular mixture"
-                        } else {
-                            "effective-medium shortcut (grains fine against λ)"
-                        },
-                        mean.re,
-                        mean.im
-                    ),
-                },
+                efficiencies: farfield::slab_efficiencies(&sol.slab_response(), inc),
+                record: sol.record,
             };
             log_solve(progress, &entry);
             entries.push(entry);

@@ -1,7 +1,9 @@
 //! The homogeneous slab solved in closed form (Airy/Fresnel for the scalar
 //! wave): the exact answer for a layer without grains, used for the
 //! molecular-mixture limit (METHOD §7), where the layer is the slab with the
-//! volume-averaged ε, so no grid and no iteration are needed.
+//! volume-averaged ε, so no grid and no iteration are needed. The `airy`
+//! method ([`closed_form`](super::methods::closed_form)) solves a problem
+//! with it.
 //!
 //! Inside the slab `u = a e^{iγz} + b e^{iγ(H−z)}`: both exponentials decay
 //! away from the face they are referred to, so no coefficient of the 4×4
@@ -33,32 +35,73 @@ pub struct SlabResponse {
 pub fn slab(eps: C64, thickness_nm: f64, wavelength_nm: f64, polar_deg: f64) -> SlabResponse {
     let k0 = 2.0 * std::f64::consts::PI / wavelength_nm;
     let kx = k0 * polar_deg.to_radians().sin();
-    let beta = C64::new((k0 * k0 - kx * kx).max(0.0).sqrt(), 0.0);
-    let g = sqrt_branch(eps * k0 * k0 - kx * kx);
-    let h = thickness_nm;
-    let e1 = (C64::i() * g * h).exp();
-    let one = C64::new(1.0, 0.0);
-    let zero = C64::new(0.0, 0.0);
-    // Unknowns x = (r, a, b, t); rows: u and u' continuous at z = 0 and z = H.
-    let mut m = [
-        [-one, one, e1, zero, one],
-        [beta, g, -g * e1, zero, beta],
-        [zero, e1, one, -one, zero],
-        [zero, g * e1, -g, -beta, zero],
-    ];
-    let x = solve4(&mut m);
-    let (r, a, b, t) = (x[0], x[1], x[2], x[3]);
-    // ∫₀ᴴ |a e^{iγz} + b e^{iγ(H−z)}|² dz in closed form.
-    let (gr, gi) = (g.re, g.im);
-    let decay = h * phi1(C64::new(-2.0 * gi * h, 0.0)).re;
-    let cross = a
-        * b.conj()
-        * (C64::new(0.0, -gr * h).exp() * (-gi * h).exp())
-        * h
-        * phi1(C64::new(0.0, 2.0 * gr * h));
-    let integral = (a.norm_sqr() + b.norm_sqr()) * decay + 2.0 * cross.re;
-    let absorption = k0 * k0 * eps.im * integral / beta.re;
-    SlabResponse { r, t, absorption }
+    SlabField::new(eps, thickness_nm, k0, kx).response
+}
+
+/// The exact field of a homogeneous slab: its response and the two waves
+/// inside, `u = a e^{iγz} + b e^{iγ(H−z)}`.
+#[derive(Debug, Clone, Copy)]
+pub struct SlabField {
+    pub response: SlabResponse,
+    a: C64,
+    b: C64,
+    gamma: C64,
+    thickness: f64,
+}
+
+impl SlabField {
+    /// The slab of permittivity `eps`, `thickness_nm` thick, in vacuum, lit
+    /// from above by a wave of free-space wavenumber `k0` and lateral
+    /// wavenumber `kx` (rad/nm).
+    pub fn new(eps: C64, thickness_nm: f64, k0: f64, kx: f64) -> SlabField {
+        let beta = C64::new((k0 * k0 - kx * kx).max(0.0).sqrt(), 0.0);
+        let g = sqrt_branch(eps * k0 * k0 - kx * kx);
+        let h = thickness_nm;
+        let e1 = (C64::i() * g * h).exp();
+        let one = C64::new(1.0, 0.0);
+        let zero = C64::new(0.0, 0.0);
+        // Unknowns x = (r, a, b, t); rows: u and u' continuous at z = 0 and z = H.
+        let mut m = [
+            [-one, one, e1, zero, one],
+            [beta, g, -g * e1, zero, beta],
+            [zero, e1, one, -one, zero],
+            [zero, g * e1, -g, -beta, zero],
+        ];
+        let x = solve4(&mut m);
+        let (r, a, b, t) = (x[0], x[1], x[2], x[3]);
+        // ∫₀ᴴ |a e^{iγz} + b e^{iγ(H−z)}|² dz in closed form.
+        let (gr, gi) = (g.re, g.im);
+        let decay = h * phi1(C64::new(-2.0 * gi * h, 0.0)).re;
+        let cross = a
+            * b.conj()
+            * (C64::new(0.0, -gr * h).exp() * (-gi * h).exp())
+            * h
+            * phi1(C64::new(0.0, 2.0 * gr * h));
+        let integral = (a.norm_sqr() + b.norm_sqr()) * decay + 2.0 * cross.re;
+        let absorption = k0 * k0 * eps.im * integral / beta.re;
+        SlabField {
+            response: SlabResponse { r, t, absorption },
+            a,
+            b,
+            gamma: g,
+            thickness: h,
+        }
+    }
+
+    /// Averages of the field over `nz` equal z cells (both waves decay away
+    /// from the face they are referred to, so nothing overflows).
+    pub fn cell_averages(&self, nz: usize) -> Vec<C64> {
+        let dz = self.thickness / nz as f64;
+        let i = C64::i();
+        let cell = phi1(i * self.gamma * dz);
+        (0..nz)
+            .map(|j| {
+                let (top, bottom) = (j as f64 * dz, self.thickness - (j + 1) as f64 * dz);
+                cell * (self.a * (i * self.gamma * top).exp()
+                    + self.b * (i * self.gamma * bottom).exp())
+            })
+            .collect()
+    }
 }
 
 /// One grain species as [`effective_medium_error`] sees it.

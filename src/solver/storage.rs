@@ -6,10 +6,67 @@
 //! arithmetic step; operator applications, inner products and norms run in
 //! f64 and only the stored result is rounded, so f32 storage costs about one
 //! f32 rounding (6e-8 relative) per stored vector and nothing else.
+//!
+//! The object-safe method interface passes a field as a [`Field`] (either
+//! storage); `on_field!` and `with_storage!` turn it, or a [`Precision`],
+//! back into a call of a generic function.
 
+use crate::config::Precision;
 use ndarray::Array3;
 use num_complex::{Complex32 as C32, Complex64 as C64};
 use rayon::prelude::*;
+
+/// A field, (nz, ny, nx), in the storage of its [`Precision`].
+pub enum Field {
+    F64(Array3<C64>),
+    F32(Array3<C32>),
+}
+
+impl Field {
+    /// Zeros in the storage of `precision`.
+    pub fn zeros(precision: Precision, dim: (usize, usize, usize)) -> Field {
+        match precision {
+            Precision::F64 => Field::F64(Array3::default(dim)),
+            Precision::F32 => Field::F32(Array3::default(dim)),
+        }
+    }
+
+    pub fn precision(&self) -> Precision {
+        match self {
+            Field::F64(_) => Precision::F64,
+            Field::F32(_) => Precision::F32,
+        }
+    }
+}
+
+/// `$body` with `$u` bound to the array inside a [`Field`] (by value,
+/// reference or mutable reference, as `$field` is), whatever its storage.
+macro_rules! on_field {
+    ($field:expr, $u:ident => $body:expr) => {
+        match $field {
+            $crate::solver::storage::Field::F64($u) => $body,
+            $crate::solver::storage::Field::F32($u) => $body,
+        }
+    };
+}
+pub(crate) use on_field;
+
+/// `$body` with the type `$s` standing for the [`Storage`] of a [`Precision`].
+macro_rules! with_storage {
+    ($precision:expr, $s:ident => $body:expr) => {
+        match $precision {
+            $crate::config::Precision::F64 => {
+                type $s = num_complex::Complex64;
+                $body
+            }
+            $crate::config::Precision::F32 => {
+                type $s = num_complex::Complex32;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_storage;
 
 /// A complex field element: f64 or f32.
 pub trait Storage: Copy + Send + Sync + Default + 'static {

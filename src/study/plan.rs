@@ -19,15 +19,15 @@
 //! grid with the same `nz` and fewer lateral cells, scaled by
 //! `N log₂(nx ny)` (the FFTs). `applications` is the mean number of operator
 //! applications per solve of this study's finished results when there are
-//! any (BiCGStab counts 2 per iteration, GMRES and time-marching 1), else
-//! [`DEFAULT_APPLICATIONS`]. Geometry packing and output are not modelled
+//! any (iterations + 1 times the method's applications per iteration, from
+//! the solver's registry), else [`DEFAULT_APPLICATIONS`]. Geometry packing and output are not modelled
 //! (seconds per variant). The estimate is a guide (±2×), not a promise.
 
 use super::run::{self, State};
 use super::sweep::Variant;
 use crate::config::{Method, Precision, Scene};
 use crate::pipeline;
-use crate::solver::{MethodUsed, Problem, System};
+use crate::solver::{Problem, System};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
@@ -46,20 +46,12 @@ pub const DEFAULT_APPLICATIONS: f64 = 200.0;
 /// vector updates and inner products), as a factor.
 pub const KRYLOV_OVERHEAD: f64 = 1.25;
 
-/// Bytes per voxel of a solve: the solver's own peak measured by
-/// `examples/solver_memory` (docs/PERFORMANCE.md, "Memory") plus the
-/// pipeline's ε grid and its flipped copy for the solves from below
-/// (16 B each).
+/// Bytes per voxel of a solve: the method's own peak from the solver's
+/// registry (measured by `examples/solver_memory`, docs/PERFORMANCE.md,
+/// "Memory") plus the pipeline's ε grid and its flipped copy for the solves
+/// from below (16 B each).
 pub fn bytes_per_voxel(m: Method, p: Precision) -> f64 {
-    let solver = match (m, p) {
-        (Method::TimeMarching | Method::Born, Precision::F64) => 86.0,
-        (Method::TimeMarching | Method::Born, Precision::F32) => 70.0,
-        (Method::BiCgStab | Method::Auto, Precision::F64) => 165.0,
-        (Method::BiCgStab | Method::Auto, Precision::F32) => 109.0,
-        (Method::Gmres, Precision::F64) => 421.0,
-        (Method::Gmres, Precision::F32) => 237.0,
-    };
-    solver + 32.0
+    m.solver().bytes_per_voxel(p) + 32.0
 }
 
 /// Timings of one grid.
@@ -150,13 +142,14 @@ fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
     let mut out = Array3::zeros((nz, ny, nx));
     for _ in 0..3 {
         let t = Instant::now();
-        let Ok(mut sys) = System::new(&p) else {
+        let Ok(sys) = System::new(&p) else {
             return (f64::NAN, f64::NAN);
         };
+        let mut scr = sys.scratch();
         setups.push(t.elapsed().as_secs_f64());
-        sys.apply_a_shifted(&x, &mut out);
+        sys.apply_a_shifted(&mut scr, &x, &mut out);
         let t = Instant::now();
-        sys.apply_a_shifted(&x, &mut out);
+        sys.apply_a_shifted(&mut scr, &x, &mut out);
         applies.push(t.elapsed().as_secs_f64());
     }
     setups.sort_by(f64::total_cmp);
@@ -177,10 +170,7 @@ pub fn measured_applications(variants: &[Variant]) -> Option<(f64, usize)> {
         };
         files += 1;
         for e in &s.entries {
-            sum += match e.method {
-                MethodUsed::BiCgStab => 2.0 * e.iterations as f64 + 2.0,
-                _ => e.iterations as f64 + 1.0,
-            };
+            sum += (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
             n += 1;
         }
     }

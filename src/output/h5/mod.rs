@@ -85,10 +85,10 @@ use hdf5::types::VarLenUnicode;
 use hdf5::{H5Type, Location};
 use ndarray::Array2;
 
+use crate::config::Method;
 use crate::geometry::Statistics;
 use crate::optics::appearance::{Appearance, Estimate};
 use crate::optics::farfield::{Side, SolveEntry};
-use crate::solver::MethodUsed;
 
 /// Version of the layout described in the module docs, stored as `format_version`.
 pub const FORMAT_VERSION: u32 = 1;
@@ -247,7 +247,7 @@ pub struct EntrySummary {
     pub total_transmittance: f64,
     pub absorption: f64,
     pub energy_balance: f64,
-    pub method: MethodUsed,
+    pub method: Method,
     pub iterations: u64,
     pub residual: f64,
 }
@@ -331,7 +331,7 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
                 .map_err(hdf)
         };
         let method_text = read_str_attr(&g, "method").map_err(hdf)?;
-        let method: MethodUsed = method_text
+        let method: Method = method_text
             .parse()
             .map_err(|e: String| format(format!("/solves/{name}: attribute `method`: {e}")))?;
         let side_text = read_str_attr(&g, "side").map_err(hdf)?;

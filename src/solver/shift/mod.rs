@@ -21,9 +21,11 @@
 //! a few complex operations per cell. Harmonics near `γ = 0` use a dense
 //! inverse of the contour-averaged matrix.
 //!
+//! Takes a [`Lattice`], the binder permittivity and the shift `c`; gives a
+//! [`ShiftTable`] that applies `(I − c G_h)⁻¹` or `G_s` to one harmonic's
+//! column ([`BandScratch`]) or to a whole spectral row ([`RowScratch`]).
 //! This module holds the table and its scratch; `coef` builds the per-cell
-//! coefficients of the sweeps (and the dense inverses), `sweep` applies them
-//! to one column or, `W` harmonics at a time, to a spectral row.
+//! coefficients of the sweeps (and the dense inverses), `sweep` applies them.
 
 mod coef;
 mod sweep;

@@ -8,7 +8,7 @@
 //! outside stays vacuum and is lossy for outgoing waves),
 //! `c = k0²(ε_r + iε_s − ε_b)`, `G_s = (G_b⁻¹ − c)⁻¹` the shifted operator
 //! *of the same discrete* `G_b`, `V' = V − c` and `u_s = (I − c G_b)⁻¹ u_bg`.
-//! [`shift`](super::shift) applies `G_s` exactly in O(N) per harmonic without
+//! [`shift`](crate::solver::shift) applies `G_s` exactly in O(N) per harmonic without
 //! ever forming `G_b`, so guided-mode poles of the binder slab never enter.
 //! We march `du/dτ = γ r'`, `r' = u_s + G_s V' u − u`,
 //! `γ = 1 + i(ε − ε_r)/ε_s`, by explicit Euler; with `dτ = 1` this is the CBS
@@ -19,11 +19,13 @@
 //! above its best. Cost per step: one application of `G_s` between a forward
 //! and an inverse 2-D FFT.
 
-use super::{
-    Controls, IterativeMethod, MethodUsed, Monitor, Outcome, SolveError, Storage, System, Validity,
-};
+use super::{run_in_field_storage, Monitor, Outcome, Solver};
+use crate::config::{Method, Precision};
+use crate::solver::storage::Storage;
+use crate::solver::system::{Scratch, System};
+use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
-use num_complex::Complex64 as C64;
+
 /// Time-marching settings.
 #[derive(Debug, Clone, Copy)]
 pub struct TimeMarching {
@@ -31,51 +33,43 @@ pub struct TimeMarching {
     pub step: f64,
 }
 
-impl Default for TimeMarching {
-    fn default() -> Self {
-        TimeMarching { step: 1.0 }
+impl Solver for TimeMarching {
+    fn method(&self) -> Method {
+        Method::TimeMarching
     }
+
+    fn bytes_per_voxel(&self, precision: Precision) -> f64 {
+        precision.select(86.0, 70.0)
+    }
+
+    fn applications_per_iteration(&self) -> f64 {
+        1.0
+    }
+
+    run_in_field_storage!();
 }
 
-/// Real centre and radius of the permittivity values: (ε_r, max|ε − ε_r|).
-pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
-    let (mut lo, mut hi) = (eps_binder, eps_binder);
-    for e in eps.iter() {
-        lo = lo.min(e.re);
-        hi = hi.max(e.re);
-    }
-    let er = 0.5 * (lo + hi);
-    let rad = eps
-        .iter()
-        .map(|e| (e - er).norm())
-        .fold((eps_binder - er).abs(), f64::max);
-    (er, rad)
-}
+impl TimeMarching {
+    /// The CBS iteration.
+    pub const DEFAULT: TimeMarching = TimeMarching { step: 1.0 };
 
-impl<S: Storage> IterativeMethod<S> for TimeMarching {
-    fn kind(&self) -> MethodUsed {
-        MethodUsed::TimeMarching
-    }
-
-    fn validity(&self, _sys: &mut System) -> Validity {
-        Validity::Always
-    }
-
-    fn run(
+    fn iterate<S: Storage>(
         &self,
-        sys: &mut System,
+        sys: &System,
+        scr: &mut Scratch,
         u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
-        let (er, es) = (sys.shift.er, sys.shift.es);
+        let (er, es) = sys.shift();
         let mut r = Array3::<S>::default(u.dim());
         let step = self.step;
-        let mut monitor = Monitor::new(MethodUsed::TimeMarching);
+        let mut monitor = Monitor::new(Method::TimeMarching);
         for it in 0..=ctl.max_iterations {
-            let res = sys.residual_shifted(u, &mut r);
+            let res = sys.residual_shifted(scr, u, &mut r);
             if monitor.check(res, it, ctl)? {
                 let note = format!("ε_r = {er:.4}, ε_s = {es:.4}, dτ = {step}");
                 return Ok(Outcome {
+                    method: Method::TimeMarching,
                     iterations: it,
                     applications: it + 1,
                     residual: res,

@@ -6,11 +6,11 @@
 //! learned, it needs far fewer applications. Breakdowns (⟨r̂, v⟩ ≈ 0) restart
 //! from the current iterate; convergence is confirmed on the true residual.
 
-use super::storage::norm_sqr;
-use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, Storage,
-    System, Validity,
-};
+use super::{restart, run_in_field_storage, Monitor, Outcome, Restart, Solver, Validity};
+use crate::config::{Method, Precision};
+use crate::solver::storage::{dot, norm_sqr, Storage};
+use crate::solver::system::{Scratch, System};
+use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -18,28 +18,39 @@ use num_complex::Complex64 as C64;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BiCgStab {}
 
-impl BiCgStab {
-    /// `out ← P A x`.
-    fn op<S: Storage>(sys: &mut System, x: &Array3<S>, out: &mut Array3<S>) {
-        sys.apply_a_shifted(x, out);
-        sys.precondition(out);
-    }
-}
-
-impl<S: Storage> IterativeMethod<S> for BiCgStab {
-    fn kind(&self) -> MethodUsed {
-        MethodUsed::BiCgStab
+impl Solver for BiCgStab {
+    fn method(&self) -> Method {
+        Method::BiCgStab
     }
 
-    fn validity(&self, _sys: &mut System) -> Validity {
+    fn bytes_per_voxel(&self, precision: Precision) -> f64 {
+        precision.select(165.0, 109.0)
+    }
+
+    fn applications_per_iteration(&self) -> f64 {
+        2.0
+    }
+
+    fn validity(&self, _sys: &mut System, _scr: &mut Scratch, _precision: Precision) -> Validity {
         Validity::Likely(
             "preconditioned BiCGStab; breakdowns restart, time-marching backs it up".into(),
         )
     }
 
-    fn run(
+    run_in_field_storage!();
+}
+
+impl BiCgStab {
+    /// `out ← P A x`.
+    fn op<S: Storage>(sys: &System, scr: &mut Scratch, x: &Array3<S>, out: &mut Array3<S>) {
+        sys.apply_a_shifted(scr, x, out);
+        sys.precondition(out);
+    }
+
+    fn iterate<S: Storage>(
         &self,
-        sys: &mut System,
+        sys: &System,
+        scr: &mut Scratch,
         u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
@@ -48,17 +59,16 @@ impl<S: Storage> IterativeMethod<S> for BiCgStab {
         let (mut r, mut rh, mut p, mut v, mut s, mut t) = (z(), z(), z(), z(), z(), z());
         let mut iterations = 0;
         let mut applications = 0;
-        let mut monitor = Monitor::new(MethodUsed::BiCgStab);
+        let mut monitor = Monitor::new(Method::BiCgStab);
         let one = C64::new(1.0, 0.0);
         loop {
             applications += 1;
-            let (r0, target) = match sys.restart(u, &mut r, &mut monitor, iterations, ctl)? {
+            let (r0, target) = match restart(sys, scr, u, &mut r, &mut monitor, iterations, ctl)? {
                 Restart::Converged(residual) => {
-                    let note = format!(
-                        "BiCGStab, ε_r = {:.4}, ε_s = {:.4}",
-                        sys.shift.er, sys.shift.es
-                    );
+                    let (er, es) = sys.shift();
+                    let note = format!("BiCGStab, ε_r = {er:.4}, ε_s = {es:.4}");
                     return Ok(Outcome {
+                        method: Method::BiCgStab,
                         iterations,
                         applications,
                         residual,
@@ -82,7 +92,7 @@ impl<S: Storage> IterativeMethod<S> for BiCgStab {
                 Zip::from(&mut p).and(&r).and(&v).par_for_each(|p, r, v| {
                     *p = S::store(r.load() + beta * (p.load() - omega * v.load()))
                 });
-                Self::op(sys, &p, &mut v);
+                Self::op(sys, scr, &p, &mut v);
                 let rv = dot(&rh, &v);
                 if rv.norm() < 1e-30 * r0 * r0 {
                     break;
@@ -92,7 +102,7 @@ impl<S: Storage> IterativeMethod<S> for BiCgStab {
                     .and(&r)
                     .and(&v)
                     .par_for_each(|s, r, v| *s = S::store(r.load() - alpha * v.load()));
-                Self::op(sys, &s, &mut t);
+                Self::op(sys, scr, &s, &mut t);
                 applications += 2;
                 let tt = norm_sqr(&t);
                 omega = if tt > 0.0 {

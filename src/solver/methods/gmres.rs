@@ -10,11 +10,11 @@
 //! `‖u_s + G_s V' u − u‖ / ‖u_s‖`, evaluated at every restart. Inner products are
 //! summed in a fixed order, so results do not depend on the thread count.
 
-use super::storage::norm_sqr;
-use super::{
-    dot, Controls, IterativeMethod, MethodUsed, Monitor, Outcome, Restart, SolveError, Storage,
-    System, Validity,
-};
+use super::{restart, run_in_field_storage, Monitor, Outcome, Restart, Solver};
+use crate::config::{Method, Precision};
+use crate::solver::storage::{dot, norm_sqr, Storage};
+use crate::solver::system::{Scratch, System};
+use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -25,24 +25,31 @@ pub struct Gmres {
     pub restart: usize,
 }
 
-impl Default for Gmres {
-    fn default() -> Self {
-        Gmres { restart: 20 }
+impl Solver for Gmres {
+    fn method(&self) -> Method {
+        Method::Gmres
     }
+
+    /// Measured for GMRES(20).
+    fn bytes_per_voxel(&self, precision: Precision) -> f64 {
+        precision.select(421.0, 237.0)
+    }
+
+    fn applications_per_iteration(&self) -> f64 {
+        1.0
+    }
+
+    run_in_field_storage!();
 }
 
-impl<S: Storage> IterativeMethod<S> for Gmres {
-    fn kind(&self) -> MethodUsed {
-        MethodUsed::Gmres
-    }
+impl Gmres {
+    /// GMRES(20).
+    pub const DEFAULT: Gmres = Gmres { restart: 20 };
 
-    fn validity(&self, _sys: &mut System) -> Validity {
-        Validity::Always
-    }
-
-    fn run(
+    fn iterate<S: Storage>(
         &self,
-        sys: &mut System,
+        sys: &System,
+        scr: &mut Scratch,
         u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
@@ -55,16 +62,15 @@ impl<S: Storage> IterativeMethod<S> for Gmres {
         let mut g = vec![C64::new(0.0, 0.0); m + 1];
         let mut inner = 0;
         let mut applications = 0;
-        let mut monitor = Monitor::new(MethodUsed::Gmres);
+        let mut monitor = Monitor::new(Method::Gmres);
         loop {
             applications += 1;
-            let (beta, target) = match sys.restart(u, &mut r, &mut monitor, inner, ctl)? {
+            let (beta, target) = match restart(sys, scr, u, &mut r, &mut monitor, inner, ctl)? {
                 Restart::Converged(residual) => {
-                    let note = format!(
-                        "GMRES({m}), ε_r = {:.4}, ε_s = {:.4}",
-                        sys.shift.er, sys.shift.es
-                    );
+                    let (er, es) = sys.shift();
+                    let note = format!("GMRES({m}), ε_r = {er:.4}, ε_s = {es:.4}");
                     return Ok(Outcome {
+                        method: Method::Gmres,
                         iterations: inner,
                         applications,
                         residual,
@@ -82,7 +88,7 @@ impl<S: Storage> IterativeMethod<S> for Gmres {
             for k in 0..m {
                 let (done, rest) = basis.split_at_mut(k + 1);
                 let w = &mut rest[0];
-                sys.apply_a_shifted(&done[k], w);
+                sys.apply_a_shifted(scr, &done[k], w);
                 sys.precondition(w);
                 applications += 1;
                 inner += 1;

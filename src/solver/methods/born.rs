@@ -3,11 +3,13 @@
 //! Cheapest per step (one operator application) but converges only when the
 //! spectral radius of `G V` is below one (weak scattering). Divergence is
 //! detected from residual growth and reported as an error, never returned as
-//! a result. [`Born::validity`] estimates the contraction from a few steps.
+//! a result. [`Solver::validity`] estimates the contraction from a few steps.
 
-use super::{
-    Controls, IterativeMethod, MethodUsed, Outcome, SolveError, Storage, System, Validity,
-};
+use super::{run_in_field_storage, Outcome, Solver, Validity};
+use crate::config::{Method, Precision};
+use crate::solver::storage::{with_storage, Storage};
+use crate::solver::system::{Scratch, System};
+use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
 
 /// Steps spent on the a-priori contraction estimate.
@@ -18,19 +20,38 @@ pub const MAX_CONTRACTION: f64 = 0.8;
 /// The Born series.
 pub struct Born;
 
-impl<S: Storage> IterativeMethod<S> for Born {
-    fn kind(&self) -> MethodUsed {
-        MethodUsed::Born
+impl Solver for Born {
+    fn method(&self) -> Method {
+        Method::Born
     }
 
-    fn validity(&self, sys: &mut System) -> Validity {
-        let dim = sys.eps.dim();
+    /// Counted as time-marching (the same fields).
+    fn bytes_per_voxel(&self, precision: Precision) -> f64 {
+        Method::TimeMarching.solver().bytes_per_voxel(precision)
+    }
+
+    fn applications_per_iteration(&self) -> f64 {
+        1.0
+    }
+
+    fn validity(&self, sys: &mut System, scr: &mut Scratch, precision: Precision) -> Validity {
+        with_storage!(precision, S => self.estimate::<S>(sys, scr))
+    }
+
+    run_in_field_storage!();
+}
+
+impl Born {
+    /// The contraction estimate behind [`Solver::validity`], with fields
+    /// stored as `S`.
+    fn estimate<S: Storage>(&self, sys: &mut System, scr: &mut Scratch) -> Validity {
+        let dim = sys.eps().dim();
         let (mut u, mut r) = (Array3::<S>::default(dim), Array3::<S>::default(dim));
         sys.set_background(&mut u);
         let mut prev = f64::NAN;
         let mut ratio = 0.0;
         for _ in 0..ESTIMATE_STEPS {
-            let res = sys.residual(&u, &mut r);
+            let res = sys.residual(scr, &u, &mut r);
             if res == 0.0 {
                 return Validity::Likely("no scatterers (Δε = 0)".into());
             }
@@ -53,9 +74,10 @@ impl<S: Storage> IterativeMethod<S> for Born {
         }
     }
 
-    fn run(
+    fn iterate<S: Storage>(
         &self,
         sys: &mut System,
+        scr: &mut Scratch,
         u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
@@ -63,9 +85,10 @@ impl<S: Storage> IterativeMethod<S> for Born {
         let mut best = f64::INFINITY;
         let mut growing = 0;
         for it in 0..=ctl.max_iterations {
-            let res = sys.residual(u, &mut r);
+            let res = sys.residual(scr, u, &mut r);
             if res <= ctl.tolerance {
                 return Ok(Outcome {
+                    method: Method::Born,
                     iterations: it,
                     applications: it + 1,
                     residual: res,
@@ -75,7 +98,7 @@ impl<S: Storage> IterativeMethod<S> for Born {
             let diverged = !res.is_finite() || res > 1e3 * best.min(1.0) || growing >= 5;
             if diverged {
                 return Err(SolveError::Diverged {
-                    method: MethodUsed::Born,
+                    method: Method::Born,
                     iterations: it,
                     residual: res,
                 });
@@ -84,7 +107,7 @@ impl<S: Storage> IterativeMethod<S> for Born {
             best = best.min(res);
             if it == ctl.max_iterations {
                 return Err(SolveError::NotConverged {
-                    method: MethodUsed::Born,
+                    method: Method::Born,
                     iterations: it,
                     residual: res,
                     tolerance: ctl.tolerance,

@@ -1,0 +1,72 @@
+//! `auto`: Born where its contraction estimate says it converges, then
+//! BiCGStab, then time-marching (always convergent) as the last resort, on
+//! one system and one field. Each choice and failure is written into the
+//! note, and the record names the method that produced the answer.
+
+use super::{born, Outcome, Solver, Validity};
+use crate::config::{Method, Precision};
+use crate::solver::storage::Field;
+use crate::solver::system::{Scratch, System};
+use crate::solver::{Controls, SolveError};
+
+/// The automatic choice.
+pub struct Auto;
+
+impl Solver for Auto {
+    fn method(&self) -> Method {
+        Method::Auto
+    }
+
+    /// As BiCGStab, which it runs unless Born is chosen.
+    fn bytes_per_voxel(&self, precision: Precision) -> f64 {
+        Method::BiCgStab.solver().bytes_per_voxel(precision)
+    }
+
+    /// As BiCGStab.
+    fn applications_per_iteration(&self) -> f64 {
+        Method::BiCgStab.solver().applications_per_iteration()
+    }
+
+    fn run(
+        &self,
+        sys: &mut System,
+        scr: &mut Scratch,
+        u: &mut Field,
+        ctl: &Controls,
+    ) -> Result<Outcome, SolveError> {
+        let born = Method::Born.solver();
+        let mut chain = vec![Method::BiCgStab.solver(), Method::TimeMarching.solver()];
+        let mut notes = vec![];
+        match born.validity(sys, scr, u.precision()) {
+            Validity::Unlikely(why) => {
+                notes.push(format!("skipped Born: {why}"));
+                sys.release_binder();
+            }
+            Validity::Likely(why) => {
+                notes.push(format!("chose Born: {why}"));
+                chain.insert(0, born);
+            }
+            Validity::Always => {
+                chain.insert(0, born);
+            }
+        }
+        let spent = born::ESTIMATE_STEPS;
+        let mut last_err = None;
+        for m in chain {
+            sys.set_background_field(u);
+            match m.run(sys, scr, u, ctl) {
+                Ok(mut o) => {
+                    o.applications += spent;
+                    notes.push(o.note);
+                    o.note = format!("auto: {}", notes.join("; "));
+                    return Ok(o);
+                }
+                Err(e) => {
+                    notes.push(format!("{e}; falling back"));
+                    last_err = Some(e);
+                }
+            }
+        }
+        Err(last_err.expect("at least one method ran"))
+    }
+}

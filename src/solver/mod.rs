@@ -1,4 +1,4 @@
-//! Stage 3 — the diffraction problem (METHOD §4).
+//! Solver — the diffraction problem (METHOD §4).
 //!
 //! The layer's permittivity is split into the plain binder slab and the grains:
 //! `ε = ε_b + Δε`. The scattered field solves `u = u_bg + G_bg [k0² Δε u]`

@@ -1,6 +1,6 @@
 //! FIRE stage of the dynamics packer (inertial relaxation near jamming).
 
-use super::state::{for_each_max, State};
+use super::state::{for_each_max, FireSums, State};
 use super::CHUNK;
 use crate::geometry::periodic::wrap;
 use crate::geometry::vec3::{dot, norm, rotate};
@@ -21,15 +21,6 @@ const FIRE_ALPHA_SHRINK: f64 = 0.99;
 /// Largest sphere displacement per FIRE step, in units of the particle's
 /// smallest radius.
 const FIRE_MAX_MOVE: f64 = 0.1;
-
-/// FIRE's sums over the particles of one chunk: `F·v + M·Ω`,
-/// `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct FireSums {
-    vf: f64,
-    vv: f64,
-    ff: f64,
-}
 
 /// FIRE's adaptive state (reset at every batch).
 #[derive(Debug, Clone, Copy)]

@@ -2,7 +2,7 @@
 //! cell grid, or of every particle from the Verlet list, and the explicit Euler
 //! move.
 
-use super::forces::Contribution;
+use super::state::Contribution;
 use super::state::{for_each_max, State};
 use super::CHUNK;
 use crate::geometry::cells::EMPTY;

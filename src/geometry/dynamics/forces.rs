@@ -11,9 +11,6 @@ use crate::geometry::vec3::{add, cross, norm};
 /// Spring constant and drag (arbitrary units; only ratios matter).
 pub(super) const K: f64 = 1.0;
 
-/// A force contribution to one particle: `(particle, force, torque)`.
-pub(super) type Contribution = (u32, [f64; 3], [f64; 3]);
-
 /// Forces of one pair, on `i` (`f`, `mi`) and on `j` (`−f`, `mj`).
 pub(super) struct PairForce {
     pub(super) f: [f64; 3],

@@ -1,12 +1,22 @@
 //! Dynamic state of the ensemble: the particles, their cells and the
 //! scratch of the force passes; bookkeeping shared by every stage.
 
-use super::fire::FireSums;
-use super::forces::Contribution;
 use super::params::Spec;
 use super::{CHUNK, PARALLEL_MIN_PARTICLES};
 use crate::geometry::cells::{Bins, CellGrid, LinkedCells};
 use rayon::prelude::*;
+
+/// A force contribution to one particle: `(particle, force, torque)`.
+pub(super) type Contribution = (u32, [f64; 3], [f64; 3]);
+
+/// FIRE's sums over the particles of one chunk: `F·v + M·Ω`,
+/// `|v|² + J|Ω|²`, `|F|² + |M|²/J`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct FireSums {
+    pub(super) vf: f64,
+    pub(super) vv: f64,
+    pub(super) ff: f64,
+}
 
 /// Dynamic state of the ensemble.
 #[derive(Debug, Clone)]

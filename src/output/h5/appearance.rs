@@ -1,0 +1,172 @@
+//! The `/appearance` group: written from an [`Appearance`] (ensemble means
+//! with their standard errors) and read back as [`AppearanceArrays`].
+
+use std::path::Path;
+
+use ndarray::Array2;
+
+use super::attrs::write_scalar_attr;
+use super::IoError;
+use crate::optics::appearance::{Appearance, Estimate};
+
+/// The ensemble-mean appearance arrays of a result file (`/appearance`),
+/// for comparing runs (docs/ACCURACY.md). Shapes as in the module docs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AppearanceArrays {
+    pub wavelengths_nm: Vec<f64>,
+    pub illumination_deg: Vec<f64>,
+    pub viewing_deg: Vec<f64>,
+    pub above_deg: Vec<f64>,
+    /// (L, A) each.
+    pub reflectance: ndarray::Array2<f64>,
+    pub transmittance: ndarray::Array2<f64>,
+    pub absorption: ndarray::Array2<f64>,
+    /// (L, I, V), present with the tile.
+    pub brdf_total: Option<ndarray::Array3<f64>>,
+    /// (L, V), present with the tile.
+    pub natural: Option<ndarray::Array2<f64>>,
+    /// CIELAB of the tile's cells (V, 1 + I, 3), present with the tile.
+    pub tile_lab: Option<ndarray::Array3<f64>>,
+}
+
+/// Read the `/appearance` arrays of a result file (None when absent).
+pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    if !file.link_exists("appearance") {
+        return Ok(None);
+    }
+    let g = file.group("appearance").map_err(hdf)?;
+    let vec = |name: &str| -> Result<Vec<f64>, IoError> {
+        g.dataset(name).and_then(|d| d.read_raw()).map_err(hdf)
+    };
+    let arr2 = |name: &str| -> Result<ndarray::Array2<f64>, IoError> {
+        g.dataset(name).and_then(|d| d.read()).map_err(hdf)
+    };
+    let brdf_total = if g.link_exists("brdf_total") {
+        Some(
+            g.dataset("brdf_total")
+                .and_then(|d| d.read())
+                .map_err(hdf)?,
+        )
+    } else {
+        None
+    };
+    let natural = if g.link_exists("natural") {
+        Some(arr2("natural")?)
+    } else {
+        None
+    };
+    let tile_lab = if g.link_exists("tile_lab") {
+        Some(g.dataset("tile_lab").and_then(|d| d.read()).map_err(hdf)?)
+    } else {
+        None
+    };
+    Ok(Some(AppearanceArrays {
+        tile_lab,
+        wavelengths_nm: vec("wavelengths_nm")?,
+        illumination_deg: vec("illumination_deg")?,
+        viewing_deg: vec("viewing_deg")?,
+        above_deg: vec("above_deg")?,
+        reflectance: arr2("reflectance")?,
+        transmittance: arr2("transmittance")?,
+        absorption: arr2("absorption")?,
+        brdf_total,
+        natural,
+    }))
+}
+
+fn write_estimate<D: ndarray::Dimension>(
+    g: &hdf5::Group,
+    name: &str,
+    e: &Estimate<D>,
+) -> hdf5::Result<()> {
+    g.new_dataset_builder()
+        .with_data(e.mean.view())
+        .create(name)?;
+    if let Some(se) = &e.se {
+        g.new_dataset_builder()
+            .with_data(se.view())
+            .create(format!("{name}_se").as_str())?;
+    }
+    Ok(())
+}
+
+pub(super) fn write_appearance(
+    file: &hdf5::File,
+    a: &Appearance,
+    tile_png: Option<&[u8]>,
+) -> hdf5::Result<()> {
+    let g = file.create_group("appearance")?;
+    let sp = &a.spec;
+    let below = sp.below.as_ref().map(|h| h.polar_deg()).unwrap_or_default();
+    for (name, v) in [
+        ("wavelengths_nm", &sp.wavelengths_nm),
+        ("above_deg", &sp.above_deg),
+        ("illumination_deg", &sp.illumination_deg),
+        ("viewing_deg", &sp.viewing_deg),
+        ("below_deg", &below),
+    ] {
+        g.new_dataset_builder().with_data(&v[..]).create(name)?;
+    }
+    write_scalar_attr(&g, "azimuth_deg", sp.azimuth_deg)?;
+    write_scalar_attr(&g, "table_cell", sp.table.cell)?;
+    write_scalar_attr(&g, "realisations", sp.realisations as u64)?;
+    write_estimate(&g, "reflectance", &a.reflectance)?;
+    write_estimate(&g, "transmittance", &a.transmittance)?;
+    write_estimate(&g, "absorption", &a.absorption)?;
+    for (name, v) in [
+        ("specular_coherent", &a.specular_coherent),
+        ("specular_incoherent", &a.specular_incoherent),
+        ("direct_coherent", &a.direct_coherent),
+        ("direct_incoherent", &a.direct_incoherent),
+    ] {
+        g.new_dataset_builder().with_data(v.view()).create(name)?;
+    }
+    write_estimate(&g, "brdf_table", &a.brdf_table)?;
+    write_estimate(&g, "brdf_diffuse", &a.brdf_diffuse)?;
+    if let Some(t) = &a.btdf_table {
+        write_estimate(&g, "btdf_table", t)?;
+    }
+    if let Some(t) = &a.btdf_diffuse {
+        write_estimate(&g, "btdf_diffuse", t)?;
+    }
+    if let Some(p) = &a.paper {
+        write_scalar_attr(&g, "paper_albedo", p.albedo)?;
+        write_estimate(&g, "r_dd_up", &p.r_dd_up)?;
+        write_estimate(&g, "t_d", &p.t_d)?;
+    }
+    if let Some(t) = &a.brdf_total {
+        g.new_dataset_builder()
+            .with_data(t.view())
+            .create("brdf_total")?;
+    }
+    if let Some(n) = &a.natural {
+        g.new_dataset_builder()
+            .with_data(n.view())
+            .create("natural")?;
+    }
+    if let Some(c) = &a.colours {
+        g.new_dataset_builder()
+            .with_data(c.tile_srgb8.view())
+            .create("tile_srgb8")?;
+        g.new_dataset_builder()
+            .with_data(c.tile_lab.view())
+            .create("tile_lab")?;
+        let rgb = Array2::from_shape_fn((c.natural_srgb8.len(), 3), |(i, j)| c.natural_srgb8[i][j]);
+        g.new_dataset_builder()
+            .with_data(&rgb)
+            .create("natural_srgb8")?;
+        let lab = Array2::from_shape_fn((c.natural_lab.len(), 3), |(i, j)| c.natural_lab[i][j]);
+        g.new_dataset_builder()
+            .with_data(&lab)
+            .create("natural_lab")?;
+    }
+    if let Some(png) = tile_png {
+        g.new_dataset_builder().with_data(png).create("tile_png")?;
+    }
+    Ok(())
+}

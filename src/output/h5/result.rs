@@ -1,0 +1,354 @@
+//! The writer: a [`ResultSet`] checked, then written atomically in the
+//! layout of the module docs (root attributes, `/config`, `/plan`,
+//! `/geometry`, `/realisations`, `/solves`, `/summary`, `/picture_png`; the
+//! `/appearance` group through the `appearance` module).
+
+use std::path::Path;
+
+use hdf5::types::VarLenUnicode;
+use hdf5::{H5Type, Location};
+use ndarray::Array2;
+
+use super::appearance::write_appearance;
+use super::attrs::{vlu, write_scalar_attr, write_str_attr};
+use super::{IoError, FORMAT_VERSION};
+use crate::geometry::Statistics;
+use crate::optics::appearance::Appearance;
+use crate::optics::farfield::SolveEntry;
+use crate::output::atomic::write_atomic_with;
+
+/// Everything a result file holds; plain data filled by the pipeline.
+#[derive(Debug, Clone, Copy)]
+pub struct ResultSet<'a> {
+    pub version: &'a str,
+    pub config_path: &'a str,
+    /// The exact TOML text of the scene.
+    pub config_text: &'a str,
+    pub input_hash: &'a str,
+    /// The run's plan, one line per decision: what ran, what was skipped, why.
+    pub plan: &'a str,
+    pub seed: u64,
+    pub created_unix_s: u64,
+    pub geometry: GeometrySummary<'a>,
+    /// Raster grid: nx, ny, nz.
+    pub grid: [usize; 3],
+    /// Fragment size: Lx, Ly, H in nm.
+    pub size_nm: [f64; 3],
+    pub entries: &'a [SolveEntry],
+    pub picture_png: Option<&'a [u8]>,
+    /// Seed and achieved PVC of each realisation.
+    pub realisations: &'a [(u64, f64)],
+    pub appearance: Option<&'a Appearance>,
+    /// The tile PNG (stored in `/appearance`).
+    pub tile_png: Option<&'a [u8]>,
+}
+
+/// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
+/// `radii_nm`, `particle_of_sphere`) share one length, species arrays
+/// (`species_names` and the three fractions) another.
+#[derive(Debug, Clone, Copy)]
+pub struct GeometrySummary<'a> {
+    pub species_names: &'a [String],
+    pub centers_nm: &'a [[f64; 3]],
+    pub radii_nm: &'a [f64],
+    pub particle_of_sphere: &'a [u32],
+    pub species_of_particle: &'a [u32],
+    pub target_fraction: &'a [f64],
+    pub achieved_fraction: &'a [f64],
+    pub raster_fraction: &'a [f64],
+    /// Smallest surface gap between grains (None: no grains).
+    pub min_gap_nm: Option<f64>,
+    /// Full statistics of the fragment (None: no grains).
+    pub statistics: Option<&'a Statistics>,
+}
+
+/// Write a result file atomically (see the module docs for the layout).
+///
+/// Writes `<path>.tmp` in the same folder (created if missing), closes and
+/// syncs it, then renames it onto `path`. On any error the temporary file is
+/// removed and an existing `path` is left untouched.
+pub fn write_result(path: &Path, set: &ResultSet) -> Result<(), IoError> {
+    check_result_set(path, set)?;
+    write_atomic_with(path, |tmp| {
+        let hdf = |source| IoError::Hdf5 {
+            path: tmp.to_path_buf(),
+            source,
+        };
+        let file = hdf5::File::create(tmp).map_err(hdf)?;
+        write_contents(&file, set).map_err(hdf)?;
+        file.close().map_err(hdf)
+    })
+}
+
+/// One row of `/summary`.
+#[derive(H5Type, Clone, Copy, Debug)]
+#[repr(C)]
+struct SummaryRow {
+    wavelength_nm: f64,
+    polar_deg: f64,
+    azimuth_deg: f64,
+    reflectance: f64,
+    transmittance: f64,
+    absorption: f64,
+    energy_balance: f64,
+    residual: f64,
+    iterations: u64,
+}
+
+/// Refuse inconsistent input before any file is touched.
+fn check_result_set(path: &Path, set: &ResultSet) -> Result<(), IoError> {
+    let invalid = |what: &str, message: String| IoError::Invalid {
+        path: path.to_path_buf(),
+        what: what.to_string(),
+        message,
+    };
+    let strings = [
+        ("inksim_version", set.version),
+        ("config_path", set.config_path),
+        ("config text", set.config_text),
+        ("input_hash", set.input_hash),
+        ("plan", set.plan),
+    ];
+    for (what, s) in strings {
+        if s.contains('\0') {
+            return Err(invalid(what, "contains a NUL character".into()));
+        }
+    }
+    for (i, e) in set.entries.iter().enumerate() {
+        if e.record.note.contains('\0') {
+            return Err(invalid(
+                &format!("solve {i} note"),
+                "contains a NUL character".into(),
+            ));
+        }
+    }
+    let g = &set.geometry;
+    if let Some(name) = g.species_names.iter().find(|n| n.contains('\0')) {
+        return Err(invalid(
+            "geometry species_names",
+            format!("name {name:?} contains a NUL character"),
+        ));
+    }
+    let n = g.centers_nm.len();
+    if g.radii_nm.len() != n || g.particle_of_sphere.len() != n {
+        return Err(invalid(
+            "geometry",
+            format!(
+                "sphere arrays differ in length: centers_nm {n}, radii_nm {}, particle_of_sphere {}",
+                g.radii_nm.len(),
+                g.particle_of_sphere.len()
+            ),
+        ));
+    }
+    let s = g.species_names.len();
+    for (name, len) in [
+        ("target_fraction", g.target_fraction.len()),
+        ("achieved_fraction", g.achieved_fraction.len()),
+        ("raster_fraction", g.raster_fraction.len()),
+    ] {
+        if len != s {
+            return Err(invalid(
+                "geometry",
+                format!("{name} has {len} values for {s} species"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
+    let root: &Location = file;
+    write_scalar_attr(root, "format_version", FORMAT_VERSION)?;
+    write_str_attr(root, "inksim_version", set.version)?;
+    write_str_attr(root, "config_path", set.config_path)?;
+    write_str_attr(root, "input_hash", set.input_hash)?;
+    write_scalar_attr(root, "seed", set.seed)?;
+    write_scalar_attr(root, "created_unix_s", set.created_unix_s)?;
+    let grid = set.grid.map(|v| v as u64);
+    root.new_attr_builder()
+        .with_data(&grid[..])
+        .create("grid")?;
+    root.new_attr_builder()
+        .with_data(&set.size_nm[..])
+        .create("size_nm")?;
+
+    file.new_dataset::<VarLenUnicode>()
+        .shape(())
+        .create("config")?
+        .write_scalar(&vlu(set.config_text)?)?;
+    file.new_dataset::<VarLenUnicode>()
+        .shape(())
+        .create("plan")?
+        .write_scalar(&vlu(set.plan)?)?;
+
+    let g = &set.geometry;
+    let geo = file.create_group("geometry")?;
+    let centers = Array2::from_shape_fn((g.centers_nm.len(), 3), |(i, j)| g.centers_nm[i][j]);
+    geo.new_dataset_builder()
+        .with_data(&centers)
+        .create("centers_nm")?;
+    geo.new_dataset_builder()
+        .with_data(g.radii_nm)
+        .create("radii_nm")?;
+    geo.new_dataset_builder()
+        .with_data(g.particle_of_sphere)
+        .create("particle_of_sphere")?;
+    geo.new_dataset_builder()
+        .with_data(g.species_of_particle)
+        .create("species_of_particle")?;
+    let names = g
+        .species_names
+        .iter()
+        .map(|s| vlu(s))
+        .collect::<hdf5::Result<Vec<_>>>()?;
+    geo.new_dataset_builder()
+        .with_data(&names[..])
+        .create("species_names")?;
+    geo.new_dataset_builder()
+        .with_data(g.target_fraction)
+        .create("target_fraction")?;
+    geo.new_dataset_builder()
+        .with_data(g.achieved_fraction)
+        .create("achieved_fraction")?;
+    geo.new_dataset_builder()
+        .with_data(g.raster_fraction)
+        .create("raster_fraction")?;
+    if let Some(gap) = g.min_gap_nm {
+        write_scalar_attr(&geo, "min_gap_nm", gap)?;
+    }
+    if let Some(st) = g.statistics {
+        write_statistics(&geo.create_group("statistics")?, st)?;
+    }
+    let real = file.create_group("realisations")?;
+    let seeds: Vec<u64> = set.realisations.iter().map(|r| r.0).collect();
+    let pvc: Vec<f64> = set.realisations.iter().map(|r| r.1).collect();
+    real.new_dataset_builder()
+        .with_data(&seeds[..])
+        .create("seed")?;
+    real.new_dataset_builder()
+        .with_data(&pvc[..])
+        .create("achieved_pvc")?;
+
+    let solves = file.create_group("solves")?;
+    let mut rows = Vec::with_capacity(set.entries.len());
+    for (i, e) in set.entries.iter().enumerate() {
+        let s = solves.create_group(&format!("{i:04}"))?;
+        write_entry(&s, e)?;
+        let eff = &e.efficiencies;
+        rows.push(SummaryRow {
+            wavelength_nm: e.wavelength_nm,
+            polar_deg: e.incidence.polar_deg,
+            azimuth_deg: e.incidence.azimuth_deg,
+            reflectance: eff.total_reflectance,
+            transmittance: eff.total_transmittance,
+            absorption: eff.absorption,
+            energy_balance: eff.energy_balance,
+            residual: e.record.residual,
+            iterations: e.record.iterations as u64,
+        });
+    }
+    file.new_dataset_builder()
+        .with_data(&rows[..])
+        .create("summary")?;
+
+    if let Some(png) = set.picture_png {
+        file.new_dataset_builder()
+            .with_data(png)
+            .create("picture_png")?;
+    }
+    if let Some(app) = set.appearance {
+        write_appearance(file, app, set.tile_png)?;
+    }
+    file.flush()
+}
+
+fn write_statistics(g: &hdf5::Group, st: &Statistics) -> hdf5::Result<()> {
+    for (name, v) in [
+        ("pvc_total", st.pvc_total),
+        ("min_gap_nm", st.min_gap_nm),
+        ("worst_overlap_nm", st.worst_overlap_nm),
+        ("mean_diameter_nm", st.mean_diameter_nm),
+        ("protrusion_nm", st.protrusion_nm),
+        ("bottom_excess_nm", st.bottom_excess_nm),
+        ("rdf_slab_nm", st.rdf_slab_nm),
+        ("contact_gap_nm", st.contact_gap_nm),
+    ] {
+        write_scalar_attr(g, name, v)?;
+    }
+    if let Some(s) = st.order_parameter {
+        write_scalar_attr(g, "order_parameter", s)?;
+    }
+    let count: Vec<u64> = st.count.iter().map(|&c| c as u64).collect();
+    let clusters: Vec<u64> = st.cluster_sizes.iter().map(|&c| c as u64).collect();
+    g.new_dataset_builder()
+        .with_data(&count[..])
+        .create("count")?;
+    g.new_dataset_builder()
+        .with_data(&clusters[..])
+        .create("cluster_sizes")?;
+    for (name, v) in [
+        ("volume_nm3", &st.volume_nm3),
+        ("pvc", &st.pvc),
+        ("profile_z_nm", &st.profile_z_nm),
+        ("profile_fraction", &st.profile_fraction),
+        ("rdf_r_nm", &st.rdf_r_nm),
+        ("rdf", &st.rdf),
+    ] {
+        g.new_dataset_builder().with_data(&v[..]).create(name)?;
+    }
+    Ok(())
+}
+
+fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
+    let eff = &e.efficiencies;
+    let rec = &e.record;
+    for (name, v) in [
+        ("wavelength_nm", e.wavelength_nm),
+        ("polar_deg", e.incidence.polar_deg),
+        ("azimuth_deg", e.incidence.azimuth_deg),
+        ("total_reflectance", eff.total_reflectance),
+        ("total_transmittance", eff.total_transmittance),
+        ("absorption", eff.absorption),
+        ("energy_balance", eff.energy_balance),
+        ("residual", rec.residual),
+        ("seconds", rec.seconds),
+    ] {
+        write_scalar_attr(g, name, v)?;
+    }
+    g.new_attr_builder()
+        .with_data(&[eff.r00.re, eff.r00.im][..])
+        .create("r00")?;
+    g.new_attr_builder()
+        .with_data(&[eff.t00.re, eff.t00.im][..])
+        .create("t00")?;
+    write_str_attr(g, "method", &rec.method.to_string())?;
+    write_str_attr(g, "side", &e.side.to_string())?;
+    write_scalar_attr(g, "realisation", e.realisation as u64)?;
+    write_scalar_attr(g, "iterations", rec.iterations as u64)?;
+    write_scalar_attr(g, "operator_applications", rec.operator_applications as u64)?;
+    write_str_attr(g, "note", &rec.note)?;
+
+    let k = eff.orders.len();
+    let mn = Array2::from_shape_fn((k, 2), |(i, j)| {
+        if j == 0 {
+            eff.orders[i].m
+        } else {
+            eff.orders[i].n
+        }
+    });
+    g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
+    let column = |f: fn(&crate::optics::farfield::Order) -> f64| {
+        eff.orders.iter().map(f).collect::<Vec<_>>()
+    };
+    for (name, values) in [
+        ("orders_theta_deg", column(|o| o.theta_deg)),
+        ("orders_phi_deg", column(|o| o.phi_deg)),
+        ("orders_reflectance", column(|o| o.reflectance)),
+        ("orders_transmittance", column(|o| o.transmittance)),
+    ] {
+        g.new_dataset_builder()
+            .with_data(&values[..])
+            .create(name)?;
+    }
+    Ok(())
+}

@@ -1,4 +1,4 @@
-//! Stage 0 — configuration.
+//! Configuration: the scene file read, checked and turned into a [`Scene`].
 //!
 //! A scene is read from TOML into raw serde structs (`raw`, with
 //! `deny_unknown_fields` and tagged enums, units in key names), then validated
@@ -8,16 +8,16 @@
 //! The solution methods' names (and whether a scene may use them) are
 //! [`Method`]'s; the solver's registry gives each its implementation.
 
+mod check;
 pub mod materials;
 mod method;
 mod raw;
-mod validate;
 
 use std::path::{Path, PathBuf};
 
+pub use check::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
-pub use validate::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
 /// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).
@@ -263,7 +263,7 @@ pub struct Primitive {
     pub material: Material,
 }
 
-/// The layer given explicitly (issue #7): users with measured structures,
+/// The layer given explicitly: for users with measured structures,
 /// and validation.
 #[derive(Debug, Clone)]
 pub enum Structure {

@@ -3,7 +3,7 @@
 //! Every table denies unknown keys, so a typo is an error rather than a
 //! silently ignored setting. Units are part of the key names. Values are not
 //! checked here (integers are read as `i64` so that out-of-range values reach
-//! `validate` and get a message with the allowed range); `validate` turns this
+//! `check` and get a message with the allowed range); `check` turns this
 //! into the checked [`Scene`](super::Scene).
 
 use super::Method;

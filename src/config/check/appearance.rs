@@ -1,0 +1,103 @@
+//! `[appearance]` (products, viewing angles, BRDF cell, quadrature) and
+//! `[substrate]` (none, or paper of an albedo).
+
+use super::{Checker, MAX_POLAR_DEG};
+use crate::config::raw::{RawAppearance, RawProduct, RawSubstrate};
+use crate::config::{Appearance, ConfigError, Incidence, Products, Substrate};
+
+/// Paper albedo of the reference study (METHOD §8).
+pub const DEFAULT_PAPER_ALBEDO: f64 = 0.9;
+const DEFAULT_QUADRATURE_POINTS: i64 = 6;
+
+impl Checker<'_> {
+    pub(super) fn appearance(
+        &self,
+        raw: Option<&RawAppearance>,
+        incidence: &[Incidence],
+    ) -> Result<Appearance, ConfigError> {
+        let viewing_deg = match raw.and_then(|a| a.viewing_deg.as_ref()) {
+            None => incidence.iter().map(|i| i.polar_deg).collect(),
+            Some(list) => {
+                let key = "appearance.viewing_deg";
+                if list.is_empty() {
+                    return Err(self.invalid(key, "must not be empty"));
+                }
+                for (i, &v) in list.iter().enumerate() {
+                    let k = format!("{key}[{i}]");
+                    self.range(
+                        &k,
+                        v,
+                        (0.0..=MAX_POLAR_DEG).contains(&v),
+                        &format!("[0, {MAX_POLAR_DEG}] deg"),
+                    )?;
+                    if i > 0 && v <= list[i - 1] {
+                        return Err(self.invalid(
+                            k,
+                            format!(
+                                "values must be strictly increasing, got {v} after {}",
+                                list[i - 1]
+                            ),
+                        ));
+                    }
+                }
+                list.clone()
+            }
+        };
+        let mut products = Products::default();
+        let list = raw
+            .and_then(|a| a.outputs.clone())
+            .unwrap_or_else(|| vec![RawProduct::Brdf, RawProduct::Tile]);
+        for p in list {
+            match p {
+                RawProduct::Brdf => products.brdf = true,
+                RawProduct::Btdf => products.btdf = true,
+                RawProduct::Tile => products.tile = true,
+                RawProduct::Merl => products.merl = true,
+            }
+        }
+        let brdf_cell = match raw.and_then(|a| a.brdf_cell) {
+            None => None,
+            Some(c) => Some(self.range(
+                "appearance.brdf_cell",
+                c,
+                c > 0.0 && c <= 1.0,
+                "(0, 1] (in units of sin θ)",
+            )?),
+        };
+        let q = raw
+            .and_then(|a| a.quadrature_points)
+            .unwrap_or(DEFAULT_QUADRATURE_POINTS);
+        if !(2..=32).contains(&q) {
+            return Err(self.invalid(
+                "appearance.quadrature_points",
+                format!("must be in [2, 32], got {q}"),
+            ));
+        }
+        Ok(Appearance {
+            viewing_deg,
+            products,
+            brdf_cell,
+            quadrature_points: q as usize,
+        })
+    }
+
+    pub(super) fn substrate(&self, raw: Option<&RawSubstrate>) -> Result<Substrate, ConfigError> {
+        Ok(match raw {
+            Some(RawSubstrate::None) => Substrate::None,
+            None => Substrate::Paper {
+                albedo: DEFAULT_PAPER_ALBEDO,
+            },
+            Some(RawSubstrate::Paper { albedo }) => {
+                let a = albedo.unwrap_or(DEFAULT_PAPER_ALBEDO);
+                Substrate::Paper {
+                    albedo: self.range(
+                        "substrate.albedo",
+                        a,
+                        (0.0..=1.0).contains(&a),
+                        "[0, 1]",
+                    )?,
+                }
+            }
+        })
+    }
+}

@@ -1,0 +1,126 @@
+//! Checks a [`RawConfig`](super::raw::RawConfig) and builds the [`Scene`].
+//!
+//! Every value is checked against its documented range; the first violation
+//! (in file order) is reported as [`ConfigError::Invalid`] with the dotted key
+//! (`pigment[1].pvc`) and the allowed range. Choices made here:
+//! - From `grid.cell_nm`, `nx`/`ny` are the smallest 2^a·3^b·5^c ≥
+//!   ⌈fragment/cell⌉ (FFT-friendly; the cell in x/y may shrink slightly) and
+//!   `nz = max(2, ⌈thickness/z_cell⌉)` (z is not transformed), with
+//!   `z_cell = grid.z_cell_nm` or by default `min(cell_nm, 10 nm)`: the
+//!   z discretisation error is O(dz²) and cheap to reduce (cost is linear in
+//!   nz), and 10 nm keeps it below 1e-3 in R and T for a 1 µm layer
+//!   (tests/solver_slab.rs). The ceilings
+//!   forgive a relative 1e-9 so that e.g. 1.1/0.1 gives 11, not 12.
+//! - Wavelength and polar-angle lists must be strictly increasing (no
+//!   duplicate solves, ordered spectra).
+//! - A `wavelength_range_nm` includes `stop` when it lies on the step grid
+//!   within a relative 1e-9 of a step; the last value is then exactly `stop`.
+//! - A pigment's diameter must fit the layer (≤ thickness) and the periodic
+//!   fragment (≤ min(fragment x, y)); the total PVC is limited to
+//!   [`MAX_PVC`], what the dynamics packer reaches.
+//! - Geometry keys: `pigment.size = { kind = "fixed" | "normal" |
+//!   "log-normal", sigma }` (normal: relative σ ≤ [`MAX_NORMAL_SIGMA`];
+//!   log-normal: σ of ln d ≤ [`MAX_LOG_NORMAL_SIGMA`]); the largest draw
+//!   (3 σ) must fit the layer and the fragment like `diameter_nm`.
+//!   `pigment.agglomeration = { cluster_size }` in `[1, MAX_CLUSTER_SIZE]`;
+//!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`;
+//!   `layer.equilibrate_sweeps` in `[0, MAX_EQUILIBRATE_SWEEPS]`.
+//! - `Provenance::input_hash` is SHA-256 over the config text followed by each
+//!   pigment's table text, in pigment order, then each structure primitive's
+//!   table text or the bytes of the structure's HDF5 file.
+//! - `[structure]` (explicit layer) and `[[pigment]]` exclude each other.
+//!
+//! One file per part of the scene, each adding its methods to [`Checker`]:
+//! `scene` (the whole scene, wavelength coverage, input hash, output names),
+//! `layer` (thickness, fragment, binder, grid), `pigments` (species, shapes,
+//! sizes, agglomeration), `material` (builtin, index, CSV), `structure`
+//! (explicit primitives or an ε grid), `illumination` (wavelengths, polar
+//! angles), `solver` (method, tolerance, precision) and `appearance`
+//! (products, viewing angles, substrate).
+
+mod appearance;
+mod illumination;
+mod layer;
+mod material;
+mod pigments;
+mod scene;
+mod solver;
+mod structure;
+
+use super::raw::RawConfig;
+use super::{ConfigError, Scene};
+use std::path::Path;
+
+pub use appearance::DEFAULT_PAPER_ALBEDO;
+
+/// Largest polar angle, of illumination and of viewing.
+const MAX_POLAR_DEG: f64 = 89.0;
+/// Relative slack for ceilings and for landing on `stop` in a range.
+const REL_EPS: f64 = 1e-9;
+
+/// Reads `path` and parses it with [`parse_scene`].
+pub fn load_scene(path: &Path) -> Result<Scene, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(path, &text)
+}
+
+/// Parses and validates scene TOML `text`; `path` is where it came from (used
+/// in messages, for resolving CSV paths and for default output names).
+pub fn parse_scene(path: &Path, text: &str) -> Result<Scene, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+        file: path.to_path_buf(),
+        message: parse_message(text, &e),
+    })?;
+    Checker { file: path }.scene(path, text, raw)
+}
+
+/// The toml error on one line: `line L, column C: message; more`.
+fn parse_message(text: &str, e: &toml::de::Error) -> String {
+    let msg = e
+        .message()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ");
+    match e.span() {
+        Some(span) => {
+            let mut start = span.start.min(text.len());
+            while !text.is_char_boundary(start) {
+                start -= 1;
+            }
+            let before = &text[..start];
+            let line = before.matches('\n').count() + 1;
+            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            format!("line {line}, column {col}: {msg}")
+        }
+        None => msg,
+    }
+}
+
+/// Checks the parts of one file's raw scene; every error names `file`.
+struct Checker<'a> {
+    file: &'a Path,
+}
+
+impl Checker<'_> {
+    fn invalid(&self, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
+        ConfigError::Invalid {
+            file: self.file.to_path_buf(),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// `Ok(v)` when `ok`, else "must be in {range}, got {v}".
+    fn range(&self, key: &str, v: f64, ok: bool, range: &str) -> Result<f64, ConfigError> {
+        if ok {
+            Ok(v)
+        } else {
+            Err(self.invalid(key, format!("must be in {range}, got {v}")))
+        }
+    }
+}

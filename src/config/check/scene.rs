@@ -1,0 +1,180 @@
+//! The whole scene: its parts checked in file order, every material checked
+//! against every wavelength, the input hash, and the output folder and name.
+
+use super::Checker;
+use crate::config::raw::{RawConfig, RawOutput};
+use crate::config::{ConfigError, OutputSpec, Provenance, Scene, Structure};
+use sha2::{Digest, Sha256};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+const DEFAULT_SEED: u64 = 1;
+const MAX_REALISATIONS: i64 = 10_000;
+
+impl Checker<'_> {
+    pub(super) fn scene(
+        &self,
+        path: &Path,
+        text: &str,
+        raw: RawConfig,
+    ) -> Result<Scene, ConfigError> {
+        let seed = match raw.seed {
+            None => DEFAULT_SEED,
+            Some(s) if s >= 0 => s as u64,
+            Some(s) => return Err(self.invalid("seed", format!("must be >= 0, got {s}"))),
+        };
+        let realisations = match raw.realisations {
+            None => 1,
+            Some(r) if (1..=MAX_REALISATIONS).contains(&r) => r as usize,
+            Some(r) => {
+                return Err(self.invalid(
+                    "realisations",
+                    format!("must be in [1, {MAX_REALISATIONS}], got {r}"),
+                ))
+            }
+        };
+        let layer = self.layer(&raw.layer)?;
+        let structure = match &raw.structure {
+            None => None,
+            Some(st) => Some(self.structure(st, &layer)?),
+        };
+        let species = if structure.is_some() {
+            if !raw.pigment.is_empty() || raw.layer.pvc.is_some() {
+                return Err(self.invalid(
+                    "structure",
+                    "an explicit structure replaces the generated grains: remove [[pigment]] and layer.pvc",
+                ));
+            }
+            Vec::new()
+        } else {
+            self.pigments(&raw.pigment, &layer, raw.layer.pvc)?
+        };
+        let grid = self.grid(&raw.grid, &layer)?;
+        let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
+        let incidence = self.incidence(&raw.illumination)?;
+        let solver = self.solver(raw.solver.as_ref())?;
+        let output = self.output(path, raw.output.as_ref())?;
+        let appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
+        let substrate = self.substrate(raw.substrate.as_ref())?;
+
+        for &wl in &wavelengths_nm {
+            for s in &species {
+                if s.material.index_at(wl).is_none() {
+                    let (lo, hi) = s.material.range_nm();
+                    return Err(self.invalid(
+                        wl_key,
+                        format!(
+                            "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
+                             material {} (pigment `{}`)",
+                            s.material, s.name
+                        ),
+                    ));
+                }
+            }
+        }
+
+        if let Some(Structure::Primitives(ps)) = &structure {
+            for &wl in &wavelengths_nm {
+                for (i, p) in ps.iter().enumerate() {
+                    if p.material.index_at(wl).is_none() {
+                        let (lo, hi) = p.material.range_nm();
+                        return Err(self.invalid(
+                            wl_key,
+                            format!(
+                                "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
+                                 material {} (structure.primitive[{i}])",
+                                p.material
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+
+        let mut hasher = Sha256::new();
+        hasher.update(text.as_bytes());
+        for s in &species {
+            hasher.update(s.material.table_bytes());
+        }
+        match &structure {
+            Some(Structure::Primitives(ps)) => {
+                for p in ps {
+                    hasher.update(p.material.table_bytes());
+                }
+            }
+            Some(Structure::Hdf5(path)) => {
+                let bytes = std::fs::read(path).map_err(|source| ConfigError::Read {
+                    file: path.clone(),
+                    source,
+                })?;
+                hasher.update(&bytes);
+            }
+            None => {}
+        }
+        let mut input_hash = String::with_capacity(64);
+        for b in hasher.finalize() {
+            let _ = write!(input_hash, "{b:02x}");
+        }
+
+        Ok(Scene {
+            provenance: Provenance {
+                path: path.to_path_buf(),
+                text: text.to_string(),
+                input_hash,
+            },
+            seed,
+            realisations,
+            layer,
+            species,
+            grid,
+            wavelengths_nm,
+            incidence,
+            solver,
+            output,
+            appearance,
+            substrate,
+            structure,
+        })
+    }
+
+    pub(super) fn output(
+        &self,
+        path: &Path,
+        raw: Option<&RawOutput>,
+    ) -> Result<OutputSpec, ConfigError> {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty())
+            .unwrap_or_else(|| "scene".to_string());
+        let dir = match raw.and_then(|o| o.dir.as_deref()) {
+            Some(d) if d.trim().is_empty() => {
+                return Err(self.invalid("output.dir", "must not be empty"))
+            }
+            Some(d) => PathBuf::from(d),
+            None => Path::new("runs").join(&stem),
+        };
+        let (name, from_stem) = match raw.and_then(|o| o.name.clone()) {
+            Some(n) => (n, false),
+            None => (stem, true),
+        };
+        let valid = !name.is_empty()
+            && name != "."
+            && name != ".."
+            && name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '-'));
+        if !valid {
+            let origin = if from_stem {
+                " (defaulted from the config file name; set output.name)"
+            } else {
+                ""
+            };
+            return Err(self.invalid(
+                "output.name",
+                format!("must be non-empty and use only A-Z a-z 0-9 _ . -, got `{name}`{origin}"),
+            ));
+        }
+        Ok(OutputSpec { dir, name })
+    }
+}

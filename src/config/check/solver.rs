@@ -1,0 +1,72 @@
+//! `[solver]`: the method, tolerance, iteration limit, field precision and
+//! the effective-medium tolerance.
+
+use super::Checker;
+use crate::config::raw::{RawMethod, RawPrecision, RawSolver};
+use crate::config::{ConfigError, Method, Precision, SolverSpec};
+
+const DEFAULT_TOLERANCE: f64 = 1e-6;
+const DEFAULT_MAX_ITERATIONS: usize = 5000;
+/// Smallest relative residual f32 field storage reaches reliably.
+pub const F32_MIN_TOLERANCE: f64 = 1e-6;
+const MAX_ITERATIONS: i64 = 10_000_000;
+/// Default accepted error of the effective-medium shortcut: the R/T/A error
+/// of the recommended 25 nm grid (docs/ACCURACY.md), so the shortcut costs
+/// no more accuracy than the discretisation it replaces.
+pub const DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 1e-3;
+/// Largest accepted error of the effective-medium shortcut.
+pub const MAX_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 0.1;
+
+impl Checker<'_> {
+    pub(super) fn solver(&self, raw: Option<&RawSolver>) -> Result<SolverSpec, ConfigError> {
+        let method = raw
+            .and_then(|s| s.method)
+            .map_or(Method::Auto, |RawMethod(m)| m);
+        let t = raw.and_then(|s| s.tolerance).unwrap_or(DEFAULT_TOLERANCE);
+        let tolerance = self.range(
+            "solver.tolerance",
+            t,
+            (1e-12..=1e-1).contains(&t),
+            "[1e-12, 1e-1]",
+        )?;
+        let max_iterations = match raw.and_then(|s| s.max_iterations) {
+            None => DEFAULT_MAX_ITERATIONS,
+            Some(m) if (1..=MAX_ITERATIONS).contains(&m) => m as usize,
+            Some(m) => {
+                return Err(self.invalid(
+                    "solver.max_iterations",
+                    format!("must be in [1, {MAX_ITERATIONS}], got {m}"),
+                ))
+            }
+        };
+        let precision = match raw.and_then(|s| s.precision) {
+            Some(RawPrecision::F32) => Precision::F32,
+            Some(RawPrecision::F64) | None => Precision::F64,
+        };
+        if precision == Precision::F32 && tolerance < F32_MIN_TOLERANCE {
+            return Err(self.invalid(
+                "solver.tolerance",
+                format!(
+                    "must be in [{F32_MIN_TOLERANCE:e}, 1e-1] with precision = \"f32\" \
+                     (f32 fields cannot hold a smaller residual), got {tolerance:e}"
+                ),
+            ));
+        }
+        let e = raw
+            .and_then(|s| s.effective_medium_tolerance)
+            .unwrap_or(DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE);
+        let effective_medium_tolerance = self.range(
+            "solver.effective_medium_tolerance",
+            e,
+            (0.0..=MAX_EFFECTIVE_MEDIUM_TOLERANCE).contains(&e),
+            "[0, 0.1] (absolute error in R, T, A; 0 never takes the shortcut)",
+        )?;
+        Ok(SolverSpec {
+            method,
+            tolerance,
+            max_iterations,
+            precision,
+            effective_medium_tolerance,
+        })
+    }
+}

@@ -5,6 +5,8 @@
 //!   the energy balance, and the angular BRDF/BTDF tables;
 //! - [`substrate`]: the Lambertian paper and the layer–paper inter-reflections;
 //! - [`colour`]: CIE colorimetry (XYZ, CIELAB, CIEDE2000, sRGB);
+//! - [`effective_medium`]: the homogeneous slab of the volume-averaged ε
+//!   and the estimated error of replacing grains by it;
 //! - [`appearance`]: ensemble means with standard errors, natural light and
 //!   the colours of a result.
 //!
@@ -12,5 +14,6 @@
 
 pub mod appearance;
 pub mod colour;
+pub mod effective_medium;
 pub mod farfield;
 pub mod substrate;

@@ -1,0 +1,144 @@
+//! The three ways a layer is made and solved: the homogeneous slab in closed
+//! form (a molecular mixture, or grains fine enough for the effective-medium
+//! shortcut), an explicit structure (primitive bodies or an ε grid), or
+//! packed grains, one particle set per realisation. Each gives its solves
+//! and what the result file records of the layer.
+
+use crate::config::{Scene, Structure};
+use crate::geometry::Geometry;
+use crate::optics::farfield::SolveEntry;
+use crate::output::progress::Progress;
+use crate::raster::structure::{self, EpsGrid};
+use crate::raster::{self, Raster};
+
+use super::grains::{build_geometry_seeded, grid_of};
+use super::plan::RunPlan;
+use super::solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
+use super::{PipelineError, SUPERSAMPLE};
+
+/// A solved layer.
+pub struct SolvedLayer {
+    /// Every solve, in run order.
+    pub entries: Vec<SolveEntry>,
+    /// Seed and achieved PVC of each realisation.
+    pub realisations: Vec<(u64, f64)>,
+    /// The particle set of realisation 0 (generated grains only).
+    pub geometry: Option<Geometry>,
+    /// The raster of realisation 0, or of explicit primitives.
+    pub raster: Option<Raster>,
+}
+
+/// Make and solve the layer the plan calls for.
+pub fn solve(
+    scene: &Scene,
+    plan: &RunPlan,
+    progress: &Progress,
+) -> Result<SolvedLayer, PipelineError> {
+    if plan.analytic {
+        homogeneous(scene, plan, progress)
+    } else if let Some(st) = &scene.structure {
+        explicit(scene, plan, st, progress)
+    } else {
+        grains(scene, plan, progress)
+    }
+}
+
+/// The homogeneous slab of the volume-averaged ε, in closed form.
+fn homogeneous(
+    scene: &Scene,
+    plan: &RunPlan,
+    progress: &Progress,
+) -> Result<SolvedLayer, PipelineError> {
+    Ok(SolvedLayer {
+        entries: solve_analytic(scene, plan, progress)?,
+        realisations: vec![(scene.seed, scene.total_pvc())],
+        geometry: None,
+        raster: None,
+    })
+}
+
+/// An explicit structure: primitives rasterised by volume fraction, or an ε
+/// grid read from a file (no fractions: its PVC is recorded as 0).
+fn explicit(
+    scene: &Scene,
+    plan: &RunPlan,
+    st: &Structure,
+    progress: &Progress,
+) -> Result<SolvedLayer, PipelineError> {
+    let grid = grid_of(scene);
+    match st {
+        Structure::Primitives(ps) => {
+            let raster = structure::rasterize_primitives(ps, &grid);
+            let f: f64 = raster.mean_fractions().iter().sum();
+            let entries = solve_layer(scene, plan, LayerEps::Raster(&raster), 0, progress)?;
+            Ok(SolvedLayer {
+                entries,
+                realisations: vec![(scene.seed, f)],
+                geometry: None,
+                raster: Some(raster),
+            })
+        }
+        Structure::Hdf5(path) => {
+            let eg = EpsGrid::read(path, &grid, &scene.wavelengths_nm)?;
+            let entries = solve_layer(scene, plan, LayerEps::Grid(&eg, grid), 0, progress)?;
+            Ok(SolvedLayer {
+                entries,
+                realisations: vec![(scene.seed, 0.0)],
+                geometry: None,
+                raster: None,
+            })
+        }
+    }
+}
+
+/// Packed grains: per realisation a particle set from its seed, rasterised
+/// and solved; realisation 0's geometry and raster are kept.
+fn grains(
+    scene: &Scene,
+    plan: &RunPlan,
+    progress: &Progress,
+) -> Result<SolvedLayer, PipelineError> {
+    let grid = grid_of(scene);
+    let mut layer = SolvedLayer {
+        entries: Vec::new(),
+        realisations: Vec::new(),
+        geometry: None,
+        raster: None,
+    };
+    for (r, &seed) in plan.seeds.iter().enumerate() {
+        let geometry = build_geometry_seeded(scene, seed)?;
+        let st = &geometry.stats;
+        let pvc: f64 = st.achieved_fraction.iter().sum();
+        progress.log(&format!(
+            "geometry{}: {} particles, PVC {:.4} (target {:.4}), worst overlap {:.3} nm{}",
+            if plan.realisations > 1 {
+                format!(" #{r} (seed {seed})")
+            } else {
+                String::new()
+            },
+            geometry.particles.len(),
+            pvc,
+            scene.total_pvc(),
+            st.worst_overlap_nm,
+            st.order_parameter
+                .map(|o| format!(", order parameter S = {o:.3}"))
+                .unwrap_or_default()
+        ));
+        let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+        if r == 0 {
+            progress.log(&format!(
+                "raster: {} × {} × {} voxels",
+                grid.nx, grid.ny, grid.nz
+            ));
+        }
+        layer
+            .entries
+            .extend(solve_realisation(scene, plan, &raster, r, progress)?);
+        layer.realisations.push((seed, pvc));
+        if layer.geometry.is_none() {
+            layer.geometry = Some(geometry);
+            layer.raster = Some(raster);
+        }
+    }
+    Ok(layer)
+}

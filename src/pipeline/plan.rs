@@ -1,0 +1,449 @@
+//! The run plan: what a run computes and what it skips, and why, derived
+//! from what the scene asks for — how the layer is made (closed-form slab,
+//! explicit structure or generated grains, and which packer), how many
+//! realisations with which seeds, which solves from above and below, and
+//! which appearance products. Every decision is one line of the plan that is
+//! logged and stored with the results.
+
+use crate::config::{GrainShape, Incidence, Scene, Structure, Substrate};
+use crate::optics::effective_medium::{self, GrainClass, WorstError};
+use crate::optics::farfield::table::TableSpec;
+use crate::optics::farfield::{Side, SolveEntry};
+use crate::optics::substrate::Hemisphere;
+
+use super::eps::species_eps;
+use super::grains::{largest_grain_nm, Packer, RSA_MAX_PVC};
+
+/// Seed of realisation `r`: the scene's seed for r = 0 (so a
+/// one-realisation run equals the plain scene), else SplitMix64 of
+/// `seed + r · 0x9E3779B97F4A7C15` — fixed by (seed, r), never by scheduling.
+pub fn realisation_seed(seed: u64, r: usize) -> u64 {
+    if r == 0 {
+        return seed;
+    }
+    let mut z = seed.wrapping_add((r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// What a run computes and what it skips, derived from what the scene asks
+/// for: only the effects a scene calls for.
+#[derive(Debug, Clone)]
+pub struct RunPlan {
+    /// Homogeneous layer in closed form: no geometry, grid or iteration.
+    pub analytic: bool,
+    /// Realisations actually run (1 for a deterministic homogeneous layer).
+    pub realisations: usize,
+    pub seeds: Vec<u64>,
+    /// Polar angles solved from above.
+    pub above_deg: Vec<f64>,
+    /// Quadrature for light from below (paper term), if needed.
+    pub below: Option<Hemisphere>,
+    pub table: TableSpec,
+    /// One line per decision: what runs, what is skipped, and why.
+    pub lines: Vec<String>,
+}
+
+impl RunPlan {
+    /// Derive the plan of a scene.
+    pub fn of(scene: &Scene) -> RunPlan {
+        let explicit = scene.structure.is_some();
+        let (above, extra) = above_angles(scene);
+        let paper = matches!(scene.substrate, Substrate::Paper { .. });
+        let below = (scene.appearance.products.tile && paper)
+            .then(|| Hemisphere::new(scene.appearance.quadrature_points));
+        let shortcut = if scene.is_molecular() || explicit {
+            None
+        } else {
+            let mut angles = above.clone();
+            angles.extend(below.iter().flat_map(|h| h.polar_deg()));
+            Some(effective_medium_shortcut(scene, &angles))
+        };
+        let analytic = scene.is_molecular() || matches!(shortcut, Some(Ok(_)));
+        let mut lines = layer_lines(scene, shortcut.as_ref());
+        if !analytic && !explicit {
+            lines.extend(grain_lines(scene));
+        }
+        let (realisations, line) = realisations_of(scene, analytic, explicit);
+        lines.push(line);
+        let seeds = (0..realisations)
+            .map(|r| realisation_seed(scene.seed, r))
+            .collect();
+        lines.extend(solve_lines(&above, extra, below.as_ref(), paper));
+        let (table, line) = table_of(scene);
+        lines.push(line);
+        lines.extend(product_lines(scene));
+        RunPlan {
+            analytic,
+            realisations,
+            seeds,
+            above_deg: above,
+            below,
+            table,
+            lines,
+        }
+    }
+
+    /// Solves per realisation and wavelength.
+    pub fn solves_per_wavelength(&self) -> usize {
+        self.above_deg.len() + self.below.as_ref().map_or(0, |h| h.mu.len())
+    }
+
+    /// Total solves of a run.
+    pub fn solves(&self, scene: &Scene) -> usize {
+        self.realisations * scene.wavelengths_nm.len() * self.solves_per_wavelength()
+    }
+}
+
+/// How the layer is made: a closed-form slab (molecular mixture or the
+/// effective-medium shortcut), an explicit structure, or packed grains (and,
+/// when the shortcut was weighed, why it was refused).
+fn layer_lines(scene: &Scene, shortcut: Option<&Result<String, String>>) -> Vec<String> {
+    let mut lines = Vec::new();
+    if scene.is_molecular() {
+        lines.push(
+            "geometry: none — molecular mixture: the homogeneous slab with the \
+             volume-averaged ε, solved in closed form (Airy); no grid, no iteration"
+                .to_string(),
+        );
+    } else if let Some(Ok(why)) = shortcut {
+        lines.push(format!(
+            "geometry: none — effective-medium shortcut: {why}; the homogeneous slab with \
+             the volume-averaged ε, solved in closed form (Airy); no packing, no grid, no iteration"
+        ));
+    } else if let Some(st) = &scene.structure {
+        lines.push(match st {
+            Structure::Primitives(ps) => format!(
+                "geometry: explicit structure, {} primitive bodies rasterised by volume fraction; no packing",
+                ps.len()
+            ),
+            Structure::Hdf5(p) => format!(
+                "geometry: explicit structure, ε grid from {}; no packing, no raster",
+                p.display()
+            ),
+        });
+    } else {
+        let (packer, why) = Packer::of(scene);
+        lines.push(format!("geometry: {packer} ({why})"));
+        if let Some(Err(why)) = shortcut {
+            lines.push(format!("effective-medium shortcut: refused — {why}"));
+        }
+    }
+    lines
+}
+
+/// What the packed grains go through: surface relief, equilibration,
+/// agglomeration.
+fn grain_lines(scene: &Scene) -> Vec<String> {
+    let mut lines = Vec::new();
+    let rf = scene.layer.relief_fraction;
+    lines.push(if rf > 0.0 {
+        format!(
+            "surface relief: grains may protrude up to {:.0} % of their size through the top; \
+             the grid extends above the binder (vacuum around the grains, binder surface flat)",
+            rf * 100.0
+        )
+    } else {
+        "surface relief: none (grains stay inside the binder)".to_string()
+    });
+    if scene.layer.equilibrate_sweeps > 0 {
+        lines.push(format!(
+            "equilibration: {} hard-particle Monte Carlo sweeps after packing \
+             (Brownian settling; agglomerates move as a whole)",
+            scene.layer.equilibrate_sweeps
+        ));
+    }
+    for s in &scene.species {
+        if s.cluster_size > 1 {
+            lines.push(format!(
+                "agglomeration: `{}` grains seeded in clusters of ~{}",
+                s.name, s.cluster_size
+            ));
+        }
+    }
+    lines
+}
+
+/// Realisations actually run (one for a deterministic layer), and the line
+/// that says so.
+fn realisations_of(scene: &Scene, analytic: bool, explicit: bool) -> (usize, String) {
+    let realisations = if analytic || explicit {
+        1
+    } else {
+        scene.realisations
+    };
+    let line = if (analytic || explicit) && scene.realisations > 1 {
+        format!(
+            "realisations: 1 of {} requested — {} is deterministic",
+            scene.realisations,
+            if analytic {
+                "a homogeneous layer"
+            } else {
+                "an explicit structure"
+            }
+        )
+    } else {
+        format!(
+            "realisations: {realisations}{}",
+            if realisations == 1 {
+                " (no standard errors; the specular split needs ≥ 2)"
+            } else {
+                ""
+            }
+        )
+    };
+    (realisations, line)
+}
+
+/// The solves from above and from below, or why those from below are
+/// skipped.
+fn solve_lines(
+    above: &[f64],
+    extra: usize,
+    below: Option<&Hemisphere>,
+    paper: bool,
+) -> Vec<String> {
+    let mut lines = vec![format!(
+        "solves from above at {} polar angles {}{}",
+        above.len(),
+        fmt_list(above),
+        if extra > 0 {
+            format!(" ({extra} viewing angles beyond the illumination angles: the tile needs R and T there)")
+        } else {
+            String::new()
+        }
+    )];
+    if let Some(h) = below {
+        lines.push(format!(
+            "solves from below (layer flipped) at {} Gauss–Legendre nodes {}: the paper term needs R_dd↑ and T_d",
+            h.mu.len(),
+            fmt_list(&h.polar_deg())
+        ));
+    } else if !paper {
+        lines.push("solves from below: skipped — no substrate".to_string());
+    } else {
+        lines.push(
+            "solves from below: skipped — no tile requested, nothing uses the paper term"
+                .to_string(),
+        );
+    }
+    lines
+}
+
+/// The angular table of the BRDF/BTDF, and the line describing it.
+fn table_of(scene: &Scene) -> (TableSpec, String) {
+    let max_wl = scene.wavelengths_nm.iter().copied().fold(0.0, f64::max);
+    let l = &scene.layer;
+    let cell = scene
+        .appearance
+        .brdf_cell
+        .unwrap_or_else(|| TableSpec::default_cell(max_wl, [l.fragment_x_nm, l.fragment_y_nm]));
+    let table = TableSpec::new(cell);
+    let line = format!(
+        "BRDF table: cell {cell:.4} in sin θ ({}), {}×{} nodes",
+        if scene.appearance.brdf_cell.is_some() {
+            "set"
+        } else {
+            "default 2 λ_max / L"
+        },
+        table.n(),
+        table.n()
+    );
+    (table, line)
+}
+
+/// Which appearance products run and which are skipped.
+fn product_lines(scene: &Scene) -> Vec<String> {
+    let products = scene.appearance.products;
+    let mut lines = vec![
+        if products.btdf {
+            "BTDF table: computed (requested)".to_string()
+        } else {
+            "BTDF table: skipped — not requested".to_string()
+        },
+        if products.tile {
+            "tile: computed (sky strip + BRDF square, CIE 1931 2°, D65, sRGB)".to_string()
+        } else {
+            "tile and colours: skipped — not requested".to_string()
+        },
+    ];
+    if products.merl {
+        lines.push("MERL export: written beside the result (approximation: see docs)".to_string());
+    }
+    lines
+}
+
+/// Polar angles solved from above (the illumination angles, plus the
+/// viewing angles when the tile needs R and T there), and how many of them
+/// are viewing-only.
+fn above_angles(scene: &Scene) -> (Vec<f64>, usize) {
+    let illum: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
+    let mut above = illum.clone();
+    if scene.appearance.products.tile {
+        for &v in &scene.appearance.viewing_deg {
+            if !above.contains(&v) {
+                above.push(v);
+            }
+        }
+        above.sort_by(f64::total_cmp);
+    }
+    let extra = above.len() - illum.len();
+    (above, extra)
+}
+
+/// Whether a layer of generated grains may be replaced by the homogeneous
+/// slab of the volume-averaged ε: `Ok(why)` when the estimated error
+/// ([`effective_medium::worst_error`]) at the scene's worst wavelength and
+/// angle is within `[solver] effective_medium_tolerance`, `Err(why not)`
+/// otherwise, or when the layer has something the slab cannot represent or
+/// lies outside what the estimate was measured on.
+fn effective_medium_shortcut(scene: &Scene, polar_deg: &[f64]) -> Result<String, String> {
+    let tol = scene.solver.effective_medium_tolerance;
+    if tol <= 0.0 {
+        return Err("solver.effective_medium_tolerance = 0".to_string());
+    }
+    let products = scene.appearance.products;
+    if products.brdf || products.btdf {
+        return Err(format!(
+            "the {} table is the grains' diffuse scattering, which a homogeneous slab does not have \
+             (outputs = [\"tile\"] allows the shortcut)",
+            if products.brdf { "BRDF" } else { "BTDF" }
+        ));
+    }
+    if scene.layer.relief_fraction > 0.0 {
+        return Err("surface relief: grains protruding through the top are not a flat slab".into());
+    }
+    if let Some(s) = scene.species.iter().find(|s| s.shape != GrainShape::Sphere) {
+        return Err(format!(
+            "`{}` grains are not spheres; the estimate was measured on sphere layers",
+            s.name
+        ));
+    }
+    if let Some(s) = scene.species.iter().find(|s| s.cluster_size > 1) {
+        return Err(format!(
+            "`{}` grains agglomerate (clusters scatter as larger grains); the estimate was \
+             measured on dispersed grains",
+            s.name
+        ));
+    }
+    if scene.total_pvc() > RSA_MAX_PVC {
+        return Err(format!(
+            "PVC {:.3} > {RSA_MAX_PVC}: the estimate was measured on random-sequential-addition \
+             layers up to PVC {RSA_MAX_PVC}",
+            scene.total_pvc()
+        ));
+    }
+    let d_max = largest_grain_nm(scene);
+    let lambda_min = scene
+        .wavelengths_nm
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
+    let x = effective_medium::size_parameter(d_max, lambda_min);
+    if effective_medium::beyond_measured_size(x) {
+        return Err(format!(
+            "grains up to {d_max:.3} nm are beyond λ/20 at {lambda_min} nm (k0 d = {x:.3}), \
+             outside the range where the effective-medium error was measured"
+        ));
+    }
+    let grains: Vec<GrainClass> = scene
+        .species
+        .iter()
+        .map(|s| GrainClass {
+            volume_fraction: s.volume_fraction,
+            max_diameter_nm: s.size.max_diameter(s.diameter_nm),
+        })
+        .collect();
+    let WorstError {
+        error: est,
+        wavelength_nm: lambda,
+        polar_deg: p,
+    } = effective_medium::worst_error(
+        &grains,
+        scene.layer.binder_index.powi(2),
+        scene.layer.thickness_nm,
+        &scene.wavelengths_nm,
+        polar_deg,
+        |lambda| species_eps(scene, lambda).map_err(|e| e.to_string()),
+    )?;
+    let at = format!(
+        "estimated error in R/T/A {est:.1e} (grains ≤ {d_max:.3} nm, worst at {lambda} nm, \
+         {}°)",
+        (p * 100.0).round() / 100.0
+    );
+    if est <= tol {
+        Ok(format!("{at} ≤ tolerance {tol:.1e}"))
+    } else {
+        Err(format!(
+            "{at} > solver.effective_medium_tolerance {tol:.1e}: full solve"
+        ))
+    }
+}
+
+fn fmt_list(v: &[f64]) -> String {
+    let items: Vec<String> = v
+        .iter()
+        .map(|x| format!("{}", (x * 100.0).round() / 100.0))
+        .collect();
+    format!("[{}]°", items.join(", "))
+}
+
+/// Number of Helmholtz solves a run of `scene` performs (what `inksim plan`
+/// reports; a run's result holds exactly this many `/solves` entries).
+pub fn planned_solves(scene: &Scene) -> usize {
+    RunPlan::of(scene).solves(scene)
+}
+
+/// The polar angles and sides solved per wavelength, in solve order.
+pub fn incidences(scene: &Scene, plan: &RunPlan) -> Vec<(Side, Incidence)> {
+    let az = scene.incidence.first().map_or(0.0, |i| i.azimuth_deg);
+    let mut out: Vec<(Side, Incidence)> = plan
+        .above_deg
+        .iter()
+        .map(|&p| {
+            (
+                Side::Above,
+                Incidence {
+                    polar_deg: p,
+                    azimuth_deg: az,
+                },
+            )
+        })
+        .collect();
+    if let Some(h) = &plan.below {
+        for p in h.polar_deg() {
+            out.push((
+                Side::Below,
+                Incidence {
+                    polar_deg: p,
+                    azimuth_deg: az,
+                },
+            ));
+        }
+    }
+    out
+}
+
+/// The run's plan as stored with the results: one line per decision, then
+/// one line per solve (method and why).
+pub fn plan_text(plan: &RunPlan, entries: &[SolveEntry]) -> String {
+    let mut lines = plan.lines.clone();
+    if entries.is_empty() {
+        lines.push("solves: none (geometry only)".to_string());
+        return lines.join("\n");
+    }
+    for e in entries {
+        lines.push(format!(
+            "solve {} nm, {}°/{}° {} #{}: {} ({})",
+            e.wavelength_nm,
+            e.incidence.polar_deg,
+            e.incidence.azimuth_deg,
+            e.side,
+            e.realisation,
+            e.record.method,
+            e.record.note
+        ));
+    }
+    lines.join("\n")
+}

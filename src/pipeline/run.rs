@@ -1,0 +1,278 @@
+//! A run end to end: the output folder checked, the plan logged, the layer
+//! made and solved, the appearance assembled, the pictures, the MERL file
+//! and the result written; and the geometry-only run of `inksim geometry`.
+
+use std::path::{Path, PathBuf};
+
+use crate::config::{Scene, Structure};
+use crate::geometry::{self, Geometry, StatsParams};
+use crate::optics::appearance::{self, Appearance};
+use crate::optics::colour::Observer;
+use crate::optics::farfield::{Side, SolveEntry};
+use crate::output::atomic;
+use crate::output::merl;
+use crate::output::progress::Progress;
+use crate::output::render;
+use crate::raster::{self, structure, Raster};
+
+use super::appearance::appearance_spec;
+use super::grains::{build_geometry, grid_of, Packer};
+use super::layer;
+use super::plan::{plan_text, RunPlan};
+use super::result::ResultParts;
+use super::{check_output_dir, result_paths, PipelineError, SUPERSAMPLE};
+
+/// What a finished run produced.
+pub struct RunReport {
+    pub result_path: PathBuf,
+    /// The tile (or the orders picture when no tile was asked for).
+    pub picture_path: PathBuf,
+    /// Every reflected order of every solve, drawn per wavelength and angle.
+    pub orders_picture_path: PathBuf,
+    /// Geometry of realisation 0 (None for a molecular mixture).
+    pub geometry: Option<Geometry>,
+    pub entries: Vec<SolveEntry>,
+    pub appearance: Option<Appearance>,
+}
+
+/// Run a scene end to end and write its result files, with a progress bar
+/// (terminal) or log lines.
+pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
+    run_with(scene, false)
+}
+
+/// [`run`], optionally without any progress output (variants of a study
+/// running side by side report through the study's own bar).
+pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> {
+    let (result_path, picture_path) = result_paths(scene);
+    let orders_path = scene
+        .output
+        .dir
+        .join(format!("{}-orders.png", scene.output.name));
+    check_output_dir(&scene.output.dir)?;
+    let plan = RunPlan::of(scene);
+    let total = plan.solves(scene) as u64;
+    let progress = if quiet {
+        Progress::hidden(total, &scene.output.name)
+    } else {
+        Progress::new(total, &scene.output.name)
+    };
+    for l in &plan.lines {
+        progress.log(l);
+    }
+    let layer = layer::solve(scene, &plan, &progress)?;
+    progress.finish("all solves done");
+
+    let pictures = assemble_products(scene, &plan, &layer.entries)?;
+    atomic::write_atomic(&orders_path, &pictures.orders_png)?;
+    atomic::write_atomic(
+        &picture_path,
+        pictures.tile_png.as_deref().unwrap_or(&pictures.orders_png),
+    )?;
+    ResultParts {
+        scene,
+        geometry: layer.geometry.as_ref(),
+        raster: layer.raster.as_ref(),
+        entries: &layer.entries,
+        realisations: &layer.realisations,
+        plan: &plan_text(&plan, &layer.entries),
+        orders_png: &pictures.orders_png,
+        tile_png: pictures.tile_png.as_deref(),
+        appearance: pictures.appearance.as_ref(),
+    }
+    .write(&result_path)?;
+    Ok(RunReport {
+        result_path,
+        picture_path,
+        orders_picture_path: orders_path,
+        geometry: layer.geometry,
+        entries: layer.entries,
+        appearance: pictures.appearance,
+    })
+}
+
+/// The appearance products of a run and its pictures.
+struct RunProducts {
+    /// Every reflected order of every solve from above.
+    orders_png: Vec<u8>,
+    /// The colour tile, when the scene asked for it.
+    tile_png: Option<Vec<u8>>,
+    appearance: Option<Appearance>,
+}
+
+/// Draw the orders, assemble the appearance the scene asks for, draw its
+/// tile, and write the MERL file when asked.
+fn assemble_products(
+    scene: &Scene,
+    plan: &RunPlan,
+    entries: &[SolveEntry],
+) -> Result<RunProducts, PipelineError> {
+    let above: Vec<SolveEntry> = entries
+        .iter()
+        .filter(|e| e.side == Side::Above)
+        .cloned()
+        .collect();
+    let orders_png = render::diffuse_brdf_png(&above, &scene.output.name)?;
+    let products = scene.appearance.products;
+    let wants_appearance = products.brdf || products.btdf || products.tile || products.merl;
+    let appearance = if wants_appearance {
+        let obs = Observer::cie1931_d65();
+        Some(appearance::assemble(
+            &appearance_spec(scene, plan),
+            entries,
+            &obs,
+        )?)
+    } else {
+        None
+    };
+    let tile_png = match appearance.as_ref() {
+        Some(
+            a @ Appearance {
+                colours: Some(c), ..
+            },
+        ) => Some(render::tile::tile_png(
+            &c.tile_srgb8,
+            &a.spec.viewing_deg,
+            &a.spec.illumination_deg,
+            &scene.output.name,
+        )?),
+        _ => None,
+    };
+    if let (Some(a), true) = (appearance.as_ref(), products.merl) {
+        let merl = merl::encode(a)?;
+        atomic::write_atomic(
+            &scene
+                .output
+                .dir
+                .join(format!("{}.binary", scene.output.name)),
+            &merl,
+        )?;
+    }
+    Ok(RunProducts {
+        orders_png,
+        tile_png,
+        appearance,
+    })
+}
+
+/// What `inksim geometry` produced.
+pub struct GeometryReport {
+    pub result_path: PathBuf,
+    pub picture_path: PathBuf,
+    /// The particle set (None for an explicit structure).
+    pub geometry: Option<Geometry>,
+    /// Human-readable statistics (also drawn under the picture).
+    pub lines: Vec<String>,
+}
+
+/// Build and rasterise a scene's layer only: the particle set and its
+/// statistics to `<name>-geometry.h5`, a top view and a cross-section to
+/// `<name>-geometry.png`. No solves.
+pub fn run_geometry(scene: &Scene) -> Result<GeometryReport, PipelineError> {
+    let d = &scene.output.dir;
+    let name = &scene.output.name;
+    let result_path = d.join(format!("{name}-geometry.h5"));
+    let picture_path = d.join(format!("{name}-geometry.png"));
+    check_output_dir(d)?;
+    match &scene.structure {
+        Some(Structure::Primitives(ps)) => {
+            // Draw the explicit layer's raster: what the solver will see.
+            let raster = structure::rasterize_primitives(ps, &grid_of(scene));
+            let fr = raster.mean_fractions();
+            let mut lines = vec![format!(
+                "explicit structure: {} bodies; volume fraction {:.4} in all",
+                ps.len(),
+                fr.iter().sum::<f64>()
+            )];
+            for (i, (p, f)) in ps.iter().zip(&fr).enumerate() {
+                lines.push(format!("body {i}: {} fraction {f:.4}", p.material.name));
+            }
+            write_geometry_only(
+                scene,
+                None,
+                &raster,
+                fr.iter().sum(),
+                &lines,
+                (&result_path, &picture_path),
+            )?;
+            return Ok(GeometryReport {
+                result_path,
+                picture_path,
+                geometry: None,
+                lines,
+            });
+        }
+        Some(Structure::Hdf5(p)) => {
+            return Err(PipelineError::NoGrains(format!(
+                "{}: the layer is an ε grid from {}: nothing to build; use `inksim run`",
+                scene.path().display(),
+                p.display()
+            )))
+        }
+        None if scene.is_molecular() => {
+            return Err(PipelineError::NoGrains(format!(
+                "{}: the pigments are dissolved (molecular): the layer is homogeneous, \
+                 there are no grains to build",
+                scene.path().display()
+            )))
+        }
+        None => {}
+    }
+    let geometry = build_geometry(scene)?;
+    let grid = grid_of(scene);
+    let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+    let s = &geometry.stats;
+    let (packer, _) = Packer::of(scene);
+    let mut lines = vec![format!(
+        "{} particles by {packer}; PVC {:.4} (target {:.4}; raster {:.4})",
+        geometry.particles.len(),
+        s.achieved_fraction.iter().sum::<f64>(),
+        scene.total_pvc(),
+        raster.mean_fractions().iter().sum::<f64>()
+    )];
+    // Worst overlap, S, relief, clusters (the PVC line is the one above).
+    let stats = geometry::analyse(&geometry, &StatsParams::default());
+    lines.extend(stats.lines().into_iter().skip(1));
+    let pvc = geometry.stats.achieved_fraction.iter().sum();
+    let layer = (geometry, raster);
+    write_geometry_only(
+        scene,
+        Some(&layer.0),
+        &layer.1,
+        pvc,
+        &lines,
+        (&result_path, &picture_path),
+    )?;
+    Ok(GeometryReport {
+        result_path,
+        picture_path,
+        geometry: Some(layer.0),
+        lines,
+    })
+}
+
+/// The picture and the result file of `inksim geometry`: the raster drawn
+/// with `lines` under it, and a result set without solves.
+fn write_geometry_only(
+    scene: &Scene,
+    geometry: Option<&Geometry>,
+    raster: &Raster,
+    pvc: f64,
+    lines: &[String],
+    (result_path, picture_path): (&Path, &Path),
+) -> Result<(), PipelineError> {
+    let png = render::geometry_png(raster, &scene.output.name, lines)?;
+    atomic::write_atomic(picture_path, &png)?;
+    ResultParts {
+        scene,
+        geometry,
+        raster: Some(raster),
+        entries: &[],
+        realisations: &[(scene.seed, pvc)],
+        plan: &plan_text(&RunPlan::of(scene), &[]),
+        orders_png: &png,
+        tile_png: None,
+        appearance: None,
+    }
+    .write(result_path)
+}

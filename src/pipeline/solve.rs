@@ -1,0 +1,193 @@
+//! The solves of one layer: every (wavelength, incidence, side) on a
+//! permittivity grid through the configured iterative method, or in closed
+//! form on the homogeneous slab; each solve logged to the progress bar.
+
+use ndarray::{s, Array3};
+use num_complex::Complex64 as C64;
+
+use crate::config::{Method, Scene};
+use crate::optics::farfield::{self, Side, SolveEntry};
+use crate::output::progress::Progress;
+use crate::raster::structure::EpsGrid;
+use crate::raster::{Grid, Raster};
+use crate::solver::{self, Controls, Problem};
+
+use super::eps::{fraction_eps, mean_eps};
+use super::plan::{incidences, RunPlan};
+use super::PipelineError;
+
+/// One progress step per solve, with its R, T, A, method and balance.
+fn log_solve(progress: &Progress, e: &SolveEntry) {
+    let eff = &e.efficiencies;
+    progress.inc(
+        1,
+        &format!(
+            "{} nm, {}° {}{}: R {:.4} T {:.4} A {:.4} ({} {} it, balance {:.1e})",
+            e.wavelength_nm,
+            (e.incidence.polar_deg * 100.0).round() / 100.0,
+            e.side,
+            if e.realisation > 0 {
+                format!(" #{}", e.realisation)
+            } else {
+                String::new()
+            },
+            eff.total_reflectance,
+            eff.total_transmittance,
+            eff.absorption,
+            e.record.method,
+            e.record.iterations,
+            eff.energy_balance
+        ),
+    );
+}
+
+/// Solve every (wavelength, incidence, side) of one realisation on a raster.
+pub fn solve_realisation(
+    scene: &Scene,
+    plan: &RunPlan,
+    raster: &Raster,
+    realisation: usize,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    solve_layer(scene, plan, LayerEps::Raster(raster), realisation, progress)
+}
+
+/// Where the permittivity of each wavelength comes from.
+#[derive(Clone, Copy)]
+pub enum LayerEps<'a> {
+    /// Volume fractions (grains or primitives) and the materials' n(λ).
+    Raster(&'a Raster),
+    /// A permittivity grid read from a file.
+    Grid(&'a EpsGrid, Grid),
+}
+
+/// Solve every (wavelength, incidence, side) on one layer.
+pub fn solve_layer(
+    scene: &Scene,
+    plan: &RunPlan,
+    layer: LayerEps,
+    realisation: usize,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    let g = match layer {
+        LayerEps::Raster(r) => r.grid,
+        LayerEps::Grid(_, g) => g,
+    };
+    let eps_b = scene.layer.binder_index.powi(2);
+    let ctl = controls(scene);
+    let incs = incidences(scene, plan);
+    let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
+    let mut flipped = plan
+        .below
+        .as_ref()
+        .map(|_| Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0)));
+    let mut entries = Vec::new();
+    for &lambda in &scene.wavelengths_nm {
+        match layer {
+            LayerEps::Raster(raster) => {
+                let eps_species = fraction_eps(scene, lambda)?;
+                raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
+            }
+            LayerEps::Grid(grid_eps, _) => grid_eps.epsilon_into(lambda, &mut eps),
+        }
+        if let Some(f) = flipped.as_mut() {
+            f.assign(&eps.slice(s![..;-1, .., ..]));
+        }
+        for (side, inc) in &incs {
+            let lattice = Problem::lattice(
+                [g.nx, g.ny, g.nz],
+                g.size_nm,
+                lambda,
+                inc.polar_deg,
+                inc.azimuth_deg,
+            );
+            let grid_eps = match (side, flipped.as_ref()) {
+                (Side::Below, Some(f)) => f,
+                _ => &eps,
+            };
+            let p = Problem {
+                lattice,
+                eps: grid_eps,
+                eps_binder: eps_b,
+            };
+            let sol = solver::solve(&p, scene.solver.method, &ctl).map_err(|source| {
+                PipelineError::Solve {
+                    wavelength_nm: lambda,
+                    polar_deg: inc.polar_deg,
+                    source,
+                }
+            })?;
+            let entry = SolveEntry {
+                wavelength_nm: lambda,
+                incidence: *inc,
+                side: *side,
+                realisation,
+                efficiencies: farfield::efficiencies(&sol),
+                record: sol.record,
+            };
+            log_solve(progress, &entry);
+            entries.push(entry);
+        }
+    }
+    Ok(entries)
+}
+
+/// The solver's iteration controls of a scene.
+fn controls(scene: &Scene) -> Controls {
+    Controls {
+        tolerance: scene.solver.tolerance,
+        max_iterations: scene.solver.max_iterations,
+        precision: scene.solver.precision,
+    }
+}
+
+/// The homogeneous slab of a molecular mixture (or of grains fine enough for
+/// the effective-medium shortcut), `⟨ε⟩ = Σ f ε_s + (1 − Σ f) ε_b`, in closed
+/// form (the `airy` method) for every (wavelength, incidence, side).
+pub fn solve_analytic(
+    scene: &Scene,
+    plan: &RunPlan,
+    progress: &Progress,
+) -> Result<Vec<SolveEntry>, PipelineError> {
+    let incs = incidences(scene, plan);
+    let ctl = controls(scene);
+    let eps_b = scene.layer.binder_index.powi(2);
+    let why = if scene.is_molecular() {
+        "molecular mixture"
+    } else {
+        "effective-medium shortcut (grains fine against λ)"
+    };
+    let mut entries = Vec::new();
+    for &lambda in &scene.wavelengths_nm {
+        let mean = Array3::from_elem((1, 1, 1), mean_eps(scene, lambda)?);
+        for (side, inc) in &incs {
+            // A homogeneous slab is symmetric (from below = from above) and
+            // the same at every azimuth: one cell, lit at azimuth 0.
+            let size = [1.0, 1.0, scene.layer.thickness_nm];
+            let lattice = Problem::lattice([1, 1, 1], size, lambda, inc.polar_deg, 0.0);
+            let p = Problem {
+                lattice,
+                eps: &mean,
+                eps_binder: eps_b,
+            };
+            let mut sol =
+                solver::solve(&p, Method::Airy, &ctl).map_err(|source| PipelineError::Solve {
+                    wavelength_nm: lambda,
+                    polar_deg: inc.polar_deg,
+                    source,
+                })?;
+            sol.record.note = format!("{why}: {}", sol.record.note);
+            let entry = SolveEntry {
+                wavelength_nm: lambda,
+                incidence: *inc,
+                side: *side,
+                realisation: 0,
+                efficiencies: farfield::slab_efficiencies(&sol.slab_response(), inc),
+                record: sol.record,
+            };
+            log_solve(progress, &entry);
+            entries.push(entry);
+        }
+    }
+    Ok(entries)
+}

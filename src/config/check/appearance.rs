@@ -1,7 +1,7 @@
 //! `[appearance]` (products, viewing angles, BRDF cell, quadrature) and
 //! `[substrate]` (none, or paper of an albedo).
 
-use super::{Checker, MAX_POLAR_DEG};
+use super::Checker;
 use crate::config::raw::{RawAppearance, RawProduct, RawSubstrate};
 use crate::config::{Appearance, ConfigError, Incidence, Products, Substrate};
 
@@ -22,24 +22,7 @@ impl Checker<'_> {
                 if list.is_empty() {
                     return Err(self.invalid(key, "must not be empty"));
                 }
-                for (i, &v) in list.iter().enumerate() {
-                    let k = format!("{key}[{i}]");
-                    self.range(
-                        &k,
-                        v,
-                        (0.0..=MAX_POLAR_DEG).contains(&v),
-                        &format!("[0, {MAX_POLAR_DEG}] deg"),
-                    )?;
-                    if i > 0 && v <= list[i - 1] {
-                        return Err(self.invalid(
-                            k,
-                            format!(
-                                "values must be strictly increasing, got {v} after {}",
-                                list[i - 1]
-                            ),
-                        ));
-                    }
-                }
+                self.polar_angles(key, list)?;
                 list.clone()
             }
         };

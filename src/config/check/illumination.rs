@@ -1,7 +1,7 @@
 //! `[illumination]`: the wavelengths (a list or a range) and the polar
 //! angles of incidence with their azimuth.
 
-use super::{Checker, MAX_POLAR_DEG, REL_EPS};
+use super::{Checker, REL_EPS};
 use crate::config::raw::RawIllumination;
 use crate::config::{ConfigError, Incidence};
 
@@ -33,19 +33,7 @@ impl Checker<'_> {
                         format!("at most {MAX_WAVELENGTHS} values, got {}", list.len()),
                     ));
                 }
-                for (i, &w) in list.iter().enumerate() {
-                    let k = format!("{key}[{i}]");
-                    self.range(&k, w, w > 0.0 && w.is_finite(), "(0, inf) nm")?;
-                    if i > 0 && w <= list[i - 1] {
-                        return Err(self.invalid(
-                            k,
-                            format!(
-                                "values must be strictly increasing, got {w} after {}",
-                                list[i - 1]
-                            ),
-                        ));
-                    }
-                }
+                self.increasing(key, list, |w| w > 0.0 && w.is_finite(), "(0, inf) nm")?;
                 Ok((list.clone(), key))
             }
             (None, Some(r)) => {
@@ -101,29 +89,14 @@ impl Checker<'_> {
             (-360.0..=360.0).contains(&a),
             "[-360, 360] deg",
         )?;
-        let mut out = Vec::with_capacity(raw.polar_deg.len());
-        for (i, &p) in raw.polar_deg.iter().enumerate() {
-            let k = format!("{key}[{i}]");
-            self.range(
-                &k,
-                p,
-                (0.0..=MAX_POLAR_DEG).contains(&p),
-                &format!("[0, {MAX_POLAR_DEG}] deg"),
-            )?;
-            if i > 0 && p <= raw.polar_deg[i - 1] {
-                return Err(self.invalid(
-                    k,
-                    format!(
-                        "values must be strictly increasing, got {p} after {}",
-                        raw.polar_deg[i - 1]
-                    ),
-                ));
-            }
-            out.push(Incidence {
+        self.polar_angles(key, &raw.polar_deg)?;
+        Ok(raw
+            .polar_deg
+            .iter()
+            .map(|&p| Incidence {
                 polar_deg: p,
                 azimuth_deg,
-            });
-        }
-        Ok(out)
+            })
+            .collect())
     }
 }

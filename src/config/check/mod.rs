@@ -123,4 +123,39 @@ impl Checker<'_> {
             Err(self.invalid(key, format!("must be in {range}, got {v}")))
         }
     }
+
+    /// Every value of `list` in range (`ok`, message as [`Self::range`]) and
+    /// strictly increasing, checked in order; errors name `key[i]`.
+    fn increasing(
+        &self,
+        key: &str,
+        list: &[f64],
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<(), ConfigError> {
+        for (i, &v) in list.iter().enumerate() {
+            let k = format!("{key}[{i}]");
+            self.range(&k, v, ok(v), range)?;
+            if i > 0 && v <= list[i - 1] {
+                return Err(self.invalid(
+                    k,
+                    format!(
+                        "values must be strictly increasing, got {v} after {}",
+                        list[i - 1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Polar angles in `[0, MAX_POLAR_DEG]`, strictly increasing.
+    fn polar_angles(&self, key: &str, list: &[f64]) -> Result<(), ConfigError> {
+        self.increasing(
+            key,
+            list,
+            |p| (0.0..=MAX_POLAR_DEG).contains(&p),
+            &format!("[0, {MAX_POLAR_DEG}] deg"),
+        )
+    }
 }

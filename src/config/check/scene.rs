@@ -3,7 +3,7 @@
 
 use super::Checker;
 use crate::config::raw::{RawConfig, RawOutput};
-use crate::config::{ConfigError, OutputSpec, Provenance, Scene, Structure};
+use crate::config::{ConfigError, Material, OutputSpec, Provenance, Scene, Structure};
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -57,39 +57,18 @@ impl Checker<'_> {
         let appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
         let substrate = self.substrate(raw.substrate.as_ref())?;
 
-        for &wl in &wavelengths_nm {
-            for s in &species {
-                if s.material.index_at(wl).is_none() {
-                    let (lo, hi) = s.material.range_nm();
-                    return Err(self.invalid(
-                        wl_key,
-                        format!(
-                            "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
-                             material {} (pigment `{}`)",
-                            s.material, s.name
-                        ),
-                    ));
-                }
-            }
-        }
-
+        let mut materials: Vec<(&Material, String)> = species
+            .iter()
+            .map(|s| (&s.material, format!("pigment `{}`", s.name)))
+            .collect();
         if let Some(Structure::Primitives(ps)) = &structure {
-            for &wl in &wavelengths_nm {
-                for (i, p) in ps.iter().enumerate() {
-                    if p.material.index_at(wl).is_none() {
-                        let (lo, hi) = p.material.range_nm();
-                        return Err(self.invalid(
-                            wl_key,
-                            format!(
-                                "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
-                                 material {} (structure.primitive[{i}])",
-                                p.material
-                            ),
-                        ));
-                    }
-                }
-            }
+            materials.extend(
+                ps.iter()
+                    .enumerate()
+                    .map(|(i, p)| (&p.material, format!("structure.primitive[{i}]"))),
+            );
         }
+        self.coverage(wl_key, &wavelengths_nm, &materials)?;
 
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
@@ -135,6 +114,32 @@ impl Checker<'_> {
             substrate,
             structure,
         })
+    }
+
+    /// Every material has data at every wavelength: the first gap (in
+    /// wavelength order, then in `materials` order) is an error on `key`
+    /// naming the material and whose it is.
+    fn coverage(
+        &self,
+        key: &str,
+        wavelengths_nm: &[f64],
+        materials: &[(&Material, String)],
+    ) -> Result<(), ConfigError> {
+        for &wl in wavelengths_nm {
+            for (m, whose) in materials {
+                if m.index_at(wl).is_none() {
+                    let (lo, hi) = m.range_nm();
+                    return Err(self.invalid(
+                        key,
+                        format!(
+                            "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of \
+                             material {m} ({whose})"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     pub(super) fn output(

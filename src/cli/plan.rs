@@ -2,6 +2,7 @@
 //! time model calibrated now on this machine.
 
 use anyhow::Result;
+use inksim::config::{Method, Precision};
 use inksim::study::plan::{self, human_bytes, human_time};
 use inksim::study::run::{self as srun, Shard, State};
 use inksim::study::sweep::Expansion;
@@ -61,10 +62,23 @@ pub fn plan(
             }
         );
     }
+    let rates: Vec<String> = Method::ALL
+        .into_iter()
+        .filter(|m| m.in_records() && *m != Method::Airy)
+        .map(|m| {
+            format!(
+                "{} {:.0}/{:.0}",
+                m.name(),
+                plan::bytes_per_voxel(m, Precision::F64),
+                plan::bytes_per_voxel(m, Precision::F32)
+            )
+        })
+        .collect();
     println!(
-        "memory model: {} + voxels × (bytes per voxel of the method: time-marching 238, \
-         BiCGStab/auto 318, GMRES 574; docs/PERFORMANCE.md) + 8 B per voxel and species",
-        human_bytes(plan::BASELINE_BYTES)
+        "memory model: {} + voxels × (bytes per voxel of the method, f64/f32 storage: {}; \
+         docs/PERFORMANCE.md) + 8 B per voxel and species",
+        human_bytes(plan::BASELINE_BYTES),
+        rates.join(", ")
     );
     println!(
         "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>10} {:>9}  state",

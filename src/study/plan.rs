@@ -5,10 +5,10 @@
 //!
 //! Memory model (peak resident bytes of one variant):
 //! `BASELINE_BYTES + voxels × (B_method + 8 × species)`, with `B_method` the
-//! measured bytes per voxel of docs/PERFORMANCE.md (time-marching 238,
-//! BiCGStab 318, GMRES(20) 574; `auto` runs BiCGStab, so 318; Born is
-//! counted as time-marching) and 8 B per species for the raster's volume
-//! fractions.
+//! method's bytes per voxel from the solver registry ([`bytes_per_voxel`]:
+//! the solver's fields at the storage precision plus 32 B of raster and
+//! tables; measured in docs/PERFORMANCE.md) and 8 B per species for the
+//! raster's volume fractions.
 //!
 //! Time model (one variant, all threads): per solve
 //! `t_setup + applications × t_apply × KRYLOV_OVERHEAD`, where `t_setup`

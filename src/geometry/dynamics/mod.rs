@@ -81,7 +81,7 @@
 //! list holding each pair from both sides (each particle sums its own). The
 //! choice depends on the size only, and FIRE's sums are taken per chunk
 //! then over chunks in order, so this stage is deterministic for any thread
-//! count too. First-order dynamics stays the core: at the 50–55 %
+//! count too. First-order dynamics stays the core: at the 50–55 % the study asks for
 //! targets batches converge in it or need a short FIRE tail; near jamming
 //! FIRE's inertia unjams far faster.
 //!

@@ -9,8 +9,8 @@ use hdf5::Location;
 
 use super::attrs::read_str_attr;
 use super::IoError;
-use crate::optics::farfield::Side;
 use crate::config::Method;
+use crate::optics::farfield::Side;
 
 /// What [`read_summary`] returns.
 #[derive(Debug, Clone, PartialEq)]

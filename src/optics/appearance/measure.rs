@@ -28,12 +28,11 @@
 use std::fmt;
 
 use super::colours::de00_standard_error;
-use super::proxy::{through_proxy, SpectralProxy};
+use super::proxy::{through_proxy, SlabOnPaper, SpectralProxy};
 use super::{reduce, AppearanceError, AppearanceSpec, Estimate};
 use crate::optics::colour::{self, Observer};
 use crate::optics::farfield::table::{self, Part};
 use crate::optics::farfield::{Side, SolveEntry};
-use crate::solver::airy;
 use ndarray::{Array1, Ix1};
 use std::f64::consts::PI;
 
@@ -161,14 +160,7 @@ fn proxy_factor(m: Measurement, p: &SpectralProxy, albedo: f64, spec: &Appearanc
         .iter()
         .zip(&p.eps)
         .map(|(&wl, &eps)| {
-            let rt = |polar: f64| {
-                let s = airy::slab(eps, p.thickness_nm, wl, polar);
-                (s.r.norm_sqr(), s.t.norm_sqr())
-            };
-            let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(rt).collect();
-            let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
-            let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
-            let denom = 1.0 - albedo * rdd;
+            let SlabOnPaper { rt, td, denom } = p.on_paper(wl, eps, albedo, h);
             match m {
                 Measurement::FortyFiveZero => albedo * rt(45.0).1 * rt(0.0).1 / denom,
                 Measurement::DiffuseEightSci => rt(8.0).0 + albedo * td * rt(8.0).1 / denom,

@@ -40,14 +40,7 @@ impl SpectralProxy {
         let mut f = Array3::zeros((nf, ni, nv));
         let mut sky = Array2::zeros((nf, nv));
         for (l, (&wl, &eps)) in self.wavelengths_nm.iter().zip(&self.eps).enumerate() {
-            let rt = |polar: f64| {
-                let r = airy::slab(eps, self.thickness_nm, wl, polar);
-                (r.r.norm_sqr(), r.t.norm_sqr())
-            };
-            let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(rt).collect();
-            let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
-            let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
-            let denom = 1.0 - albedo * rdd;
+            let SlabOnPaper { rt, td, denom } = self.on_paper(wl, eps, albedo, h);
             let ti: Vec<f64> = spec.illumination_deg.iter().map(|&a| rt(a).1).collect();
             for (o, &v) in spec.viewing_deg.iter().enumerate() {
                 let (ro, to) = rt(v);
@@ -59,6 +52,41 @@ impl SpectralProxy {
         }
         (f, sky)
     }
+
+    /// The slab at `wl` (permittivity `eps`) on paper of albedo `albedo`:
+    /// its power coefficients at any polar angle and its diffuse terms by the
+    /// quadrature `h`.
+    pub(super) fn on_paper(
+        &self,
+        wl: f64,
+        eps: C64,
+        albedo: f64,
+        h: &Hemisphere,
+    ) -> SlabOnPaper<impl Fn(f64) -> (f64, f64) + '_> {
+        let thickness = self.thickness_nm;
+        let rt = move |polar: f64| {
+            let r = airy::slab(eps, thickness, wl, polar);
+            (r.r.norm_sqr(), r.t.norm_sqr())
+        };
+        let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(&rt).collect();
+        let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
+        let td = h.diffuse(&nodes.iter().map(|x| x.1).collect::<Vec<_>>());
+        SlabOnPaper {
+            rt,
+            td,
+            denom: 1.0 - albedo * rdd,
+        }
+    }
+}
+
+/// A homogeneous slab on Lambertian paper at one wavelength.
+pub(super) struct SlabOnPaper<F: Fn(f64) -> (f64, f64)> {
+    /// `(R, T)` of the slab at a polar angle (deg).
+    pub rt: F,
+    /// Diffuse transmittance `T_d`.
+    pub td: f64,
+    /// `1 − ρ R_dd↑`.
+    pub denom: f64,
 }
 
 /// Largest factor by which the ratio layer / proxy may change across one

@@ -330,7 +330,7 @@ fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
     let full_text = grains_scene(
         dir.path(),
         2,
-        "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\nquadrature_points = 4\n",
+        "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\nquadrature_points = 4\nmeasurements = []\n",
     );
     let full = run_text(dir.path(), &full_text);
     let s = scene_of(dir.path());
@@ -345,7 +345,7 @@ fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
         &grains_scene(
             dir.path(),
             2,
-            "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\n[substrate]\nkind = \"none\"\n",
+            "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\nmeasurements = []\n[substrate]\nkind = \"none\"\n",
         ),
     );
     assert!(bare.entries.iter().all(|e| e.side == Side::Above));
@@ -479,7 +479,8 @@ fn colour_between_solved_wavelengths_follows_the_proxy() {
     let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.558, 32));
     let a = rep.appearance.unwrap();
     let eps = 1.558f64.powi(2);
-    let obs = inksim::optics::colour::Observer::cie1931_d65();
+    let (ill, so) = a.colour_conditions.unwrap();
+    let obs = inksim::optics::colour::Observer::standard(ill, so);
     let fine: Vec<f64> = (0..=40).map(|k| 450.0 + 5.0 * k as f64).collect();
     for (o, &view) in a.spec.viewing_deg.iter().enumerate() {
         let spectrum: Vec<f64> = fine
@@ -535,7 +536,8 @@ fn colour_standard_errors_agree_with_batch_means() {
     let (nv, nc, _) = c.tile_lab.dim();
     assert_eq!(spread.realisation_lab.dim(), (32, nv, nc, 3));
     assert!(spread.lab_se.iter().all(|v| v.is_finite() && *v > 0.0));
-    let obs = Observer::cie1931_d65();
+    let (ill, so) = a.colour_conditions.unwrap();
+    let obs = Observer::standard(ill, so);
     let mut batch_spec = a.spec.clone();
     batch_spec.realisations = 4;
     let batches: Vec<_> = (0..8)
@@ -680,4 +682,39 @@ fn clear_binder_on_paper_measures_as_the_closed_form() {
     }
     // SCI ≥ SCE: the slab's mirror reflection is what the trap removes.
     assert!(m[1].lab[0] > m[2].lab[0]);
+}
+
+/// A scene with a tile reports colour in every measurement geometry, under
+/// the default D50 / 2° conditions, with standard errors from two
+/// realisations; the geometries' angles (8° and 45°) are solved for it, and
+/// the result file carries them with units.
+#[test]
+fn measurement_geometries_run_by_default_and_reach_the_result_file() {
+    use inksim::config::{Illuminant, StandardObserver};
+    let dir = tempfile::tempdir().unwrap();
+    let rep = run_text(dir.path(), &grains_scene(dir.path(), 2, ""));
+    let a = rep.appearance.as_ref().unwrap();
+    assert_eq!(a.spec.above_deg, [0.0, 8.0, 25.0, 45.0, 50.0]);
+    assert_eq!(
+        a.colour_conditions,
+        Some((Illuminant::D50, StandardObserver::TwoDegree))
+    );
+    assert_eq!(a.measured.len(), 3);
+    for m in &a.measured {
+        assert!(m.lab_se.unwrap().iter().all(|v| v.is_finite() && *v >= 0.0));
+        assert!(m.de00_se.unwrap() > 0.0);
+        assert!(m.reflectance.mean.iter().all(|v| (0.0..=1.0).contains(v)));
+    }
+    let f = hdf5::File::open(&rep.result_path).unwrap();
+    let g = f.group("appearance").unwrap();
+    let ill: hdf5::types::VarLenUnicode = g.attr("illuminant").unwrap().read_scalar().unwrap();
+    assert_eq!(ill.as_str(), "D50");
+    for slug in ["45_0", "d8_sci", "d8_sce"] {
+        let lab = g.dataset(&format!("measured/{slug}/lab")).unwrap();
+        assert_eq!(lab.read_raw::<f64>().unwrap().len(), 3);
+        let units: hdf5::types::VarLenUnicode = lab.attr("units").unwrap().read_scalar().unwrap();
+        assert_eq!(units.as_str(), "1");
+        assert!(g.link_exists(&format!("measured/{slug}/de00_se")));
+    }
+    assert!(g.link_exists("tile_lab_se") && g.link_exists("tile_de00_se"));
 }

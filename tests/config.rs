@@ -732,3 +732,46 @@ fn equilibrate_sweeps_key() {
         assert!(shown.contains("100000"), "{shown}");
     }
 }
+
+#[test]
+fn colour_conditions_and_measurement_geometries() {
+    let s = parse(BASE).unwrap();
+    assert_eq!(s.appearance.illuminant, Illuminant::D50);
+    assert_eq!(s.appearance.observer, StandardObserver::TwoDegree);
+    assert_eq!(s.appearance.measurements, Measurement::ALL.to_vec());
+    let text = format!(
+        "{BASE}[appearance]\nilluminant = \"a\"\nobserver_deg = 10\nmeasurements = [\"d/8 SCE\"]\n"
+    );
+    let s = parse(&text).unwrap();
+    assert_eq!(s.appearance.illuminant, Illuminant::A);
+    assert_eq!(s.appearance.observer, StandardObserver::TenDegree);
+    assert_eq!(s.appearance.measurements, [Measurement::DiffuseEightSce]);
+    let s = parse(&format!("{BASE}[appearance]\nmeasurements = []\n")).unwrap();
+    assert!(s.appearance.measurements.is_empty());
+    for (line, key, says) in [
+        (
+            "illuminant = \"F2\"",
+            "appearance.illuminant",
+            "allowed: \"D50\", \"D65\", \"A\"",
+        ),
+        (
+            "observer_deg = 5",
+            "appearance.observer_deg",
+            "must be 2 (CIE 1931) or 10 (CIE 1964), got 5",
+        ),
+        (
+            "measurements = [\"0/45\"]",
+            "appearance.measurements",
+            "allowed: \"45/0\", \"d/8 SCI\"",
+        ),
+        (
+            "measurements = [\"45/0\", \"45/0\"]",
+            "appearance.measurements",
+            "listed twice",
+        ),
+    ] {
+        let (k, shown) = invalid(&format!("{BASE}[appearance]\n{line}\n"));
+        assert_eq!(k, key);
+        assert!(shown.contains(says), "{shown}");
+    }
+}

@@ -178,6 +178,10 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
     let text = scene_text(dir.path(), 15.0, "")
         .replace("[450.0, 550.0, 650.0]", "[550.0]")
         .replace("polar_deg = [0.0, 40.0]", "polar_deg = [0.0]")
+        .replace(
+            "quadrature_points = 2",
+            "quadrature_points = 2\nmeasurements = []",
+        )
         .replace("kind = \"paper\"\nalbedo = 0.9", "kind = \"none\"");
     let s = scene(dir.path(), &text);
     let plan = RunPlan::of(&s);

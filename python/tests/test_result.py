@@ -30,8 +30,9 @@ def test_identity(tiny, tiny_run):
 def test_solves(tiny):
     s = tiny.solves
     assert s["total_reflectance"].dims == ("solve",)
-    # 2 wavelengths x (2 angles from above + 6 from below) x 2 realisations
-    assert s.sizes["solve"] == 32
+    # 2 wavelengths x (4 angles from above: 0 and 30 deg lit, 8 and 45 deg for the
+    # measurement geometries; + 6 from below) x 2 realisations
+    assert s.sizes["solve"] == 40
     assert s["wavelength_nm"].attrs["units"] == "nm"
     assert s["polar_deg"].attrs["units"] == "deg"
     assert s["seconds"].attrs["units"] == "s"
@@ -71,12 +72,12 @@ def test_spectra(tiny):
     for k in ("reflectance", "transmittance", "absorption"):
         da = sp[k]
         assert da.dims == ("wavelength_nm", "above_deg")
-        assert da.shape == (2, 2)
+        assert da.shape == (2, 4)
         assert da.attrs["units"] == "1"
         assert np.all(np.isfinite(da)) and np.all((da >= 0) & (da <= 1))
-        assert sp[k + "_se"].shape == (2, 2)  # two realisations
+        assert sp[k + "_se"].shape == (2, 4)  # two realisations
     np.testing.assert_array_equal(sp["wavelength_nm"], [450.0, 600.0])
-    np.testing.assert_array_equal(sp["above_deg"], [0.0, 30.0])
+    np.testing.assert_array_equal(sp["above_deg"], [0.0, 8.0, 30.0, 45.0])
     assert sp["wavelength_nm"].attrs["units"] == "nm"
     assert sp["above_deg"].attrs["units"] == "deg"
     np.testing.assert_allclose(sp["reflectance"] + sp["transmittance"] + sp["absorption"], 1.0, atol=1e-5)

@@ -9,6 +9,7 @@
 //! [`Method`]'s; the solver's registry gives each its implementation.
 
 mod check;
+pub mod colour;
 pub mod materials;
 mod method;
 mod raw;
@@ -16,6 +17,7 @@ mod raw;
 use std::path::{Path, PathBuf};
 
 pub use check::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
+pub use colour::{Illuminant, Measurement, StandardObserver};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
 
@@ -310,6 +312,13 @@ pub struct Appearance {
     pub brdf_cell: Option<f64>,
     /// Gauss–Legendre nodes in cos θ for hemispherical integrals.
     pub quadrature_points: usize,
+    /// CIE illuminant and standard observer of every colour (default D50,
+    /// 2°: ISO 13655, the graphic-arts condition).
+    pub illuminant: Illuminant,
+    pub observer: StandardObserver,
+    /// Measurement geometries reported with the tile (default all three:
+    /// 45°/0°, d/8° SCI and SCE); each adds its angles to the solves from above.
+    pub measurements: Vec<Measurement>,
 }
 
 /// A validated scene: every value is in range and every material covers every

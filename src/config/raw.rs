@@ -248,6 +248,9 @@ pub struct RawAppearance {
     pub outputs: Option<Vec<RawProduct>>,
     pub brdf_cell: Option<f64>,
     pub quadrature_points: Option<i64>,
+    pub illuminant: Option<String>,
+    pub observer_deg: Option<i64>,
+    pub measurements: Option<Vec<String>>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

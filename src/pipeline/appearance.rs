@@ -26,7 +26,11 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         btdf: scene.appearance.products.btdf,
         tile: scene.appearance.products.tile,
         proxy: spectral_proxy(scene),
-        measurements: Vec::new(),
+        measurements: if scene.appearance.products.tile {
+            scene.appearance.measurements.clone()
+        } else {
+            Vec::new()
+        },
     }
 }
 

@@ -209,7 +209,7 @@ fn solve_lines(
         above.len(),
         fmt_list(above),
         if extra > 0 {
-            format!(" ({extra} viewing angles beyond the illumination angles: the tile needs R and T there)")
+            format!(" ({extra} angles beyond the illumination angles: the tile's viewing angles and the measurement geometries need R and T there)")
         } else {
             String::new()
         }
@@ -263,7 +263,19 @@ fn product_lines(scene: &Scene) -> Vec<String> {
             "BTDF table: skipped — not requested".to_string()
         },
         if products.tile {
-            "tile: computed (sky strip + BRDF square, CIE 1931 2°, D65, sRGB)".to_string()
+            let a = &scene.appearance;
+            let geometries: Vec<&str> = a.measurements.iter().map(|m| m.name()).collect();
+            format!(
+                "tile and colours: computed (sky strip + BRDF square; measurement geometries: {}; \
+                 {} illuminant, {} observer; shown in sRGB, Bradford-adapted to D65)",
+                if geometries.is_empty() {
+                    "none".to_string()
+                } else {
+                    geometries.join(", ")
+                },
+                a.illuminant,
+                a.observer
+            )
         } else {
             "tile and colours: skipped — not requested".to_string()
         },
@@ -275,13 +287,18 @@ fn product_lines(scene: &Scene) -> Vec<String> {
 }
 
 /// Polar angles solved from above (the illumination angles, plus the
-/// viewing angles when the tile needs R and T there), and how many of them
-/// are viewing-only.
+/// viewing angles and the measurement geometries' angles when the tile needs
+/// colour), and how many of them are not illumination angles.
 fn above_angles(scene: &Scene) -> (Vec<f64>, usize) {
     let illum: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
     let mut above = illum.clone();
     if scene.appearance.products.tile {
-        for &v in &scene.appearance.viewing_deg {
+        let measured = scene
+            .appearance
+            .measurements
+            .iter()
+            .flat_map(|m| m.above_deg());
+        for &v in scene.appearance.viewing_deg.iter().chain(measured) {
             if !above.contains(&v) {
                 above.push(v);
             }

@@ -116,7 +116,7 @@ fn assemble_products(
     let products = scene.appearance.products;
     let wants_appearance = products.brdf || products.btdf || products.tile || products.merl;
     let appearance = if wants_appearance {
-        let obs = Observer::cie1931_d65();
+        let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
         Some(appearance::assemble(
             &appearance_spec(scene, plan),
             entries,

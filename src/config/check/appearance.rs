@@ -1,9 +1,13 @@
-//! `[appearance]` (products, viewing angles, BRDF cell, quadrature) and
+//! `[appearance]` (products, viewing angles, BRDF cell, quadrature, colour
+//! conditions and measurement geometries) and
 //! `[substrate]` (none, or paper of an albedo).
 
 use super::Checker;
 use crate::config::raw::{RawAppearance, RawProduct, RawSubstrate};
-use crate::config::{Appearance, ConfigError, Incidence, Products, Substrate};
+use crate::config::{
+    Appearance, ConfigError, Illuminant, Incidence, Measurement, Products, StandardObserver,
+    Substrate,
+};
 
 /// Paper albedo of the reference study (METHOD §8).
 pub const DEFAULT_PAPER_ALBEDO: f64 = 0.9;
@@ -56,11 +60,59 @@ impl Checker<'_> {
                 format!("must be in [2, 32], got {q}"),
             ));
         }
+        let illuminant = match raw.and_then(|a| a.illuminant.as_deref()) {
+            None => Illuminant::D50,
+            Some(name) => Illuminant::from_name(name).ok_or_else(|| {
+                self.invalid(
+                    "appearance.illuminant",
+                    format!("unknown illuminant \"{name}\"; allowed: \"D50\", \"D65\", \"A\""),
+                )
+            })?,
+        };
+        let observer = match raw.and_then(|a| a.observer_deg) {
+            None => StandardObserver::TwoDegree,
+            Some(d) => u32::try_from(d)
+                .ok()
+                .and_then(StandardObserver::from_degrees)
+                .ok_or_else(|| {
+                    self.invalid(
+                        "appearance.observer_deg",
+                        format!("must be 2 (CIE 1931) or 10 (CIE 1964), got {d}"),
+                    )
+                })?,
+        };
+        let measurements = match raw.and_then(|a| a.measurements.as_ref()) {
+            None => Measurement::ALL.to_vec(),
+            Some(names) => {
+                let mut out = Vec::with_capacity(names.len());
+                for name in names {
+                    let m = Measurement::from_name(name).ok_or_else(|| {
+                        self.invalid(
+                            "appearance.measurements",
+                            format!(
+                                "unknown geometry \"{name}\"; allowed: \"45/0\", \"d/8 SCI\", \"d/8 SCE\""
+                            ),
+                        )
+                    })?;
+                    if out.contains(&m) {
+                        return Err(self.invalid(
+                            "appearance.measurements",
+                            format!("\"{name}\" is listed twice"),
+                        ));
+                    }
+                    out.push(m);
+                }
+                out
+            }
+        };
         Ok(Appearance {
             viewing_deg,
             products,
             brdf_cell,
             quadrature_points: q as usize,
+            illuminant,
+            observer,
+            measurements,
         })
     }
 

@@ -25,7 +25,7 @@
 //! with R ≥ 2 realisations every colour carries the standard errors of L*, a*,
 //! b* and of ΔE00, as the tile's do ([`super::ColourSpread`]).
 
-use std::fmt;
+pub use crate::config::Measurement;
 
 use super::colours::de00_standard_error;
 use super::proxy::{through_proxy, SlabOnPaper, SpectralProxy};
@@ -35,56 +35,6 @@ use crate::optics::farfield::table::{self, Part};
 use crate::optics::farfield::{Side, SolveEntry};
 use ndarray::{Array1, Ix1};
 use std::f64::consts::PI;
-
-/// A colorimetric measurement geometry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Measurement {
-    /// 45°/0°: directional light at 45°, viewed at 0° (ISO 13655, print).
-    FortyFiveZero,
-    /// d/8° with the specular component included (SCI).
-    DiffuseEightSci,
-    /// d/8° with the specular component excluded (SCE).
-    DiffuseEightSce,
-}
-
-impl Measurement {
-    /// Every geometry, in the order results list them.
-    pub const ALL: [Measurement; 3] = [
-        Measurement::FortyFiveZero,
-        Measurement::DiffuseEightSci,
-        Measurement::DiffuseEightSce,
-    ];
-
-    /// The name configs and result files use: `45/0`, `d/8 SCI`, `d/8 SCE`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Measurement::FortyFiveZero => "45/0",
-            Measurement::DiffuseEightSci => "d/8 SCI",
-            Measurement::DiffuseEightSce => "d/8 SCE",
-        }
-    }
-
-    /// The geometry named `name` (case-insensitive), if there is one.
-    pub fn from_name(name: &str) -> Option<Measurement> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(name))
-    }
-
-    /// Polar angles (deg) that must be solved from above.
-    pub fn above_deg(self) -> &'static [f64] {
-        match self {
-            Measurement::FortyFiveZero => &[45.0, 0.0],
-            Measurement::DiffuseEightSci | Measurement::DiffuseEightSce => &[8.0],
-        }
-    }
-}
-
-impl fmt::Display for Measurement {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// The colour of the sample in one measurement geometry.
 #[derive(Debug, Clone)]

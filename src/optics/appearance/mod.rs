@@ -31,7 +31,7 @@ pub use colours::{ColourSpread, Colours};
 pub use measure::{MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
-use crate::optics::colour::{ColourError, Observer};
+use crate::optics::colour::{ColourError, Illuminant, Observer, StandardObserver};
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::optics::substrate::Hemisphere;
@@ -112,6 +112,9 @@ pub struct Appearance {
     pub colours: Option<Colours>,
     /// Colour in each of `spec.measurements`, in that order.
     pub measured: Vec<MeasuredColour>,
+    /// The CIE illuminant and observer every colour was computed for (None
+    /// for an observer built from custom tables).
+    pub colour_conditions: Option<(Illuminant, StandardObserver)>,
 }
 
 /// Why the appearance cannot be assembled.
@@ -368,5 +371,6 @@ pub fn assemble(
         natural,
         colours,
         measured,
+        colour_conditions: observer.conditions(),
     })
 }

@@ -14,7 +14,7 @@
 //!   profiles do for D50), then through the IEC 61966-2-1 matrix; the white is
 //!   then balanced to exactly (1, 1, 1) as for D65 (see [`super::Observer`]).
 
-use std::fmt;
+pub use crate::config::{Illuminant, StandardObserver};
 
 /// CIE 1931 2° colour-matching functions, 360–830 nm at 1 nm (source in the file).
 pub(super) const CMF_2DEG_CSV: &str = include_str!("../../../data/cie/cie1931_2deg_xyz_1nm.csv");
@@ -25,90 +25,11 @@ pub(super) const D65_CSV: &str = include_str!("../../../data/cie/cie_d65_1nm.csv
 /// CIE D50 relative spectral power, 300–780 nm at 5 nm (source in the file).
 pub(super) const D50_CSV: &str = include_str!("../../../data/cie/cie_d50_5nm.csv");
 
-/// A CIE illuminant colour can be computed under.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Illuminant {
-    /// CIE D50 (horizon daylight, 5003 K): print viewing and measurement, ISO 3664 / ISO 13655.
-    D50,
-    /// CIE D65 (average daylight, 6504 K): the sRGB display white.
-    D65,
-    /// CIE A (incandescent tungsten, 2856 K).
-    A,
-}
-
-impl Illuminant {
-    /// Every illuminant, in the order of the names.
-    pub const ALL: [Illuminant; 3] = [Illuminant::D50, Illuminant::D65, Illuminant::A];
-
-    /// The CIE name, as written in configs and result files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Illuminant::D50 => "D50",
-            Illuminant::D65 => "D65",
-            Illuminant::A => "A",
-        }
-    }
-
-    /// The illuminant named `name` (case-insensitive), if there is one.
-    pub fn from_name(name: &str) -> Option<Illuminant> {
-        Self::ALL
-            .into_iter()
-            .find(|i| i.name().eq_ignore_ascii_case(name))
-    }
-}
-
-impl fmt::Display for Illuminant {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// A CIE standard colorimetric observer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum StandardObserver {
-    /// CIE 1931 2° (fields up to 4°; the print standard).
-    TwoDegree,
-    /// CIE 1964 10° (large fields; paint and textile practice).
-    TenDegree,
-}
-
-impl StandardObserver {
-    /// Every observer.
-    pub const ALL: [StandardObserver; 2] =
-        [StandardObserver::TwoDegree, StandardObserver::TenDegree];
-
-    /// The field of view in degrees (2 or 10), as written in configs and files.
-    pub fn degrees(self) -> u32 {
-        match self {
-            StandardObserver::TwoDegree => 2,
-            StandardObserver::TenDegree => 10,
-        }
-    }
-
-    /// The observer of `degrees` (2 or 10), if there is one.
-    pub fn from_degrees(degrees: u32) -> Option<StandardObserver> {
-        Self::ALL.into_iter().find(|o| o.degrees() == degrees)
-    }
-
-    /// The CIE name.
-    pub fn name(self) -> &'static str {
-        match self {
-            StandardObserver::TwoDegree => "CIE 1931 2°",
-            StandardObserver::TenDegree => "CIE 1964 10°",
-        }
-    }
-
-    pub(super) fn cmf_csv(self) -> &'static str {
-        match self {
-            StandardObserver::TwoDegree => CMF_2DEG_CSV,
-            StandardObserver::TenDegree => CMF_10DEG_CSV,
-        }
-    }
-}
-
-impl fmt::Display for StandardObserver {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+/// The colour-matching functions' table of an observer.
+pub(super) fn cmf_csv(observer: StandardObserver) -> &'static str {
+    match observer {
+        StandardObserver::TwoDegree => CMF_2DEG_CSV,
+        StandardObserver::TenDegree => CMF_10DEG_CSV,
     }
 }
 

@@ -159,8 +159,12 @@ impl Observer {
     /// [`Illuminant`] for how each illuminant reaches that grid).
     pub fn standard(illuminant: Illuminant, observer: StandardObserver) -> Observer {
         // The embedded tables are fixed data checked by tests/colour.rs.
-        let cmf = parse_table(observer.cmf_csv(), "colour-matching functions", 3)
-            .expect("embedded CIE tables are valid");
+        let cmf = parse_table(
+            conditions::cmf_csv(observer),
+            "colour-matching functions",
+            3,
+        )
+        .expect("embedded CIE tables are valid");
         let mut obs = match illuminant {
             Illuminant::D65 => {
                 let ill = parse_table(D65_CSV, "illuminant", 1).expect("embedded table");

@@ -5,9 +5,9 @@ use std::path::Path;
 
 use ndarray::Array2;
 
-use super::attrs::write_scalar_attr;
+use super::attrs::{write_scalar_attr, write_str_attr};
 use super::IoError;
-use crate::optics::appearance::{Appearance, Estimate};
+use crate::optics::appearance::{Appearance, Estimate, MeasuredColour};
 
 /// The ensemble-mean appearance arrays of a result file (`/appearance`),
 /// for comparing runs (docs/ACCURACY.md). Shapes as in the module docs.
@@ -165,8 +165,93 @@ pub(super) fn write_appearance(
             .with_data(&lab)
             .create("natural_lab")?;
     }
+    if let Some((ill, obs)) = a.colour_conditions {
+        write_str_attr(&g, "illuminant", ill.name())?;
+        write_str_attr(&g, "observer", obs.name())?;
+        write_scalar_attr(&g, "observer_deg", obs.degrees())?;
+    }
+    if let Some(s) = a.colours.as_ref().and_then(|c| c.spread.as_ref()) {
+        let what = "of the tile's L*, a*, b* (viewing, 1 + illumination, 3)";
+        described(
+            &g,
+            "tile_lab_se",
+            s.lab_se.view(),
+            "1",
+            &format!("standard error {what}"),
+        )?;
+        let what = "of each tile colour in ΔE00 (viewing, 1 + illumination)";
+        described(
+            &g,
+            "tile_de00_se",
+            s.de00_se.view(),
+            "1",
+            &format!("standard error {what}"),
+        )?;
+        let what = "CIELAB of every realisation (realisation, viewing, 1 + illumination, 3)";
+        described(
+            &g,
+            "tile_lab_realisations",
+            s.realisation_lab.view(),
+            "1",
+            what,
+        )?;
+    }
+    if !a.measured.is_empty() {
+        let mg = g.create_group("measured")?;
+        for m in &a.measured {
+            write_measured(&mg, m)?;
+        }
+    }
     if let Some(png) = tile_png {
         g.new_dataset_builder().with_data(png).create("tile_png")?;
     }
     Ok(())
+}
+
+/// `/appearance/measured/<slug>`: one measurement geometry's colour.
+fn write_measured(parent: &hdf5::Group, m: &MeasuredColour) -> hdf5::Result<()> {
+    let g = parent.create_group(m.geometry.slug())?;
+    write_str_attr(&g, "geometry", m.geometry.name())?;
+    write_estimate(&g, "reflectance_factor", &m.reflectance)?;
+    let described = |name: &str, data: &[f64], units: &str, desc: &str| {
+        described(&g, name, ndarray::aview1(data), units, desc)
+    };
+    described(
+        "spectrum_wavelengths_nm",
+        &m.spectrum_wavelengths_nm,
+        "nm",
+        "wavelengths of the spectrum colour is integrated from",
+    )?;
+    described(
+        "spectrum",
+        &m.spectrum,
+        "1",
+        "reflectance factor colour is integrated from (through the spectral proxy where there is one)",
+    )?;
+    described("xyz", &m.xyz, "1", "CIE XYZ, white Y = 100")?;
+    described("lab", &m.lab, "1", "CIELAB L*, a*, b*")?;
+    described("lch", &m.lch, "1, 1, deg", "CIE LCh(ab): L*, C*ab, h_ab")?;
+    if let (Some(se), Some(de)) = (m.lab_se, m.de00_se) {
+        described("lab_se", &se, "1", "standard errors of L*, a*, b*")?;
+        described(
+            "de00_se",
+            &[de],
+            "1",
+            "standard error of the colour in ΔE00",
+        )?;
+    }
+    Ok(())
+}
+
+/// A dataset with `units` and `description` attributes.
+fn described<D: ndarray::Dimension>(
+    g: &hdf5::Group,
+    name: &str,
+    data: ndarray::ArrayView<'_, f64, D>,
+    units: &str,
+    description: &str,
+) -> hdf5::Result<()> {
+    let d = g.new_dataset_builder().with_data(data).create(name)?;
+    write_str_attr(&d, "units", units)?;
+    write_str_attr(&d, "description", description)
 }

@@ -3,6 +3,8 @@
 
 use inksim::config::Incidence;
 use inksim::config::Method;
+use inksim::optics::colour::gamut::{self, chroma_hue, in_gamut, lab_to_linear_srgb};
+use inksim::optics::colour::{self, xyz_to_lab, Observer};
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::output::render::{
     diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX,
@@ -339,6 +341,110 @@ fn entries_without_diffuse_orders_draw_empty_panels() {
                     assert!(p[0] == p[1] && p[1] == p[2], "tinted pixel {p:?}");
                 }
             }
+        }
+    }
+}
+
+#[test]
+fn in_gamut_colours_are_unchanged() {
+    let obs = Observer::cie1931_d65();
+    let wl: Vec<f64> = (0..=40).map(|k| 380.0 + 10.0 * k as f64).collect();
+    let mut n = 0;
+    for k in 0..60 {
+        // Smooth spectra between 0.03 and 0.9: greys, pinks, greens, blues.
+        let (c, w, a) = (
+            400.0 + 5.0 * k as f64,
+            30.0 + k as f64,
+            0.03 + 0.014 * k as f64,
+        );
+        let r: Vec<f64> = wl
+            .iter()
+            .map(|&l| a + (0.9 - a) * (-((l - c) / w).powi(2)).exp())
+            .collect();
+        let xyz = colour::xyz_from_reflectance(&obs, &wl, &r).unwrap();
+        if !in_gamut(obs.linear_srgb(xyz)) {
+            continue;
+        }
+        n += 1;
+        let m = gamut::map_lab(&obs, xyz_to_lab(xyz, obs.white_xyz()));
+        assert!(!m.moved, "{xyz:?}");
+        assert_eq!(m.srgb8, colour::to_srgb8(&obs, xyz), "{xyz:?}");
+    }
+    assert!(n > 30, "only {n} in-gamut samples");
+    // The white and the black.
+    let white = gamut::map_lab(&obs, [100.0, 0.0, 0.0]);
+    assert_eq!((white.srgb8, white.moved), ([255; 3], false));
+    assert_eq!(gamut::map_lab(&obs, [0.0, 0.0, 0.0]).srgb8, [0; 3]);
+}
+
+#[test]
+fn out_of_gamut_colours_keep_lightness_and_hue() {
+    for obs in [
+        Observer::cie1931_d65(),
+        Observer::standard(colour::Illuminant::A, colour::StandardObserver::TenDegree),
+    ] {
+        for lab in [
+            [60.0, -90.0, -40.0],
+            [50.0, 80.0, -90.0],
+            [88.0, -10.0, 120.0],
+            [30.0, 70.0, 70.0],
+            [45.0, -100.0, 80.0],
+            [75.0, 0.0, -90.0],
+            [112.0, 20.0, 5.0],
+        ] {
+            let m = gamut::map_lab(&obs, lab);
+            assert!(m.moved, "{lab:?}");
+            assert!(
+                in_gamut(lab_to_linear_srgb(&obs, m.lab)),
+                "{lab:?} -> {:?}",
+                m.lab
+            );
+            let want_l = lab[0].clamp(0.0, 100.0);
+            assert!((m.lab[0] - want_l).abs() <= 0.5, "{lab:?} -> {:?}", m.lab);
+            let (c0, h0) = chroma_hue(lab);
+            let (c1, h1) = chroma_hue(m.lab);
+            assert!(c1 <= c0);
+            if c1 > 1.0 {
+                let dh = (h1 - h0 + 540.0) % 360.0 - 180.0;
+                assert!(dh.abs() <= 0.5, "{lab:?}: hue {h0} -> {h1}");
+            }
+            // On the boundary: a little more chroma leaves the gamut.
+            if lab[0] < 100.0 {
+                let more = [m.lab[0], m.lab[1] * 1.01, m.lab[2] * 1.01];
+                assert!(!in_gamut(lab_to_linear_srgb(&obs, more)), "{lab:?}");
+            }
+            // The drawn 8 bits are the mapped colour's.
+            assert_eq!(
+                m.srgb8,
+                colour::encode_srgb8(lab_to_linear_srgb(&obs, m.lab))
+            );
+        }
+    }
+    // Not finite: drawn black, marked.
+    let obs = Observer::cie1931_d65();
+    assert!(gamut::map_lab(&obs, [f64::NAN, 0.0, 0.0]).moved);
+}
+
+#[test]
+fn mapping_is_monotone_in_chroma() {
+    let obs = Observer::cie1931_d65();
+    for l in [20.0, 50.0, 80.0, 95.0] {
+        for h in (0..360).step_by(15) {
+            let (ca, sa) = ((h as f64).to_radians().cos(), (h as f64).to_radians().sin());
+            let mut last = 0.0;
+            let mut moved_seen = false;
+            for k in 0..=100 {
+                let c = 2.0 * k as f64;
+                let m = gamut::map_lab(&obs, [l, c * ca, c * sa]);
+                let (cm, _) = chroma_hue(m.lab);
+                assert!(cm + 1e-6 >= last, "L {l} h {h}: C {c} -> {cm} < {last}");
+                assert!(cm <= c + 1e-9);
+                // Once moved, every larger chroma is moved too.
+                assert!(!moved_seen || m.moved, "L {l} h {h} C {c}");
+                moved_seen |= m.moved;
+                last = cm;
+            }
+            assert!(moved_seen, "L {l} h {h}: C 200 inside sRGB?");
         }
     }
 }

@@ -1,15 +1,22 @@
-//! The diffuse-BRDF picture: decodes, has the documented layout, and shows
-//! the orders where their directions say.
+//! The pictures: the diffuse-BRDF picture decodes, has the documented
+//! layout, shows the orders where their directions say and a colour bar over
+//! the data's range; the tile is large, labelled and marks colours mapped
+//! into the sRGB gamut; the geometry picture is labelled; and the gamut
+//! mapping keeps lightness and hue.
 
 use inksim::config::Incidence;
 use inksim::config::Method;
 use inksim::optics::colour::gamut::{self, chroma_hue, in_gamut, lab_to_linear_srgb};
 use inksim::optics::colour::{self, xyz_to_lab, Observer};
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
+use inksim::output::render::canvas::{self, Canvas};
 use inksim::output::render::{
-    diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX,
+    brdf_range, diffuse_brdf_png, geometry_png, order_cell, PanelLayout, RenderError,
+    DISK_RADIUS_PX, DOT_SIGMA_PX,
 };
+use inksim::raster::{Grid, Raster};
 use inksim::solver::SolveRecord;
+use ndarray::Array3;
 use num_complex::Complex64;
 
 const PERIOD_NM: f64 = 2000.0;
@@ -345,6 +352,89 @@ fn entries_without_diffuse_orders_draw_empty_panels() {
     }
 }
 
+/// Pixels of `img` in the rectangle (x, y, w, h) that differ from `bg`.
+fn inked(img: &Image, (x, y, w, h): (usize, usize, usize, usize), bg: [u8; 3]) -> usize {
+    let mut n = 0;
+    for yy in y..(y + h).min(img.h) {
+        for xx in x..(x + w).min(img.w) {
+            if img.rgb(xx, yy) != bg {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+const BG: [u8; 3] = [40, 40, 40];
+
+#[test]
+fn colour_bar_spans_the_data_range_and_is_labelled() {
+    let mut e = lattice_entry(550.0, 0.0, 1e-4, None);
+    for o in e.efficiencies.orders.iter_mut() {
+        if (o.m, o.n) == (1, 1) {
+            o.reflectance = 3e-2;
+        }
+    }
+    let entries = vec![e, lattice_entry(450.0, 30.0, 2e-4, None)];
+    let (lo, hi) = brdf_range(&entries).unwrap();
+    let cell = order_cell(&entries[0].efficiencies.orders);
+    assert!((hi - (3e-2 / cell).log10()).abs() < 1e-12);
+    assert!((lo - (1e-4 / cell).log10()).abs() < 1e-12);
+    let img = decode(&diffuse_brdf_png(&entries, "bar").unwrap());
+    let layout = PanelLayout::new(&entries, "bar").unwrap();
+    let (bx, by, bw, bh) = layout.bar;
+    assert!(bh >= 100 && bw >= 8, "{:?}", layout.bar);
+    // Top row: the brightest value (full white); bottom row: the dimmest (20 %).
+    let mid = bx + bw / 2;
+    assert_eq!(img.rgb(mid, by), [255, 255, 255]);
+    assert_eq!(img.rgb(mid, by + bh - 1), [51, 51, 51]);
+    // Monotone from bottom to top.
+    for y in by + 1..by + bh {
+        assert!(img.lum(mid, y) <= img.lum(mid, y - 1));
+    }
+    // The brightest order's dot centre shows the bar's top colour in its tint,
+    // and the dimmest the bottom's: the bar spans exactly what is drawn.
+    let o = entries[0]
+        .efficiencies
+        .orders
+        .iter()
+        .find(|o| (o.m, o.n) == (1, 1))
+        .unwrap();
+    let (sx, sy) = direction(o);
+    let (x, y) = layout.direction_px(0, 1, sx, sy);
+    // Green is full in the 550 nm tint; the dot's Gaussian falls off by the
+    // pixel centre's distance from the order's exact position.
+    let (px, py) = (x.round(), y.round());
+    let g = (-((px - x).powi(2) + (py - y).powi(2)) / (2.0 * DOT_SIGMA_PX * DOT_SIGMA_PX)).exp();
+    let peak = img.rgb(px as usize, py as usize);
+    assert!((peak[1] as f64 - 255.0 * g).abs() <= 1.0, "{peak:?} vs {g}");
+    // Tick labels right of the bar, the unit above it.
+    assert!(inked(&img, (bx + bw + 6, by, 50, bh), BG) > 100);
+    assert!(inked(&img, (bx, by - 20, 60, 18), BG) > 60);
+    // The legend underneath is drawn and the canvas is not much wider than
+    // the panels and the bar.
+    assert!(inked(&img, (10, layout.legend_top, layout.width - 20, 40), BG) > 500);
+    assert!(
+        layout.width - (bx + bw) < 100,
+        "width {} bar {:?}",
+        layout.width,
+        layout.bar
+    );
+}
+
+#[test]
+fn panel_labels_are_drawn() {
+    let entries = vec![lattice_entry(500.0, 20.0, 1e-3, None)];
+    let img = decode(&diffuse_brdf_png(&entries, "labels").unwrap());
+    let layout = PanelLayout::new(&entries, "labels").unwrap();
+    let (cx, cy) = layout.center(0, 0);
+    let r = DISK_RADIUS_PX as usize;
+    // Left of the disk: the row's θᵢ; above it: the column's λ; the title.
+    assert!(inked(&img, (0, cy as usize - 10, cx as usize - r - 4, 20), BG) > 40);
+    assert!(inked(&img, (cx as usize - r, cy as usize - r - 30, 2 * r, 20), BG) > 40);
+    assert!(inked(&img, (0, 0, layout.width, 30), BG) > 40);
+}
+
 #[test]
 fn in_gamut_colours_are_unchanged() {
     let obs = Observer::cie1931_d65();
@@ -447,4 +537,48 @@ fn mapping_is_monotone_in_chroma() {
             assert!(moved_seen, "L {l} h {h}: C 200 inside sRGB?");
         }
     }
+}
+
+#[test]
+fn geometry_picture_has_axes_scale_bar_and_section() {
+    let (nx, ny, nz) = (40, 40, 20);
+    let grid = Grid::new(nx, ny, nz, [2000.0, 2000.0, 1000.0]).unwrap();
+    let mut f = Array3::zeros((nz, ny, nx));
+    for iz in 0..nz {
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let d = ((ix as f64 - 20.0).powi(2) + (iy as f64 - 20.0).powi(2)).sqrt();
+                if d < 8.0 && iz > 4 && iz < 15 {
+                    f[[iz, iy, ix]] = 1.0;
+                }
+            }
+        }
+    }
+    let raster = Raster {
+        grid,
+        fractions: vec![f],
+        top_cells: 0,
+    };
+    let lines = vec!["pigment volume fraction 0.2 (µm³ per µm³)".to_string()];
+    let png = geometry_png(&raster, "demo layer", &lines).unwrap();
+    let c = Canvas::decode_png(&png).unwrap();
+    let img = Image {
+        w: c.w,
+        h: c.h,
+        px: c.px,
+    };
+    assert!(img.w >= 2 * 320 && img.h >= 320, "{} × {}", img.w, img.h);
+    let bg = [24, 24, 28];
+    // Every quarter of the picture's height carries drawing or text.
+    for q in 0..4 {
+        let band = (0, q * img.h / 4, img.w, img.h / 4);
+        assert!(inked(&img, band, bg) > 200, "quarter {q}");
+    }
+    // The section's dashed line on the top view (orange).
+    let orange = (0..img.h)
+        .flat_map(|y| (0..img.w).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.rgb(x, y) == [230, 120, 60])
+        .count();
+    assert!(orange > 100, "{orange}");
+    assert!(canvas::text_width("x (µm)") > 20);
 }

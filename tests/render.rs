@@ -10,13 +10,14 @@ use inksim::optics::colour::gamut::{self, chroma_hue, in_gamut, lab_to_linear_sr
 use inksim::optics::colour::{self, xyz_to_lab, Observer};
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::output::render::canvas::{self, Canvas};
+use inksim::output::render::tile::{self, TileCaption, TileLayout, MARK_PX, PATCH_PX};
 use inksim::output::render::{
     brdf_range, diffuse_brdf_png, geometry_png, order_cell, PanelLayout, RenderError,
     DISK_RADIUS_PX, DOT_SIGMA_PX,
 };
 use inksim::raster::{Grid, Raster};
 use inksim::solver::SolveRecord;
-use ndarray::Array3;
+use ndarray::{Array3, Axis};
 use num_complex::Complex64;
 
 const PERIOD_NM: f64 = 2000.0;
@@ -433,6 +434,109 @@ fn panel_labels_are_drawn() {
     assert!(inked(&img, (0, cy as usize - 10, cx as usize - r - 4, 20), BG) > 40);
     assert!(inked(&img, (cx as usize - r, cy as usize - r - 30, 2 * r, 20), BG) > 40);
     assert!(inked(&img, (0, 0, layout.width, 30), BG) > 40);
+}
+
+fn caption(obs: &Observer) -> TileCaption<'_> {
+    TileCaption {
+        name: "magenta",
+        observer: obs,
+        paper_albedo: Some(0.8),
+        azimuth_deg: 0.0,
+    }
+}
+
+/// A 3 × (1 + 4) tile: in-gamut greyish colours, one out-of-gamut cyan.
+fn tile_input(obs: &Observer) -> (Array3<u8>, Array3<f64>) {
+    let (nv, nc) = (3, 5);
+    let mut lab = Array3::zeros((nv, nc, 3));
+    let mut rgb = Array3::zeros((nv, nc, 3));
+    for v in 0..nv {
+        for c in 0..nc {
+            let l = [
+                30.0 + 15.0 * v as f64,
+                5.0 * c as f64 - 10.0,
+                10.0 - 3.0 * c as f64,
+            ];
+            let s = colour::encode_srgb8(lab_to_linear_srgb(obs, l));
+            for k in 0..3 {
+                lab[[v, c, k]] = l[k];
+                rgb[[v, c, k]] = s[k];
+            }
+        }
+    }
+    // Cell (1, 2): a cyan beyond sRGB, stored clipped as today.
+    let cyan = [60.0, -90.0, -40.0];
+    let clipped = colour::encode_srgb8(lab_to_linear_srgb(obs, cyan));
+    for k in 0..3 {
+        lab[[1, 2, k]] = cyan[k];
+        rgb[[1, 2, k]] = clipped[k];
+    }
+    (rgb, lab)
+}
+
+#[test]
+fn tile_is_large_labelled_and_marks_mapped_colours() {
+    let obs = Observer::cie1931_d65();
+    let cap = caption(&obs);
+    assert!(
+        tile::glyphs_missing(&cap).is_empty(),
+        "{:?}",
+        tile::glyphs_missing(&cap)
+    );
+    assert_eq!(cap.conditions(), "D65, 2°");
+    assert!(cap.lines()[0].contains("magenta") && cap.lines()[0].contains("0.8"));
+    let (rgb, lab) = tile_input(&obs);
+    let viewing = [0.0, 30.0, 60.0];
+    let illum = [0.0, 15.0, 45.0, 60.0];
+    let img = decode(&tile::tile_png(&rgb, &lab, &viewing, &illum, &cap).unwrap());
+    let l = TileLayout::new(3, 4, &viewing, &cap);
+    assert_eq!((img.w, img.h), (l.width, l.height));
+    assert!(l.columns_x[2] - l.columns_x[1] >= 64 && l.rows_y[1] - l.rows_y[0] >= 64);
+    assert!(img.w >= 5 * PATCH_PX && img.h >= 3 * PATCH_PX);
+    // Headings: every column's θᵢ and every row's θₒ put ink in its place.
+    let (hx, hy, _, hh) = l.column_heads;
+    for c in 0..5 {
+        let x = l.columns_x[c];
+        assert!(inked(&img, (x, hy, PATCH_PX, hh), BG) > 20, "column {c}");
+        assert!(x >= hx);
+    }
+    let (rx, _, rw, _) = l.row_heads;
+    for r in 0..3 {
+        let y = l.rows_y[r];
+        assert!(inked(&img, (rx, y, rw, PATCH_PX), BG) > 20, "row {r}");
+    }
+    // Title and legend.
+    assert!(inked(&img, (0, 0, img.w, hy - 25), BG) > 300);
+    assert!(inked(&img, (0, l.legend_top, img.w, img.h - l.legend_top), BG) > 300);
+    for r in 0..3 {
+        for c in 0..5 {
+            let (x, y) = (l.columns_x[c], l.rows_y[r]);
+            // Top-left corner: the patch's own colour; numbers at the bottom.
+            let corner = img.rgb(x + 3, y + 3);
+            let mark = img.rgb(x + PATCH_PX - 2, y + 1);
+            let own = |p: [u8; 3]| p == corner;
+            let numbers = (y + PATCH_PX / 2..y + PATCH_PX)
+                .flat_map(|yy| (x..x + PATCH_PX).map(move |xx| (xx, yy)))
+                .filter(|&(xx, yy)| !own(img.rgb(xx, yy)))
+                .count();
+            assert!(numbers > 60, "patch ({r}, {c}): {numbers} text pixels");
+            if (r, c) == (1, 2) {
+                let m = gamut::map_lab(&obs, [lab[[1, 2, 0]], lab[[1, 2, 1]], lab[[1, 2, 2]]]);
+                assert!(m.moved);
+                assert_eq!(corner, m.srgb8);
+                assert_ne!(corner, [rgb[[1, 2, 0]], rgb[[1, 2, 1]], rgb[[1, 2, 2]]]);
+                assert!(!own(mark), "no mark on the mapped patch");
+                // The mark's inside: a filled triangle of MARK_PX.
+                assert_eq!(img.rgb(x + PATCH_PX - MARK_PX / 2, y + 2), mark);
+            } else {
+                assert_eq!(corner, [rgb[[r, c, 0]], rgb[[r, c, 1]], rgb[[r, c, 2]]]);
+                assert!(own(mark), "mark on in-gamut patch ({r}, {c})");
+            }
+        }
+    }
+    // Mismatched inputs are errors.
+    let short = lab.select(Axis(0), &[0, 1]);
+    assert!(tile::tile_png(&rgb, &short, &viewing, &illum, &cap).is_err());
 }
 
 #[test]

@@ -6,8 +6,8 @@
 
 use inksim::config::Incidence;
 use inksim::config::Method;
-use inksim::optics::colour::gamut::{self, chroma_hue, in_gamut, lab_to_linear_srgb};
-use inksim::optics::colour::{self, xyz_to_lab, Observer};
+use inksim::optics::colour::gamut::{self, in_gamut, lab_to_linear_srgb};
+use inksim::optics::colour::{self, lab_to_lch, xyz_to_lab, Observer};
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
 use inksim::output::render::canvas::{self, Canvas};
 use inksim::output::render::tile::{self, TileCaption, TileLayout, MARK_PX, PATCH_PX};
@@ -595,8 +595,8 @@ fn out_of_gamut_colours_keep_lightness_and_hue() {
             );
             let want_l = lab[0].clamp(0.0, 100.0);
             assert!((m.lab[0] - want_l).abs() <= 0.5, "{lab:?} -> {:?}", m.lab);
-            let (c0, h0) = chroma_hue(lab);
-            let (c1, h1) = chroma_hue(m.lab);
+            let [_, c0, h0] = lab_to_lch(lab);
+            let [_, c1, h1] = lab_to_lch(m.lab);
             assert!(c1 <= c0);
             if c1 > 1.0 {
                 let dh = (h1 - h0 + 540.0) % 360.0 - 180.0;
@@ -630,7 +630,7 @@ fn mapping_is_monotone_in_chroma() {
             for k in 0..=100 {
                 let c = 2.0 * k as f64;
                 let m = gamut::map_lab(&obs, [l, c * ca, c * sa]);
-                let (cm, _) = chroma_hue(m.lab);
+                let [_, cm, _] = lab_to_lch(m.lab);
                 assert!(cm + 1e-6 >= last, "L {l} h {h}: C {c} -> {cm} < {last}");
                 assert!(cm <= c + 1e-9);
                 // Once moved, every larger chroma is moved too.

@@ -24,7 +24,7 @@
 //! chroma: more chroma in never gives less chroma out. Colours inside are
 //! encoded exactly as [`super::to_srgb8`] encodes their XYZ.
 
-use super::{encode_srgb8, Observer};
+use super::{encode_srgb8, lab_to_lch, Observer};
 
 /// How far outside [0, 1] a linear channel may lie and still count as
 /// inside: rounding of the Lab ↔ XYZ round trip, far below one 8-bit step.
@@ -80,13 +80,6 @@ pub fn in_gamut(rgb: [f64; 3]) -> bool {
         .all(|&v| (-GAMUT_TOLERANCE..=1.0 + GAMUT_TOLERANCE).contains(&v))
 }
 
-/// Chroma `C*ab` and hue angle `h°` (degrees in [0, 360)) of a CIELAB colour.
-pub fn chroma_hue(lab: [f64; 3]) -> (f64, f64) {
-    let c = lab[1].hypot(lab[2]);
-    let h = lab[2].atan2(lab[1]).to_degrees();
-    (c, if h < 0.0 { h + 360.0 } else { h })
-}
-
 /// Map a CIELAB colour (white of `obs`) into the sRGB gamut (module docs).
 /// A colour with a non-finite component is drawn black and marked moved.
 pub fn map_lab(obs: &Observer, lab: [f64; 3]) -> Mapped {
@@ -107,7 +100,7 @@ pub fn map_lab(obs: &Observer, lab: [f64; 3]) -> Mapped {
             moved: l != lab[0],
         };
     }
-    let (c, _) = chroma_hue(clamped);
+    let [_, c, _] = lab_to_lch(clamped);
     let (ua, ub) = (lab[1] / c, lab[2] / c);
     let at = |chroma: f64| [l, chroma * ua, chroma * ub];
     let (mut lo, mut hi) = (0.0, c);

@@ -15,8 +15,7 @@
 
 use super::canvas::{self, text_width_px, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
 use super::{fmt_num, RenderError};
-use crate::optics::colour::gamut::{self, chroma_hue};
-use crate::optics::colour::Observer;
+use crate::optics::colour::{gamut, lab_to_lch, Observer};
 use ndarray::Array3;
 
 /// Side of one patch, pixels.
@@ -269,7 +268,7 @@ fn ink_on(lightness: f64) -> [u8; 3] {
 
 /// L*, C*ab and h° of `lab` in three lines at the bottom left of a patch.
 fn patch_numbers(img: &mut Canvas, (x, y): (usize, usize), lab: [f64; 3], ink: [u8; 3], s: f64) {
-    let (c, h) = chroma_hue(lab);
+    let [_, c, h] = lab_to_lch(lab);
     let lines = [
         format!("L* {:.1}", lab[0]),
         format!("C* {c:.1}"),

@@ -1,13 +1,23 @@
-//! The diffuse-BRDF picture: decodes, has the documented layout, and shows
-//! the orders where their directions say.
+//! The pictures: the diffuse-BRDF picture decodes, has the documented
+//! layout, shows the orders where their directions say and a colour bar over
+//! the data's range; the tile is large, labelled and marks colours mapped
+//! into the sRGB gamut; the geometry picture is labelled; and the gamut
+//! mapping keeps lightness and hue.
 
 use inksim::config::Incidence;
 use inksim::config::Method;
+use inksim::optics::colour::gamut::{self, in_gamut, lab_to_linear_srgb};
+use inksim::optics::colour::{self, lab_to_lch, xyz_to_lab, Observer};
 use inksim::optics::farfield::{Efficiencies, Order, Side, SolveEntry};
+use inksim::output::render::canvas::{self, Canvas};
+use inksim::output::render::tile::{self, TileCaption, TileLayout, MARK_PX, PATCH_PX};
 use inksim::output::render::{
-    diffuse_brdf_png, order_cell, PanelLayout, RenderError, DISK_RADIUS_PX,
+    brdf_range, diffuse_brdf_png, geometry_png, order_cell, PanelLayout, RenderError,
+    DISK_RADIUS_PX, DOT_SIGMA_PX,
 };
+use inksim::raster::{Grid, Raster};
 use inksim::solver::SolveRecord;
+use ndarray::{Array3, Axis};
 use num_complex::Complex64;
 
 const PERIOD_NM: f64 = 2000.0;
@@ -341,4 +351,338 @@ fn entries_without_diffuse_orders_draw_empty_panels() {
             }
         }
     }
+}
+
+/// Pixels of `img` in the rectangle (x, y, w, h) that differ from `bg`.
+fn inked(img: &Image, (x, y, w, h): (usize, usize, usize, usize), bg: [u8; 3]) -> usize {
+    let mut n = 0;
+    for yy in y..(y + h).min(img.h) {
+        for xx in x..(x + w).min(img.w) {
+            if img.rgb(xx, yy) != bg {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+const BG: [u8; 3] = [40, 40, 40];
+
+#[test]
+fn colour_bar_spans_the_data_range_and_is_labelled() {
+    let mut e = lattice_entry(550.0, 0.0, 1e-4, None);
+    for o in e.efficiencies.orders.iter_mut() {
+        if (o.m, o.n) == (1, 1) {
+            o.reflectance = 3e-2;
+        }
+    }
+    let entries = vec![e, lattice_entry(450.0, 30.0, 2e-4, None)];
+    let (lo, hi) = brdf_range(&entries).unwrap();
+    let cell = order_cell(&entries[0].efficiencies.orders);
+    assert!((hi - (3e-2 / cell).log10()).abs() < 1e-12);
+    assert!((lo - (1e-4 / cell).log10()).abs() < 1e-12);
+    let img = decode(&diffuse_brdf_png(&entries, "bar").unwrap());
+    let layout = PanelLayout::new(&entries, "bar").unwrap();
+    let (bx, by, bw, bh) = layout.bar;
+    assert!(bh >= 100 && bw >= 8, "{:?}", layout.bar);
+    // Top row: the brightest value (full white); bottom row: the dimmest (20 %).
+    let mid = bx + bw / 2;
+    assert_eq!(img.rgb(mid, by), [255, 255, 255]);
+    assert_eq!(img.rgb(mid, by + bh - 1), [51, 51, 51]);
+    // Monotone from bottom to top.
+    for y in by + 1..by + bh {
+        assert!(img.lum(mid, y) <= img.lum(mid, y - 1));
+    }
+    // The brightest order's dot centre shows the bar's top colour in its tint,
+    // and the dimmest the bottom's: the bar spans exactly what is drawn.
+    let o = entries[0]
+        .efficiencies
+        .orders
+        .iter()
+        .find(|o| (o.m, o.n) == (1, 1))
+        .unwrap();
+    let (sx, sy) = direction(o);
+    let (x, y) = layout.direction_px(0, 1, sx, sy);
+    // Green is full in the 550 nm tint; the dot's Gaussian falls off by the
+    // pixel centre's distance from the order's exact position.
+    let (px, py) = (x.round(), y.round());
+    let g = (-((px - x).powi(2) + (py - y).powi(2)) / (2.0 * DOT_SIGMA_PX * DOT_SIGMA_PX)).exp();
+    let peak = img.rgb(px as usize, py as usize);
+    assert!((peak[1] as f64 - 255.0 * g).abs() <= 1.0, "{peak:?} vs {g}");
+    // Tick labels right of the bar, the unit above it.
+    assert!(inked(&img, (bx + bw + 6, by, 50, bh), BG) > 100);
+    assert!(inked(&img, (bx, by - 20, 60, 18), BG) > 60);
+    // The legend underneath is drawn and the canvas is not much wider than
+    // the panels and the bar.
+    assert!(inked(&img, (10, layout.legend_top, layout.width - 20, 40), BG) > 500);
+    assert!(
+        layout.width - (bx + bw) < 100,
+        "width {} bar {:?}",
+        layout.width,
+        layout.bar
+    );
+}
+
+#[test]
+fn panel_labels_are_drawn() {
+    let entries = vec![lattice_entry(500.0, 20.0, 1e-3, None)];
+    let img = decode(&diffuse_brdf_png(&entries, "labels").unwrap());
+    let layout = PanelLayout::new(&entries, "labels").unwrap();
+    let (cx, cy) = layout.center(0, 0);
+    let r = DISK_RADIUS_PX as usize;
+    // Left of the disk: the row's θᵢ; above it: the column's λ; the title.
+    assert!(inked(&img, (0, cy as usize - 10, cx as usize - r - 4, 20), BG) > 40);
+    assert!(inked(&img, (cx as usize - r, cy as usize - r - 30, 2 * r, 20), BG) > 40);
+    assert!(inked(&img, (0, 0, layout.width, 30), BG) > 40);
+}
+
+fn caption(obs: &Observer) -> TileCaption<'_> {
+    TileCaption {
+        name: "magenta",
+        observer: obs,
+        paper_albedo: Some(0.8),
+        azimuth_deg: 0.0,
+    }
+}
+
+/// A 3 × (1 + 4) tile: in-gamut greyish colours, one out-of-gamut cyan.
+fn tile_input(obs: &Observer) -> (Array3<u8>, Array3<f64>) {
+    let (nv, nc) = (3, 5);
+    let mut lab = Array3::zeros((nv, nc, 3));
+    let mut rgb = Array3::zeros((nv, nc, 3));
+    for v in 0..nv {
+        for c in 0..nc {
+            let l = [
+                30.0 + 15.0 * v as f64,
+                5.0 * c as f64 - 10.0,
+                10.0 - 3.0 * c as f64,
+            ];
+            let s = colour::encode_srgb8(lab_to_linear_srgb(obs, l));
+            for k in 0..3 {
+                lab[[v, c, k]] = l[k];
+                rgb[[v, c, k]] = s[k];
+            }
+        }
+    }
+    // Cell (1, 2): a cyan beyond sRGB, stored clipped as today.
+    let cyan = [60.0, -90.0, -40.0];
+    let clipped = colour::encode_srgb8(lab_to_linear_srgb(obs, cyan));
+    for k in 0..3 {
+        lab[[1, 2, k]] = cyan[k];
+        rgb[[1, 2, k]] = clipped[k];
+    }
+    (rgb, lab)
+}
+
+#[test]
+fn tile_is_large_labelled_and_marks_mapped_colours() {
+    let obs = Observer::cie1931_d65();
+    let cap = caption(&obs);
+    assert!(
+        tile::glyphs_missing(&cap).is_empty(),
+        "{:?}",
+        tile::glyphs_missing(&cap)
+    );
+    assert_eq!(cap.conditions(), "D65, 2°");
+    assert!(cap.lines()[0].contains("magenta") && cap.lines()[0].contains("0.8"));
+    let (rgb, lab) = tile_input(&obs);
+    let viewing = [0.0, 30.0, 60.0];
+    let illum = [0.0, 15.0, 45.0, 60.0];
+    let img = decode(&tile::tile_png(&rgb, &lab, &viewing, &illum, &cap).unwrap());
+    let l = TileLayout::new(3, 4, &viewing, &cap);
+    assert_eq!((img.w, img.h), (l.width, l.height));
+    assert!(l.columns_x[2] - l.columns_x[1] >= 64 && l.rows_y[1] - l.rows_y[0] >= 64);
+    assert!(img.w >= 5 * PATCH_PX && img.h >= 3 * PATCH_PX);
+    // Headings: every column's θᵢ and every row's θₒ put ink in its place.
+    let (hx, hy, _, hh) = l.column_heads;
+    for c in 0..5 {
+        let x = l.columns_x[c];
+        assert!(inked(&img, (x, hy, PATCH_PX, hh), BG) > 20, "column {c}");
+        assert!(x >= hx);
+    }
+    let (rx, _, rw, _) = l.row_heads;
+    for r in 0..3 {
+        let y = l.rows_y[r];
+        assert!(inked(&img, (rx, y, rw, PATCH_PX), BG) > 20, "row {r}");
+    }
+    // Title and legend.
+    assert!(inked(&img, (0, 0, img.w, hy - 25), BG) > 300);
+    assert!(inked(&img, (0, l.legend_top, img.w, img.h - l.legend_top), BG) > 300);
+    for r in 0..3 {
+        for c in 0..5 {
+            let (x, y) = (l.columns_x[c], l.rows_y[r]);
+            // Top-left corner: the patch's own colour; numbers at the bottom.
+            let corner = img.rgb(x + 3, y + 3);
+            let mark = img.rgb(x + PATCH_PX - 2, y + 1);
+            let own = |p: [u8; 3]| p == corner;
+            let numbers = (y + PATCH_PX / 2..y + PATCH_PX)
+                .flat_map(|yy| (x..x + PATCH_PX).map(move |xx| (xx, yy)))
+                .filter(|&(xx, yy)| !own(img.rgb(xx, yy)))
+                .count();
+            assert!(numbers > 60, "patch ({r}, {c}): {numbers} text pixels");
+            if (r, c) == (1, 2) {
+                let m = gamut::map_lab(&obs, [lab[[1, 2, 0]], lab[[1, 2, 1]], lab[[1, 2, 2]]]);
+                assert!(m.moved);
+                assert_eq!(corner, m.srgb8);
+                assert_ne!(corner, [rgb[[1, 2, 0]], rgb[[1, 2, 1]], rgb[[1, 2, 2]]]);
+                assert!(!own(mark), "no mark on the mapped patch");
+                // The mark's inside: a filled triangle of MARK_PX.
+                assert_eq!(img.rgb(x + PATCH_PX - MARK_PX / 2, y + 2), mark);
+            } else {
+                assert_eq!(corner, [rgb[[r, c, 0]], rgb[[r, c, 1]], rgb[[r, c, 2]]]);
+                assert!(own(mark), "mark on in-gamut patch ({r}, {c})");
+            }
+        }
+    }
+    // Mismatched inputs are errors.
+    let short = lab.select(Axis(0), &[0, 1]);
+    assert!(tile::tile_png(&rgb, &short, &viewing, &illum, &cap).is_err());
+}
+
+#[test]
+fn in_gamut_colours_are_unchanged() {
+    let obs = Observer::cie1931_d65();
+    let wl: Vec<f64> = (0..=40).map(|k| 380.0 + 10.0 * k as f64).collect();
+    let mut n = 0;
+    for k in 0..60 {
+        // Smooth spectra between 0.03 and 0.9: greys, pinks, greens, blues.
+        let (c, w, a) = (
+            400.0 + 5.0 * k as f64,
+            30.0 + k as f64,
+            0.03 + 0.014 * k as f64,
+        );
+        let r: Vec<f64> = wl
+            .iter()
+            .map(|&l| a + (0.9 - a) * (-((l - c) / w).powi(2)).exp())
+            .collect();
+        let xyz = colour::xyz_from_reflectance(&obs, &wl, &r).unwrap();
+        if !in_gamut(obs.linear_srgb(xyz)) {
+            continue;
+        }
+        n += 1;
+        let m = gamut::map_lab(&obs, xyz_to_lab(xyz, obs.white_xyz()));
+        assert!(!m.moved, "{xyz:?}");
+        assert_eq!(m.srgb8, colour::to_srgb8(&obs, xyz), "{xyz:?}");
+    }
+    assert!(n > 30, "only {n} in-gamut samples");
+    // The white and the black.
+    let white = gamut::map_lab(&obs, [100.0, 0.0, 0.0]);
+    assert_eq!((white.srgb8, white.moved), ([255; 3], false));
+    assert_eq!(gamut::map_lab(&obs, [0.0, 0.0, 0.0]).srgb8, [0; 3]);
+}
+
+#[test]
+fn out_of_gamut_colours_keep_lightness_and_hue() {
+    for obs in [
+        Observer::cie1931_d65(),
+        Observer::standard(colour::Illuminant::A, colour::StandardObserver::TenDegree),
+    ] {
+        for lab in [
+            [60.0, -90.0, -40.0],
+            [50.0, 80.0, -90.0],
+            [88.0, -10.0, 120.0],
+            [30.0, 70.0, 70.0],
+            [45.0, -100.0, 80.0],
+            [75.0, 0.0, -90.0],
+            [112.0, 20.0, 5.0],
+        ] {
+            let m = gamut::map_lab(&obs, lab);
+            assert!(m.moved, "{lab:?}");
+            assert!(
+                in_gamut(lab_to_linear_srgb(&obs, m.lab)),
+                "{lab:?} -> {:?}",
+                m.lab
+            );
+            let want_l = lab[0].clamp(0.0, 100.0);
+            assert!((m.lab[0] - want_l).abs() <= 0.5, "{lab:?} -> {:?}", m.lab);
+            let [_, c0, h0] = lab_to_lch(lab);
+            let [_, c1, h1] = lab_to_lch(m.lab);
+            assert!(c1 <= c0);
+            if c1 > 1.0 {
+                let dh = (h1 - h0 + 540.0) % 360.0 - 180.0;
+                assert!(dh.abs() <= 0.5, "{lab:?}: hue {h0} -> {h1}");
+            }
+            // On the boundary: a little more chroma leaves the gamut.
+            if lab[0] < 100.0 {
+                let more = [m.lab[0], m.lab[1] * 1.01, m.lab[2] * 1.01];
+                assert!(!in_gamut(lab_to_linear_srgb(&obs, more)), "{lab:?}");
+            }
+            // The drawn 8 bits are the mapped colour's.
+            assert_eq!(
+                m.srgb8,
+                colour::encode_srgb8(lab_to_linear_srgb(&obs, m.lab))
+            );
+        }
+    }
+    // Not finite: drawn black, marked.
+    let obs = Observer::cie1931_d65();
+    assert!(gamut::map_lab(&obs, [f64::NAN, 0.0, 0.0]).moved);
+}
+
+#[test]
+fn mapping_is_monotone_in_chroma() {
+    let obs = Observer::cie1931_d65();
+    for l in [20.0, 50.0, 80.0, 95.0] {
+        for h in (0..360).step_by(15) {
+            let (ca, sa) = ((h as f64).to_radians().cos(), (h as f64).to_radians().sin());
+            let mut last = 0.0;
+            let mut moved_seen = false;
+            for k in 0..=100 {
+                let c = 2.0 * k as f64;
+                let m = gamut::map_lab(&obs, [l, c * ca, c * sa]);
+                let [_, cm, _] = lab_to_lch(m.lab);
+                assert!(cm + 1e-6 >= last, "L {l} h {h}: C {c} -> {cm} < {last}");
+                assert!(cm <= c + 1e-9);
+                // Once moved, every larger chroma is moved too.
+                assert!(!moved_seen || m.moved, "L {l} h {h} C {c}");
+                moved_seen |= m.moved;
+                last = cm;
+            }
+            assert!(moved_seen, "L {l} h {h}: C 200 inside sRGB?");
+        }
+    }
+}
+
+#[test]
+fn geometry_picture_has_axes_scale_bar_and_section() {
+    let (nx, ny, nz) = (40, 40, 20);
+    let grid = Grid::new(nx, ny, nz, [2000.0, 2000.0, 1000.0]).unwrap();
+    let mut f = Array3::zeros((nz, ny, nx));
+    for iz in 0..nz {
+        for iy in 0..ny {
+            for ix in 0..nx {
+                let d = ((ix as f64 - 20.0).powi(2) + (iy as f64 - 20.0).powi(2)).sqrt();
+                if d < 8.0 && iz > 4 && iz < 15 {
+                    f[[iz, iy, ix]] = 1.0;
+                }
+            }
+        }
+    }
+    let raster = Raster {
+        grid,
+        fractions: vec![f],
+        top_cells: 0,
+    };
+    let lines = vec!["pigment volume fraction 0.2 (µm³ per µm³)".to_string()];
+    let png = geometry_png(&raster, "demo layer", &lines).unwrap();
+    let c = Canvas::decode_png(&png).unwrap();
+    let img = Image {
+        w: c.w,
+        h: c.h,
+        px: c.px,
+    };
+    assert!(img.w >= 2 * 320 && img.h >= 320, "{} × {}", img.w, img.h);
+    let bg = [24, 24, 28];
+    // Every quarter of the picture's height carries drawing or text.
+    for q in 0..4 {
+        let band = (0, q * img.h / 4, img.w, img.h / 4);
+        assert!(inked(&img, band, bg) > 200, "quarter {q}");
+    }
+    // The section's dashed line on the top view (orange).
+    let orange = (0..img.h)
+        .flat_map(|y| (0..img.w).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.rgb(x, y) == [230, 120, 60])
+        .count();
+    assert!(orange > 100, "{orange}");
+    assert!(canvas::text_width("x (µm)") > 20);
 }

@@ -132,9 +132,15 @@ fn assemble_products(
             },
         ) => Some(render::tile::tile_png(
             &c.tile_srgb8,
+            &c.tile_lab,
             &a.spec.viewing_deg,
             &a.spec.illumination_deg,
-            &scene.output.name,
+            &render::tile::TileCaption {
+                name: &scene.output.name,
+                observer: &Observer::cie1931_d65(),
+                paper_albedo: a.spec.paper_albedo,
+                azimuth_deg: a.spec.azimuth_deg,
+            },
         )?),
         _ => None,
     };

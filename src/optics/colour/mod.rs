@@ -38,6 +38,7 @@
 use std::f64::consts::PI;
 
 pub mod conditions;
+pub mod gamut;
 
 pub use conditions::{bradford, illuminant_a, Illuminant, StandardObserver, SRGB_WHITE};
 use conditions::{interpolate, mat_vec, D50_CSV, D65_CSV};

@@ -1,23 +1,113 @@
-//! An RGB8 canvas with a built-in 5×7 bitmap font, PNG encoding and
+//! An RGB8 canvas with anti-aliased TrueType text, PNG encoding and
 //! decoding: what every picture of inksim (result panels, geometry views,
 //! tiles, comparison grids) is drawn on.
 //!
-//! The font covers upper-case letters, digits and common punctuation; lower
-//! case is drawn as upper case, other characters as `?`. Glyphs are drawn at
-//! [`FONT_SCALE`] times their size.
+//! Text is set in DejaVu Sans (`data/fonts/DejaVuSans.ttf`, Bitstream Vera
+//! licence beside it), embedded in the binary and rasterised by `ab_glyph`
+//! with kerning. It covers Latin, Greek (λ, θ, µ), degree and superscript or
+//! subscript signs (sr⁻¹, nm², θᵢ, θₒ); a character the font lacks is drawn
+//! as the font's empty-box glyph. Sizes are line heights (ascent − descent)
+//! in pixels; [`GLYPH_HEIGHT`] is the default.
+
+use std::sync::OnceLock;
+
+use ab_glyph::{Font, FontRef, GlyphId, PxScale, ScaleFont};
 
 use super::RenderError;
 
-/// Font scale (5×7 glyphs drawn as 10×14 pixels, advance 12).
-pub const FONT_SCALE: usize = 2;
-/// Horizontal advance of one character, pixels.
-pub const GLYPH_ADVANCE: usize = 6 * FONT_SCALE;
-/// Height of a line of text, pixels.
-pub const GLYPH_HEIGHT: usize = 7 * FONT_SCALE;
+/// Line height of the default text size, pixels (an em of about 14.6 px).
+pub const GLYPH_HEIGHT: usize = 17;
+/// Line height of small text (numbers on patches, tick labels), pixels.
+pub const SMALL_HEIGHT: usize = 14;
+/// Line height of titles, pixels.
+pub const TITLE_HEIGHT: usize = 21;
+
+static FONT_BYTES: &[u8] = include_bytes!("../../../data/fonts/DejaVuSans.ttf");
+
+/// The embedded font.
+pub fn font() -> &'static FontRef<'static> {
+    static FONT: OnceLock<FontRef<'static>> = OnceLock::new();
+    FONT.get_or_init(|| FontRef::try_from_slice(FONT_BYTES).expect("embedded DejaVu Sans parses"))
+}
+
+/// Whether the font has a glyph for `ch` (else it draws an empty box).
+pub fn has_glyph(ch: char) -> bool {
+    font().glyph_id(ch) != GlyphId(0)
+}
+
+/// Distance from the top of the line box to the baseline, for line height `size`.
+pub fn ascent(size: f64) -> f64 {
+    font().as_scaled(PxScale::from(size as f32)).ascent() as f64
+}
 
 /// Width of `s` in pixels when drawn with [`Canvas::text`].
 pub fn text_width(s: &str) -> usize {
-    s.chars().count() * GLYPH_ADVANCE
+    text_width_px(s, GLYPH_HEIGHT as f64).ceil() as usize
+}
+
+/// Advance width of `s` (kerning included) at line height `size`, pixels.
+pub fn text_width_px(s: &str, size: f64) -> f64 {
+    let f = font().as_scaled(PxScale::from(size as f32));
+    let mut w = 0.0f32;
+    let mut prev: Option<GlyphId> = None;
+    for ch in s.chars() {
+        let id = f.glyph_id(ch);
+        if let Some(p) = prev {
+            w += f.kern(p, id);
+        }
+        w += f.h_advance(id);
+        prev = Some(id);
+    }
+    w as f64
+}
+
+/// Split `text` at spaces into lines no wider than `max_px` at the default
+/// size (a single word wider than that gets a line of its own).
+pub fn wrap(text: &str, max_px: usize) -> Vec<String> {
+    let mut lines = Vec::new();
+    let mut cur = String::new();
+    for word in text.split_whitespace() {
+        let candidate = if cur.is_empty() {
+            word.to_string()
+        } else {
+            format!("{cur} {word}")
+        };
+        if text_width(&candidate) <= max_px || cur.is_empty() {
+            cur = candidate;
+        } else {
+            lines.push(std::mem::replace(&mut cur, word.to_string()));
+        }
+    }
+    if !cur.is_empty() {
+        lines.push(cur);
+    }
+    lines
+}
+
+/// Call `o(x, y, coverage)` for every covered pixel of `s` laid out from the
+/// origin on the baseline (y negative above it), at line height `size`.
+fn for_each_coverage(s: &str, size: f64, mut o: impl FnMut(i32, i32, f32)) {
+    let scale = PxScale::from(size as f32);
+    let f = font().as_scaled(scale);
+    let mut pen = 0.0f32;
+    let mut prev: Option<GlyphId> = None;
+    for ch in s.chars() {
+        let id = f.glyph_id(ch);
+        if let Some(p) = prev {
+            pen += f.kern(p, id);
+        }
+        let glyph = id.with_scale_and_position(scale, ab_glyph::point(pen.round(), 0.0));
+        if let Some(outlined) = font().outline_glyph(glyph) {
+            let b = outlined.px_bounds();
+            outlined.draw(|gx, gy, a| {
+                if a > 0.0 {
+                    o(b.min.x as i32 + gx as i32, b.min.y as i32 + gy as i32, a)
+                }
+            });
+        }
+        pen += f.h_advance(id);
+        prev = Some(id);
+    }
 }
 
 /// An RGB8 image; all drawing clips at the border.
@@ -111,26 +201,63 @@ impl Canvas {
         }
     }
 
+    /// Draw `s` in the default size with the top of its line box at
+    /// `(x, y)` (the baseline lies [`ascent`]`(GLYPH_HEIGHT)` lower).
     pub fn text(&mut self, x: usize, y: usize, s: &str, c: [u8; 3]) {
-        for (k, ch) in s.chars().enumerate() {
-            let g = glyph(ch);
-            let x0 = x + k * GLYPH_ADVANCE;
-            for (row, bits) in g.iter().enumerate() {
-                for col in 0..5 {
-                    if bits & (0x10 >> col) == 0 {
-                        continue;
-                    }
-                    for dy in 0..FONT_SCALE {
-                        for dx in 0..FONT_SCALE {
-                            self.set(
-                                (x0 + col * FONT_SCALE + dx) as i64,
-                                (y + row * FONT_SCALE + dy) as i64,
-                                c,
-                            );
-                        }
-                    }
-                }
+        self.text_px(x as f64, y as f64, s, c, GLYPH_HEIGHT as f64);
+    }
+
+    /// Draw `s` with line height `size` pixels, top of the line box at `(x, y)`.
+    pub fn text_px(&mut self, x: f64, y: f64, s: &str, c: [u8; 3], size: f64) {
+        let base = y + ascent(size);
+        for_each_coverage(s, size, |px, py, a| {
+            self.blend(
+                (x + px as f64).floor() as i64,
+                (base + py as f64).floor() as i64,
+                c,
+                a,
+            )
+        });
+    }
+
+    /// Draw `s` with line height `size` centred horizontally on `cx`.
+    pub fn text_centered(&mut self, cx: f64, y: f64, s: &str, c: [u8; 3], size: f64) {
+        self.text_px(cx - text_width_px(s, size) / 2.0, y, s, c, size);
+    }
+
+    /// Draw `s` turned a quarter turn anticlockwise (reading upwards), line
+    /// height `size`; `(x, y)` is the left end of the line box's top edge
+    /// before turning, i.e. the turned text occupies `[x, x + size) ×
+    /// (y − width, y]`.
+    pub fn text_up(&mut self, x: f64, y: f64, s: &str, c: [u8; 3], size: f64) {
+        let asc = ascent(size);
+        for_each_coverage(s, size, |px, py, a| {
+            // Unturned (u, v) = (px, asc + py) → turned (v, −u).
+            let (u, v) = (px as f64, asc + py as f64);
+            self.blend((x + v).floor() as i64, (y - u).floor() as i64, c, a)
+        });
+    }
+
+    /// Mix `c` into pixel (x, y) with weight `a` in [0, 1].
+    pub fn blend(&mut self, x: i64, y: i64, c: [u8; 3], a: f32) {
+        if let Some(i) = self.index(x, y) {
+            let a = a.clamp(0.0, 1.0);
+            for (p, v) in self.px[i..i + 3].iter_mut().zip(c) {
+                *p = (*p as f32 * (1.0 - a) + v as f32 * a).round() as u8;
             }
+        }
+    }
+
+    /// Straight line from `a` to `b`, one pixel wide.
+    pub fn line(&mut self, a: (f64, f64), b: (f64, f64), c: [u8; 3]) {
+        let n = (b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            self.set(
+                (a.0 + t * (b.0 - a.0)).round() as i64,
+                (a.1 + t * (b.1 - a.1)).round() as i64,
+                c,
+            );
         }
     }
 
@@ -178,69 +305,5 @@ impl Canvas {
             }
         }
         Ok(Canvas { w, h, px })
-    }
-}
-
-/// 5×7 glyph rows, bit 4 = leftmost column.
-pub(crate) fn glyph(c: char) -> [u8; 7] {
-    match c.to_ascii_uppercase() {
-        '0' => [0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E],
-        '1' => [0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        '2' => [0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F],
-        '3' => [0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E],
-        '4' => [0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02],
-        '5' => [0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E],
-        '6' => [0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E],
-        '7' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08],
-        '8' => [0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E],
-        '9' => [0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C],
-        'A' => [0x0E, 0x11, 0x11, 0x11, 0x1F, 0x11, 0x11],
-        'B' => [0x1E, 0x11, 0x11, 0x1E, 0x11, 0x11, 0x1E],
-        'C' => [0x0E, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0E],
-        'D' => [0x1C, 0x12, 0x11, 0x11, 0x11, 0x12, 0x1C],
-        'E' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x1F],
-        'F' => [0x1F, 0x10, 0x10, 0x1E, 0x10, 0x10, 0x10],
-        'G' => [0x0E, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0F],
-        'H' => [0x11, 0x11, 0x11, 0x1F, 0x11, 0x11, 0x11],
-        'I' => [0x0E, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0E],
-        'J' => [0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0C],
-        'K' => [0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11],
-        'L' => [0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1F],
-        'M' => [0x11, 0x1B, 0x15, 0x15, 0x11, 0x11, 0x11],
-        'N' => [0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11],
-        'O' => [0x0E, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'P' => [0x1E, 0x11, 0x11, 0x1E, 0x10, 0x10, 0x10],
-        'Q' => [0x0E, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0D],
-        'R' => [0x1E, 0x11, 0x11, 0x1E, 0x14, 0x12, 0x11],
-        'S' => [0x0F, 0x10, 0x10, 0x0E, 0x01, 0x01, 0x1E],
-        'T' => [0x1F, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04],
-        'U' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0E],
-        'V' => [0x11, 0x11, 0x11, 0x11, 0x11, 0x0A, 0x04],
-        'W' => [0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0A],
-        'X' => [0x11, 0x11, 0x0A, 0x04, 0x0A, 0x11, 0x11],
-        'Y' => [0x11, 0x11, 0x11, 0x0A, 0x04, 0x04, 0x04],
-        'Z' => [0x1F, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1F],
-        ' ' => [0; 7],
-        '.' => [0, 0, 0, 0, 0, 0x0C, 0x0C],
-        ',' => [0, 0, 0, 0, 0x0C, 0x04, 0x08],
-        '-' => [0, 0, 0, 0x1F, 0, 0, 0],
-        '+' => [0, 0x04, 0x04, 0x1F, 0x04, 0x04, 0],
-        '=' => [0, 0, 0x1F, 0, 0x1F, 0, 0],
-        ':' => [0, 0x0C, 0x0C, 0, 0x0C, 0x0C, 0],
-        ';' => [0, 0x0C, 0x0C, 0, 0x0C, 0x04, 0x08],
-        '/' => [0, 0x01, 0x02, 0x04, 0x08, 0x10, 0],
-        '%' => [0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03],
-        '(' => [0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02],
-        ')' => [0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08],
-        '[' => [0x0E, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0E],
-        ']' => [0x0E, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0E],
-        '<' => [0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02],
-        '>' => [0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08],
-        '_' => [0, 0, 0, 0, 0, 0, 0x1F],
-        '\'' => [0x0C, 0x04, 0x08, 0, 0, 0, 0],
-        '°' => [0x0C, 0x12, 0x12, 0x0C, 0, 0, 0],
-        '→' => [0, 0x04, 0x02, 0x1F, 0x02, 0x04, 0],
-        '↓' => [0x04, 0x04, 0x04, 0x04, 0x15, 0x0E, 0x04],
-        _ => [0x0E, 0x11, 0x01, 0x02, 0x04, 0, 0x04], // '?'
     }
 }

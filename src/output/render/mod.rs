@@ -2,28 +2,30 @@
 //!
 //! [`diffuse_brdf_png`] draws the diffuse reflection of every solve as an
 //! 8-bit RGB PNG: a grid of panels, one row per distinct direction of
-//! incidence (sorted by polar, then azimuth angle), one column per distinct
-//! wavelength (ascending). Several entries with the same wavelength and
-//! incidence (e.g. realisations) share a panel.
+//! incidence θᵢ (sorted by polar, then azimuth angle), one column per distinct
+//! wavelength λ (ascending), a colour bar on the right and a legend
+//! underneath, wrapped to the width of the grid. Several entries with the same
+//! wavelength and incidence (e.g. realisations) share a panel.
 //!
 //! A panel is the disk of reflected directions in the projected plane
 //! `(sx, sy) = (sin θ cos φ, sin θ sin φ)`, `sx` to the right, `sy` up, radius
 //! [`DISK_RADIUS_PX`] (faint rings mark θ = 30° and 60°). Each reflected order
 //! except (0,0) is a small Gaussian dot (σ = [`DOT_SIGMA_PX`]) whose brightness
-//! encodes the order's BRDF estimate `R_mn / Ω_cell`, where `Ω_cell` is the
-//! projected solid angle `Δsx·Δsy` owned by one order. Orders lie on a regular
-//! lattice in `(sx, sy)` (`sx = sx_inc + m λ/Lx`, likewise `sy`), so
+//! encodes the order's BRDF estimate `R_mn / Ω_cell` (sr⁻¹), where `Ω_cell` is
+//! the projected solid angle `Δsx·Δsy` owned by one order. Orders lie on a
+//! regular lattice in `(sx, sy)` (`sx = sx_inc + m λ/Lx`, likewise `sy`), so
 //! `Δsx, Δsy` come from a least-squares fit of the order positions against
 //! `m` and `n`; if one axis cannot be fitted (a single value of `m` or `n`)
 //! the other spacing is used for both, and if neither can, `Ω_cell = π / K`
 //! for `K` listed orders (they tile the unit disk). Brightness is
-//! `0.2 + 0.8 t` with `t` the position of `log10(R/Ω)` between `lo` and `hi`,
-//! shared by all panels: `hi` is the largest value drawn and
+//! `0.2 + 0.8 t` with `t` the position of `log10(R/Ω)` between `lo` and `hi`
+//! ([`brdf_range`]), shared by all panels: `hi` is the largest value drawn and
 //! `lo = max(smallest positive value, hi / 10^LOG_DECADES)`; values below `lo`
-//! are not drawn. Overlapping dots combine by maximum, so a pixel at an order's
-//! centre shows exactly that order's brightness. The specular direction (the
-//! (0,0) order, or the incidence direction when it is not listed) is marked by
-//! a small grey cross. The legend states the scale.
+//! are not drawn. The colour bar shows the same ramp in white from `lo`
+//! (bottom) to `hi` (top), with ticks at whole decades. Overlapping dots
+//! combine by maximum, so a pixel at an order's centre shows exactly that
+//! order's brightness. The specular direction (the (0,0) order, or the
+//! incidence direction when it is not listed) is marked by a small grey cross.
 //!
 //! Colour: each column is tinted by an approximate colour of its wavelength,
 //! the piecewise-linear map of Dan Bruton ("Color Science", 1996):
@@ -32,9 +34,9 @@
 //! intensity fall-off at the ends, mixed with 20 % white so every hue stays
 //! visible on black; wavelengths outside 380–780 nm are light grey.
 //!
-//! Labels use a built-in 5×7 bitmap font (upper-case letters, digits and
-//! common punctuation; lower case is drawn as upper case, other characters as
-//! `?`), drawn at twice its size.
+//! [`geometry_png`] draws a layer's raster (top view and an x–z section, with
+//! axes in nm or µm, a scale bar and the section's position); [`tile::tile_png`]
+//! the colour tile. Text is set by [`canvas`] in an embedded TrueType font.
 
 use std::cmp::Ordering;
 
@@ -43,9 +45,7 @@ use crate::optics::farfield::{Order, SolveEntry};
 
 pub mod canvas;
 pub mod tile;
-#[cfg(test)]
-use canvas::glyph;
-pub use canvas::{text_width, Canvas, FONT_SCALE, GLYPH_ADVANCE, GLYPH_HEIGHT};
+pub use canvas::{text_width, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
 
 /// Radius of a panel's disk of directions, in pixels.
 pub const DISK_RADIUS_PX: f64 = 60.0;
@@ -56,14 +56,17 @@ pub const LOG_DECADES: f64 = 4.0;
 
 /// Side of the square cell that holds one panel.
 const CELL_PX: usize = 140;
-/// Font scale (5×7 glyphs drawn as 10×14 pixels, advance 12).
 const MARGIN: usize = 12;
+/// Width of the colour bar, and the room right of it for its ticks.
+const BAR_W: usize = 16;
+const BAR_LABELS_W: usize = 64;
 /// Largest image produced (pixels), to refuse absurd grids instead of
 /// allocating gigabytes.
 const MAX_PIXELS: usize = 100_000_000;
 
 const BACKGROUND: [u8; 3] = [40, 40, 40];
 const TEXT: [u8; 3] = [230, 230, 230];
+const DIM_TEXT: [u8; 3] = [190, 190, 190];
 const DISK_EDGE: [u8; 3] = [110, 110, 110];
 const GUIDE: [u8; 3] = [45, 45, 45];
 const CROSS: [u8; 3] = [150, 150, 150];
@@ -100,6 +103,12 @@ pub struct PanelLayout {
     pub wavelengths_nm: Vec<f64>,
     /// Row values, sorted by polar then azimuth angle.
     pub incidences: Vec<Incidence>,
+    /// The colour bar: left, top, width, height (pixels); its top row shows
+    /// the largest BRDF drawn, its bottom row the smallest.
+    pub bar: (usize, usize, usize, usize),
+    /// Top of the legend, which is wrapped into these lines.
+    pub legend_top: usize,
+    pub legend: Vec<String>,
     left: usize,
     top: usize,
 }
@@ -120,23 +129,29 @@ impl PanelLayout {
 
         let left = incidences
             .iter()
-            .map(|i| text_width(&row_label(i)))
+            .flat_map(row_label)
+            .map(|l| text_width(&l))
             .max()
             .unwrap_or(0)
             + 2 * MARGIN;
-        let top = MARGIN + GLYPH_HEIGHT + MARGIN + GLYPH_HEIGHT + 6;
-        // Widest legend: the scale line with the longest numbers it can show.
-        let legend = legend_lines(None)
-            .into_iter()
-            .chain(legend_lines(Some((-999.0, -999.0))));
-        let grid_w = left + wavelengths.len() * CELL_PX + MARGIN;
-        let text_w = std::iter::once(title.to_string())
-            .chain(legend)
-            .map(|l| text_width(&l) + 2 * MARGIN)
-            .max()
-            .unwrap_or(0);
-        let width = grid_w.max(text_w);
-        let height = top + incidences.len() * CELL_PX + 3 * (GLYPH_HEIGHT + 6) + MARGIN;
+        let top = MARGIN + TITLE_HEIGHT + MARGIN + GLYPH_HEIGHT + 8;
+        let grid_h = incidences.len() * CELL_PX;
+        let bar_x = left + wavelengths.len() * CELL_PX + MARGIN;
+        let width = (bar_x + BAR_W + BAR_LABELS_W + MARGIN)
+            .max(canvas::text_width_px(title, TITLE_HEIGHT as f64).ceil() as usize + 2 * MARGIN);
+        // The bar's unit is written above it, its decades beside it.
+        let bar = (
+            bar_x,
+            top + GLYPH_HEIGHT + 4,
+            BAR_W,
+            grid_h - GLYPH_HEIGHT - 14,
+        );
+        let legend = legend_text()
+            .iter()
+            .flat_map(|p| canvas::wrap(p, width - 2 * MARGIN))
+            .collect::<Vec<_>>();
+        let legend_top = top + grid_h + 6;
+        let height = legend_top + legend.len() * (GLYPH_HEIGHT + 4) + MARGIN;
         if width.saturating_mul(height) > MAX_PIXELS {
             return Err(RenderError::TooLarge { width, height });
         }
@@ -145,6 +160,9 @@ impl PanelLayout {
             height,
             wavelengths_nm: wavelengths,
             incidences,
+            bar,
+            legend_top,
+            legend,
             left,
             top,
         })
@@ -206,18 +224,10 @@ fn diffuse_values(e: &SolveEntry) -> impl Iterator<Item = (&Order, f64)> {
         .map(move |o| (o, o.reflectance / cell))
 }
 
-/// Render the diffuse reflection of `entries` as an 8-bit RGB PNG.
-pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, RenderError> {
-    let layout = PanelLayout::new(entries, title)?;
-    let (w, h) = (layout.width, layout.height);
-    let mut img = Canvas {
-        w,
-        h,
-        px: vec![0u8; w * h * 3],
-    };
-    img.fill(BACKGROUND);
-
-    // Shared log scale.
+/// `(log10 lo, log10 hi)` of the BRDF (sr⁻¹) the orders picture shows, shared
+/// by all panels and spanned by its colour bar (module docs); `None` when no
+/// diffuse order has R > 0.
+pub fn brdf_range(entries: &[SolveEntry]) -> Option<(f64, f64)> {
     let mut hi = f64::NEG_INFINITY;
     let mut min_pos = f64::INFINITY;
     for e in entries {
@@ -226,29 +236,62 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
             min_pos = min_pos.min(v);
         }
     }
-    let scale = (hi > 0.0 && hi.is_finite()).then(|| {
+    (hi > 0.0 && hi.is_finite()).then(|| {
         let lo = min_pos.max(hi / 10f64.powf(LOG_DECADES));
         (lo.log10(), hi.log10())
-    });
+    })
+}
+
+/// Dot brightness (0.2 … 1) of log10 BRDF `lv` on the scale `(lo, hi)`.
+fn brightness(lv: f64, (lo, hi): (f64, f64)) -> f64 {
+    let t = if hi > lo { (lv - lo) / (hi - lo) } else { 1.0 };
+    0.2 + 0.8 * t.clamp(0.0, 1.0)
+}
+
+/// Render the diffuse reflection of `entries` as an 8-bit RGB PNG.
+pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, RenderError> {
+    let layout = PanelLayout::new(entries, title)?;
+    let mut img = Canvas::new(layout.width, layout.height, BACKGROUND);
+    let scale = brdf_range(entries);
 
     // Text.
-    img.text(MARGIN, MARGIN, title, TEXT);
-    let header_y = MARGIN + GLYPH_HEIGHT + MARGIN;
+    img.text_px(
+        MARGIN as f64,
+        MARGIN as f64,
+        title,
+        TEXT,
+        TITLE_HEIGHT as f64,
+    );
+    let header_y = (MARGIN + TITLE_HEIGHT + MARGIN) as f64;
     for (col, &wl) in layout.wavelengths_nm.iter().enumerate() {
-        let label = format!("{} NM", fmt_num(wl));
         let (cx, _) = layout.center(0, col);
-        let x = (cx as usize).saturating_sub(text_width(&label) / 2);
-        img.text(x, header_y, &label, TEXT);
+        let label = format!("λ = {} nm", fmt_num(wl));
+        img.text_centered(cx, header_y, &label, TEXT, GLYPH_HEIGHT as f64);
     }
     for (row, inc) in layout.incidences.iter().enumerate() {
         let (_, cy) = layout.center(row, 0);
-        let y = (cy as usize).saturating_sub(GLYPH_HEIGHT / 2);
-        img.text(MARGIN, y, &row_label(inc), TEXT);
+        let lines = row_label(inc);
+        let y0 = cy - (lines.len() * GLYPH_HEIGHT) as f64 / 2.0;
+        for (k, l) in lines.iter().enumerate() {
+            let x = layout.left - MARGIN - text_width(l);
+            img.text_px(
+                x as f64,
+                y0 + (k * GLYPH_HEIGHT) as f64,
+                l,
+                TEXT,
+                GLYPH_HEIGHT as f64,
+            );
+        }
     }
-    let legend_y = layout.top + layout.incidences.len() * CELL_PX + 6;
-    for (k, line) in legend_lines(scale).iter().enumerate() {
-        img.text(MARGIN, legend_y + k * (GLYPH_HEIGHT + 6), line, TEXT);
+    for (k, line) in layout.legend.iter().enumerate() {
+        img.text(
+            MARGIN,
+            layout.legend_top + k * (GLYPH_HEIGHT + 4),
+            line,
+            DIM_TEXT,
+        );
     }
+    colour_bar(&mut img, &layout, scale);
 
     // Empty disks with guides.
     for row in 0..layout.incidences.len() {
@@ -284,8 +327,7 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
                 if lv < lo {
                     continue;
                 }
-                let t = if hi > lo { (lv - lo) / (hi - lo) } else { 1.0 };
-                let b = 0.2 + 0.8 * t.clamp(0.0, 1.0);
+                let b = brightness(lv, (lo, hi));
                 let (sx, sy) = order_direction(o);
                 let (x, y) = layout.direction_px(row, col, sx, sy);
                 splat(&mut img, x, y, tint, b);
@@ -308,10 +350,104 @@ pub fn diffuse_brdf_png(entries: &[SolveEntry], title: &str) -> Result<Vec<u8>, 
     img.encode_png(title)
 }
 
+/// The colour bar of the orders picture: the brightness ramp of the dots in
+/// white, `hi` at the top, `lo` at the bottom, a tick and a label at every
+/// whole decade in between (and at the ends when they are far from one).
+fn colour_bar(img: &mut Canvas, layout: &PanelLayout, scale: Option<(f64, f64)>) {
+    let (x, y, w, h) = layout.bar;
+    let small = SMALL_HEIGHT as f64;
+    img.text_px(
+        x as f64 - 4.0,
+        (y - GLYPH_HEIGHT - 4) as f64,
+        "BRDF (sr⁻¹)",
+        TEXT,
+        GLYPH_HEIGHT as f64,
+    );
+    let Some((lo, hi)) = scale else {
+        img.text_up(
+            (x + 1) as f64,
+            (y + h) as f64,
+            "no diffuse order",
+            DIM_TEXT,
+            small,
+        );
+        return;
+    };
+    for row in 0..h {
+        // Top row = hi, bottom row = lo.
+        let t = if h > 1 {
+            1.0 - row as f64 / (h - 1) as f64
+        } else {
+            1.0
+        };
+        let b = brightness(lo + t * (hi - lo), (lo, hi));
+        let c = to_rgb8([1.0; 3], b);
+        img.rect(x as i64, (y + row) as i64, w, 1, c);
+    }
+    let y_of = |lv: f64| {
+        let t = if hi > lo { (lv - lo) / (hi - lo) } else { 1.0 };
+        y as f64 + (1.0 - t) * (h - 1) as f64
+    };
+    let mut ticks: Vec<(f64, String)> = (lo.ceil() as i64..=hi.floor() as i64)
+        .map(|d| (d as f64, decade_label(d)))
+        .collect();
+    // Label the ends too when no decade is close to them.
+    let spacing = small + 2.0;
+    for end in [hi, lo] {
+        if ticks
+            .iter()
+            .all(|(v, _)| (y_of(*v) - y_of(end)).abs() > spacing)
+        {
+            ticks.push((end, mantissa_label(end)));
+        }
+    }
+    for (lv, label) in ticks {
+        let ty = y_of(lv);
+        img.rect((x + w) as i64, ty.round() as i64, 4, 1, TEXT);
+        img.text_px((x + w + 6) as f64, ty - small / 2.0, &label, TEXT, small);
+    }
+}
+
+/// `10ⁿ` with a superscript exponent.
+fn decade_label(d: i64) -> String {
+    format!("10{}", superscript(&d.to_string()))
+}
+
+/// A value given by its log10, as `a.b×10ⁿ`.
+fn mantissa_label(lv: f64) -> String {
+    let d = lv.floor();
+    let m = 10f64.powf(lv - d);
+    if (m - 10.0).abs() < 0.05 {
+        return decade_label(d as i64 + 1);
+    }
+    format!("{:.1}×10{}", m, superscript(&(d as i64).to_string()))
+}
+
+/// Digits and minus sign as Unicode superscripts.
+pub fn superscript(s: &str) -> String {
+    s.chars()
+        .map(|c| match c {
+            '0' => '⁰',
+            '1' => '¹',
+            '2' => '²',
+            '3' => '³',
+            '4' => '⁴',
+            '5' => '⁵',
+            '6' => '⁶',
+            '7' => '⁷',
+            '8' => '⁸',
+            '9' => '⁹',
+            '-' => '⁻',
+            other => other,
+        })
+        .collect()
+}
+
 /// A picture of a layer so a person can see it: the top view (pigment
 /// fraction averaged over the thickness) and the x–z cross-section through
 /// the middle of the fragment (pigment fraction; z down), both on the raster,
-/// with `lines` of statistics underneath. Bright = pigment, dark = binder.
+/// with axes in nm or µm, a scale bar, the section's line marked on the top
+/// view and `lines` of statistics underneath. Bright = pigment, dark = binder.
 pub fn geometry_png(
     raster: &crate::raster::Raster,
     title: &str,
@@ -319,7 +455,7 @@ pub fn geometry_png(
 ) -> Result<Vec<u8>, RenderError> {
     let g = raster.grid;
     let (nx, ny, nz) = (g.nx, g.ny, g.nz);
-    let [dx, _, dz] = g.cell_nm();
+    let [dx, dy, dz] = g.cell_nm();
     let total = |iz: usize, iy: usize, ix: usize| -> f64 {
         raster
             .fractions
@@ -329,70 +465,228 @@ pub fn geometry_png(
             .min(1.0)
     };
     let scale = (320 / nx.max(ny)).max(1);
+    let yscale = ((scale as f64 * dy / dx).round() as usize).max(1);
     let zscale = ((scale as f64 * dz / dx).round() as usize).max(1);
     let margin = 20;
-    let label_h = 7 * FONT_SCALE + 8;
+    let line = GLYPH_HEIGHT + 6;
+    let axis_h = 6 + SMALL_HEIGHT + 4 + GLYPH_HEIGHT + 6;
+    let y_axis_w = 2 * SMALL_HEIGHT + 48;
     let top_w = nx * scale;
     let cross_w = nx * scale;
-    let w = (margin * 3 + top_w + cross_w)
-        .max(margin * 2 + lines.iter().map(|l| text_width(l)).max().unwrap_or(0));
-    let h = margin * 2 + label_h * 2 + (ny * scale).max(nz * zscale) + label_h * lines.len();
-    if w * h > MAX_PIXELS {
+    let (top_h, cross_h) = (ny * yscale, nz * zscale);
+    let body_h = top_h.max(cross_h);
+    let iy = ny / 2;
+    let y_section = (iy as f64 + 0.5) * dy;
+    let (unit, div) = length_unit(g.size_nm[0].max(g.size_nm[1]).max(g.size_nm[2]));
+    let heading_top = "top view (pigment fraction through the thickness)".to_string();
+    let heading_cross = format!(
+        "x–z section at y = {} {unit} (dashed on the top view)",
+        fmt_num(y_section / div)
+    );
+    let heading = format!(
+        "{title} — the layer on the raster: {nx} × {ny} × {nz} cells of {} × {} × {} nm",
+        fmt_num(dx),
+        fmt_num(dy),
+        fmt_num(dz)
+    );
+    let x0 = margin + y_axis_w;
+    let x1 = x0 + top_w.max(text_width(&heading_top)) + margin + y_axis_w;
+    let w = (x1 + cross_w.max(text_width(&heading_cross)) + margin)
+        .max(margin * 2 + lines.iter().map(|l| text_width(l)).max().unwrap_or(0))
+        .max(margin * 2 + canvas::text_width_px(&heading, TITLE_HEIGHT as f64).ceil() as usize);
+    let y_head = margin + TITLE_HEIGHT + 8;
+    let y_body = y_head + line;
+    let y_text = y_body + body_h + axis_h + line + 8;
+    let h = y_text + line * lines.len() + margin;
+    if w.saturating_mul(h) > MAX_PIXELS {
         return Err(RenderError::TooLarge {
             width: w,
             height: h,
         });
     }
-    let mut img = Canvas {
-        w,
-        h,
-        px: vec![0; w * h * 3],
-    };
-    img.fill([24, 24, 28]);
+    let mut img = Canvas::new(w, h, [24, 24, 28]);
     let grey = |f: f64| {
         let v = (40.0 + 215.0 * f.clamp(0.0, 1.0)).round() as u8;
         [v, v, (v as f64 * 0.9) as u8]
     };
-    let (x0, y0) = (margin, margin + label_h);
-    img.text(x0, margin, &title.to_uppercase(), [230, 230, 230]);
-    img.text(x0, y0, "TOP VIEW", [200, 200, 200]);
+    let fg = [230, 230, 230];
+    let dim = [200, 200, 200];
+    img.text_px(
+        margin as f64,
+        margin as f64,
+        &heading,
+        fg,
+        TITLE_HEIGHT as f64,
+    );
+    img.text(x0, y_head, &heading_top, dim);
     for iy in 0..ny {
         for ix in 0..nx {
             let f = (0..nz).map(|iz| total(iz, iy, ix)).sum::<f64>() / nz as f64;
-            for py in 0..scale {
-                for px in 0..scale {
-                    // y up in the picture.
-                    img.set(
-                        (x0 + ix * scale + px) as i64,
-                        (y0 + label_h + (ny - 1 - iy) * scale + py) as i64,
-                        grey(f),
-                    );
-                }
-            }
+            // y up in the picture.
+            img.rect(
+                (x0 + ix * scale) as i64,
+                (y_body + (ny - 1 - iy) * yscale) as i64,
+                scale,
+                yscale,
+                grey(f),
+            );
         }
     }
-    let x1 = x0 + top_w + margin;
-    img.text(x1, y0, "CROSS-SECTION X-Z", [200, 200, 200]);
-    let iy = ny / 2;
+    // The section's line on the top view, dashed.
+    let ys = y_body as f64 + (ny as f64 - iy as f64 - 0.5) * yscale as f64;
+    for x in (x0..x0 + top_w).filter(|x| (x - x0) % 8 < 5) {
+        img.set(x as i64, ys.round() as i64, [230, 120, 60]);
+    }
+    img.text(x1, y_head, &heading_cross, dim);
     for iz in 0..nz {
         for ix in 0..nx {
-            let c = grey(total(iz, iy, ix));
-            for py in 0..zscale {
-                for px in 0..scale {
-                    img.set(
-                        (x1 + ix * scale + px) as i64,
-                        (y0 + label_h + iz * zscale + py) as i64,
-                        c,
-                    );
-                }
-            }
+            img.rect(
+                (x1 + ix * scale) as i64,
+                (y_body + iz * zscale) as i64,
+                scale,
+                zscale,
+                grey(total(iz, iy, ix)),
+            );
         }
     }
-    let ytext = y0 + label_h + (ny * scale).max(nz * zscale) + 8;
+    let px_per_nm = scale as f64 / dx;
+    let axes = [
+        // (origin x, origin y, along x?, length nm, px per nm, label, upwards)
+        (x0, y_body + top_h, g.size_nm[0], px_per_nm, "x", false),
+        (
+            x0,
+            y_body + top_h,
+            g.size_nm[1],
+            yscale as f64 / dy,
+            "y",
+            true,
+        ),
+        (x1, y_body + cross_h, g.size_nm[0], px_per_nm, "x", false),
+        (
+            x1,
+            y_body,
+            g.size_nm[2],
+            zscale as f64 / dz,
+            "depth z",
+            false,
+        ),
+    ];
+    for (k, &(ox, oy, len, ppn, name, up)) in axes.iter().enumerate() {
+        let vertical = k % 2 == 1;
+        axis(
+            &mut img,
+            (ox, oy),
+            vertical,
+            up,
+            (len, ppn),
+            (unit, div),
+            name,
+        );
+    }
+    // Scale bar under the section's x axis.
+    let bar_nm = nice_step(g.size_nm[0] / 4.0);
+    let bar_px = (bar_nm * px_per_nm).round() as usize;
+    let by = y_body + cross_h + axis_h + 8;
+    img.rect(x1 as i64, by as i64, bar_px, 4, fg);
+    img.text(
+        x1 + bar_px + 8,
+        by + 2 - GLYPH_HEIGHT / 2,
+        &format!("{} {unit}", fmt_num(bar_nm / div)),
+        fg,
+    );
     for (k, l) in lines.iter().enumerate() {
-        img.text(x0, ytext + k * label_h, &l.to_uppercase(), [210, 210, 210]);
+        img.text(margin, y_text + k * line, l, [210, 210, 210]);
     }
     img.encode_png(title)
+}
+
+/// Unit for lengths up to `max_nm`: (name, nm per unit).
+fn length_unit(max_nm: f64) -> (&'static str, f64) {
+    if max_nm >= 2000.0 {
+        ("µm", 1000.0)
+    } else {
+        ("nm", 1.0)
+    }
+}
+
+/// The largest of 1, 2, 5 × 10ⁿ not above `x` (x > 0).
+fn nice_step(x: f64) -> f64 {
+    let d = 10f64.powf(x.log10().floor());
+    [5.0, 2.0, 1.0]
+        .into_iter()
+        .map(|m| m * d)
+        .find(|&s| s <= x)
+        .unwrap_or(d)
+}
+
+/// Ticks and a title along one edge of a view. Horizontal axes run right
+/// from `origin` below the view; vertical ones run along its left edge, up
+/// from `origin` when `up` (y) or down (z).
+fn axis(
+    img: &mut Canvas,
+    origin: (usize, usize),
+    vertical: bool,
+    up: bool,
+    (len_nm, px_per_nm): (f64, f64),
+    (unit, div): (&str, f64),
+    name: &str,
+) {
+    let fg = [200, 200, 200];
+    let small = SMALL_HEIGHT as f64;
+    let step = nice_step(len_nm / 3.0);
+    let (ox, oy) = (origin.0 as f64, origin.1 as f64);
+    let n = (len_nm / step).floor() as usize;
+    let length_px = len_nm * px_per_nm;
+    if vertical {
+        img.line(
+            (ox - 2.0, oy),
+            (ox - 2.0, oy + if up { -length_px } else { length_px }),
+            fg,
+        );
+    } else {
+        img.line((ox, oy + 2.0), (ox + length_px, oy + 2.0), fg);
+    }
+    let mut max_label = 0.0f64;
+    for k in 0..=n {
+        let v = k as f64 * step;
+        let p = v * px_per_nm;
+        let label = fmt_num(v / div);
+        if vertical {
+            let y = if up { oy - p } else { oy + p };
+            img.line((ox - 6.0, y), (ox - 2.0, y), fg);
+            let tw = canvas::text_width_px(&label, small);
+            max_label = max_label.max(tw);
+            img.text_px(ox - 9.0 - tw, y - small / 2.0, &label, fg, small);
+        } else {
+            img.line((ox + p, oy + 2.0), (ox + p, oy + 6.0), fg);
+            img.text_centered(ox + p, oy + 7.0, &label, fg, small);
+        }
+    }
+    let title = format!("{name} ({unit})");
+    if vertical {
+        let mid = oy
+            + if up {
+                -length_px / 2.0
+            } else {
+                length_px / 2.0
+            };
+        let tw = canvas::text_width_px(&title, GLYPH_HEIGHT as f64);
+        img.text_up(
+            ox - 14.0 - max_label - GLYPH_HEIGHT as f64,
+            mid + tw / 2.0,
+            &title,
+            fg,
+            GLYPH_HEIGHT as f64,
+        );
+    } else {
+        img.text_centered(
+            ox + length_px / 2.0,
+            oy + 8.0 + small,
+            &title,
+            fg,
+            GLYPH_HEIGHT as f64,
+        );
+    }
 }
 
 fn check_entries(entries: &[SolveEntry]) -> Result<(), RenderError> {
@@ -518,27 +812,23 @@ pub(crate) fn fmt_num(x: f64) -> String {
     }
 }
 
-fn row_label(i: &Incidence) -> String {
+fn row_label(i: &Incidence) -> Vec<String> {
+    let polar = format!("θᵢ = {}°", fmt_num(i.polar_deg));
     if i.azimuth_deg == 0.0 {
-        format!("{}°", fmt_num(i.polar_deg))
+        vec![polar]
     } else {
-        format!("{}° AZ {}°", fmt_num(i.polar_deg), fmt_num(i.azimuth_deg))
+        vec![polar, format!("φᵢ = {}°", fmt_num(i.azimuth_deg))]
     }
 }
 
-/// Legend text; `scale` is (log10 lo, log10 hi) of the BRDF shown.
-fn legend_lines(scale: Option<(f64, f64)>) -> Vec<String> {
-    let first = match scale {
-        Some((lo, hi)) => format!(
-            "DOT BRIGHTNESS: LOG10 BRDF (R/CELL, 1/SR) FROM {:.2} (DIM) TO {:.2} (FULL)",
-            lo, hi
-        ),
-        None => "NO DIFFUSE ORDERS WITH R > 0 TO DRAW".into(),
-    };
-    vec![
-        first,
-        "ROWS: INCIDENCE POLAR ANGLE; COLUMNS: WAVELENGTH".into(),
-        "DISK: REFLECTED DIRECTIONS (SX RIGHT, SY UP); RINGS 30° 60°; + SPECULAR (0,0)".into(),
+/// Legend paragraphs (wrapped to the picture's width when drawn).
+fn legend_text() -> [&'static str; 3] {
+    [
+        "Rows: angle of incidence θᵢ from above; columns: wavelength λ, tinted by its approximate colour.",
+        "Each disk: the directions of reflection seen from above, sx = sin θ cos φ to the right, \
+         sy = sin θ sin φ up; rings at θ = 30° and 60°; + the specular direction (order (0,0), not drawn).",
+        "Each dot: one diffracted order, its brightness the BRDF R/Ω (sr⁻¹) on the log scale of the bar, \
+         shared by all panels; orders below its lowest value are not drawn.",
     ]
 }
 
@@ -586,12 +876,19 @@ mod tests {
     }
 
     #[test]
-    fn every_legend_character_has_a_glyph() {
-        let unknown = glyph('\u{1}');
-        for line in legend_lines(Some((-1.0, 2.0))) {
-            for ch in line.chars() {
-                assert!(ch == '?' || glyph(ch) != unknown, "missing glyph {ch:?}");
-            }
+    fn every_label_character_has_a_glyph() {
+        let mut text: String = legend_text().concat();
+        text.push_str("BRDF (sr⁻¹) λ = 450 nm θᵢ = 30° φᵢ x (µm) z (down) ×10⁻¹²³⁴⁵⁶⁷⁸⁹⁰");
+        for ch in text.chars() {
+            assert!(canvas::has_glyph(ch), "missing glyph {ch:?}");
         }
+    }
+
+    #[test]
+    fn labels_are_compact() {
+        assert_eq!(decade_label(-3), "10⁻³");
+        assert_eq!(mantissa_label(2.0f64.log10() - 2.0), "2.0×10⁻²");
+        assert_eq!(nice_step(2600.0), 2000.0);
+        assert_eq!(nice_step(0.7), 0.5);
     }
 }

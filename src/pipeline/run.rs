@@ -115,8 +115,8 @@ fn assemble_products(
     let orders_png = render::diffuse_brdf_png(&above, &scene.output.name)?;
     let products = scene.appearance.products;
     let wants_appearance = products.brdf || products.btdf || products.tile || products.merl;
+    let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
     let appearance = if wants_appearance {
-        let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
         Some(appearance::assemble(
             &appearance_spec(scene, plan),
             entries,
@@ -137,7 +137,7 @@ fn assemble_products(
             &a.spec.illumination_deg,
             &render::tile::TileCaption {
                 name: &scene.output.name,
-                observer: &Observer::cie1931_d65(),
+                observer: &obs,
                 paper_albedo: a.spec.paper_albedo,
                 azimuth_deg: a.spec.azimuth_deg,
             },

@@ -717,4 +717,15 @@ fn measurement_geometries_run_by_default_and_reach_the_result_file() {
         assert!(g.link_exists(&format!("measured/{slug}/de00_se")));
     }
     assert!(g.link_exists("tile_lab_se") && g.link_exists("tile_de00_se"));
+    // Read back as the study grids do: the same colours and errors.
+    let (records, ill, deg) = inksim::output::h5::read_measured(&rep.result_path)
+        .unwrap()
+        .unwrap();
+    assert_eq!((ill.as_str(), deg), ("D50", 2));
+    for m in &a.measured {
+        let r = records.iter().find(|r| r.geometry == m.geometry.name()).unwrap();
+        assert_eq!(r.lab, m.lab);
+        assert_eq!(r.lab_se, m.lab_se);
+        assert_eq!(r.de00_se, m.de00_se);
+    }
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use ndarray::Array2;
 
-use super::attrs::{write_scalar_attr, write_str_attr};
+use super::attrs::{read_str_attr, write_scalar_attr, write_str_attr};
 use super::IoError;
 use crate::optics::appearance::{Appearance, Estimate, MeasuredColour};
 
@@ -254,4 +254,63 @@ fn described<D: ndarray::Dimension>(
     let d = g.new_dataset_builder().with_data(data).create(name)?;
     write_str_attr(&d, "units", units)?;
     write_str_attr(&d, "description", description)
+}
+
+/// One measurement geometry's colour as read back from a result file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredRecord {
+    /// The geometry's name (`45/0`, `d/8 SCI`, `d/8 SCE`).
+    pub geometry: String,
+    pub lab: [f64; 3],
+    /// Standard errors of L*, a*, b* and of ΔE00 (two or more realisations).
+    pub lab_se: Option<[f64; 3]>,
+    pub de00_se: Option<f64>,
+}
+
+/// The measured colours of a result file (`/appearance/measured`) and the
+/// illuminant and observer (degrees) they were computed for; `None` when the
+/// file has none.
+pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String, u32)>, IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    if !file.link_exists("appearance/measured") {
+        return Ok(None);
+    }
+    let g = file.group("appearance").map_err(hdf)?;
+    let illuminant = read_str_attr(&g, "illuminant").map_err(hdf)?;
+    let observer: u32 = g
+        .attr("observer_deg")
+        .and_then(|a| a.read_scalar())
+        .map_err(hdf)?;
+    let three = |d: &hdf5::Group, name: &str| -> Result<Option<[f64; 3]>, IoError> {
+        if !d.link_exists(name) {
+            return Ok(None);
+        }
+        let v: Vec<f64> = d.dataset(name).and_then(|x| x.read_raw()).map_err(hdf)?;
+        Ok(Some([v[0], v[1], v[2]]))
+    };
+    let mg = g.group("measured").map_err(hdf)?;
+    let mut out = Vec::new();
+    for name in mg.member_names().map_err(hdf)? {
+        let d = mg.group(&name).map_err(hdf)?;
+        let de00_se = if d.link_exists("de00_se") {
+            let v: Vec<f64> = d
+                .dataset("de00_se")
+                .and_then(|x| x.read_raw())
+                .map_err(hdf)?;
+            v.first().copied()
+        } else {
+            None
+        };
+        out.push(MeasuredRecord {
+            geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
+            lab: three(&d, "lab")?.unwrap_or([f64::NAN; 3]),
+            lab_se: three(&d, "lab_se")?,
+            de00_se,
+        });
+    }
+    Ok(Some((out, illuminant, observer)))
 }

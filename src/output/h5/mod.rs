@@ -91,7 +91,7 @@ mod result;
 mod summary;
 
 pub use crate::output::error::IoError;
-pub use appearance::{read_appearance, AppearanceArrays};
+pub use appearance::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
 pub use result::{write_result, GeometrySummary, ResultSet};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 

@@ -1,8 +1,11 @@
 //! The comparison grids: for one grid declaration, one picture per
 //! combination of the labels of the axes that are neither rows, columns nor
-//! fixed by `where`, each cell the variant's tile shrunk to at most
-//! [`CELL_PX`] pixels.
+//! fixed by `where`, each cell the variant's 45°/0° colour as a patch with
+//! its L*, C*ab, h° and standard errors (the variant's tile shrunk to at most
+//! [`CELL_PX`] pixels where the result has no measured colour).
 
+use crate::config::{Illuminant, StandardObserver};
+use crate::optics::colour::{gamut, lab_to_lch, Observer};
 use crate::output::h5;
 use crate::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
 use crate::study::run;
@@ -80,15 +83,18 @@ pub(super) fn draw_grid(
             let mut line = vec![];
             for c in &cols {
                 line.push(match cell(r, c) {
-                    Some(v) => {
-                        let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
-                            StudyError::Io(h5::IoError::File {
-                                path: run::paths(v).1,
-                                source,
-                            })
-                        })?;
-                        Some(shrink(&Canvas::decode_png(&bytes)?, CELL_PX))
-                    }
+                    Some(v) => Some(match colour_card(v)? {
+                        Some(card) => card,
+                        None => {
+                            let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
+                                StudyError::Io(h5::IoError::File {
+                                    path: run::paths(v).1,
+                                    source,
+                                })
+                            })?;
+                            shrink(&Canvas::decode_png(&bytes)?, CELL_PX)
+                        }
+                    }),
                     None => None,
                 });
             }
@@ -112,11 +118,80 @@ pub(super) fn draw_grid(
                 format!(" ({})", fixed.join(", "))
             }
         );
-        let subtitle = format!("rows: {}, columns: {}", g.rows, g.cols);
+        let subtitle = format!(
+            "rows: {}, columns: {}; cells: {CARD_GEOMETRY} colour ± s.e.; \
+             corner mark: outside sRGB (C*ab reduced for display)",
+            g.rows, g.cols
+        );
         let canvas = compose(&title, &subtitle, &rows, &cols, &tiles);
         out.push((format!("{}{suffix}.png", g.name), title, canvas));
     }
     Ok(out)
+}
+
+/// The measurement geometry a grid cell shows.
+const CARD_GEOMETRY: &str = "45/0";
+const CARD_W: usize = 190;
+const PATCH_H: usize = 80;
+
+/// A grid cell for a variant: a patch of its 45°/0° colour (gamut-mapped for
+/// display, marked when moved) above its L*, C*ab, h° and standard errors;
+/// `None` when the result has no measured colours (then its tile is shown).
+fn colour_card(v: &Variant) -> Result<Option<Canvas>, StudyError> {
+    let Some((records, illuminant, observer_deg)) = h5::read_measured(&run::paths(v).0)? else {
+        return Ok(None);
+    };
+    let Some(m) = records
+        .iter()
+        .find(|m| m.geometry == CARD_GEOMETRY)
+        .or(records.first())
+    else {
+        return Ok(None);
+    };
+    let (Some(ill), Some(so)) = (
+        Illuminant::from_name(&illuminant),
+        StandardObserver::from_degrees(observer_deg),
+    ) else {
+        return Ok(None);
+    };
+    let obs = Observer::standard(ill, so);
+    let mapped = gamut::map_lab(&obs, m.lab);
+    let lines = card_lines(m, ill, so);
+    let h = PATCH_H + PAD / 2 + lines.len() * (GLYPH_HEIGHT + 3);
+    let mut c = Canvas::new(CARD_W, h, BG);
+    c.rect(0, 0, CARD_W, PATCH_H, EMPTY);
+    c.rect(1, 1, CARD_W - 2, PATCH_H - 2, mapped.srgb8);
+    if mapped.moved {
+        // A black corner triangle, as on the tiles.
+        for y in 0..14usize {
+            c.rect((CARD_W - 14 + y) as i64, y as i64, 14 - y, 1, INK);
+        }
+    }
+    for (k, line) in lines.iter().enumerate() {
+        c.text(2, PATCH_H + PAD / 2 + k * (GLYPH_HEIGHT + 3), line, INK);
+    }
+    Ok(Some(c))
+}
+
+/// The text under a card's patch.
+fn card_lines(m: &h5::MeasuredRecord, ill: Illuminant, so: StandardObserver) -> Vec<String> {
+    let [l, c, h] = lab_to_lch(m.lab);
+    let pm = |se: Option<f64>| se.map_or(String::new(), |s| format!(" ± {s:.2}"));
+    let c_se = m.lab_se.map(|se| {
+        let (a, b) = (m.lab[1], m.lab[2]);
+        ((a * se[1]).powi(2) + (b * se[2]).powi(2)).sqrt() / c.max(1e-12)
+    });
+    let mut lines = vec![
+        format!("L* {l:.1}{}", pm(m.lab_se.map(|s| s[0]))),
+        format!("C*ab {c:.1}{}", pm(c_se)),
+        format!("h° {h:.0}"),
+    ];
+    lines.push(match m.de00_se {
+        Some(se) => format!("ΔE00 s.e. {se:.2}"),
+        None => "one realisation: no s.e.".to_string(),
+    });
+    lines.push(format!("{} · {ill}, {}°", m.geometry, so.degrees()));
+    lines
 }
 
 /// Shrink by the smallest integer factor that brings both sides to ≤ `max`

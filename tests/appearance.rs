@@ -12,6 +12,9 @@ use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use std::path::Path;
 
+mod common;
+use common::airy_rt;
+
 /// A CSV material of constant index n + 0i over 380–780 nm.
 fn constant_material(dir: &Path, name: &str, n: f64) -> String {
     let mut text = String::from("wavelength_nm,n,k\n");
@@ -86,20 +89,6 @@ fn bare_paper_renders_its_albedo_as_grey() {
         assert!((v - 0.9 / PI).abs() < 1e-12);
     }
     assert!(rep.entries.iter().all(|e| e.record.method == Method::Airy));
-}
-
-/// Independent Airy power coefficients of a lossless slab in vacuum.
-fn airy_rt(eps: f64, h: f64, wl: f64, polar_deg: f64) -> (f64, f64) {
-    let k0 = 2.0 * PI / wl;
-    let kx = k0 * polar_deg.to_radians().sin();
-    let b = (k0 * k0 - kx * kx).sqrt();
-    let g = (eps * k0 * k0 - kx * kx).sqrt();
-    let r12 = (b - g) / (b + g);
-    let phase = C64::from_polar(1.0, 2.0 * g * h);
-    let r = C64::new(r12, 0.0) * (C64::new(1.0, 0.0) - phase)
-        / (C64::new(1.0, 0.0) - phase * r12 * r12);
-    let rr = r.norm_sqr();
-    (rr, 1.0 - rr)
 }
 
 /// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points.
@@ -723,7 +712,10 @@ fn measurement_geometries_run_by_default_and_reach_the_result_file() {
         .unwrap();
     assert_eq!((ill.as_str(), deg), ("D50", 2));
     for m in &a.measured {
-        let r = records.iter().find(|r| r.geometry == m.geometry.name()).unwrap();
+        let r = records
+            .iter()
+            .find(|r| r.geometry == m.geometry.name())
+            .unwrap();
         assert_eq!(r.lab, m.lab);
         assert_eq!(r.lab_se, m.lab_se);
         assert_eq!(r.de00_se, m.de00_se);

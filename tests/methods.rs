@@ -6,7 +6,7 @@
 use inksim::config::{Method, Precision};
 use inksim::optics::farfield::efficiencies;
 use inksim::solver::methods::born::Born;
-use inksim::solver::{self, green, Controls, Problem, SolveError, Solver, System, Validity};
+use inksim::solver::{self, Controls, Problem, SolveError, Solver, System, Validity};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -31,19 +31,6 @@ fn bounds(ctl: &Controls) -> (f64, f64) {
         Precision::F64 => (1e-8, 1e-6),
         Precision::F32 => (1e-6, 1e-6),
     }
-}
-
-/// Exact Airy |r|², |t|² for a slab of permittivity `eps` in vacuum.
-fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
-    let g = green::sqrt_branch(k0 * k0 * eps - kap * kap);
-    let b = green::sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
-    let rho = (g - b) / (g + b);
-    let e = (2.0 * C64::i() * g * h).exp();
-    let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
-    (
-        (a * (1.0 + rho * e) - 1.0).norm_sqr(),
-        (a * (C64::i() * g * h).exp() * (1.0 + rho)).norm_sqr(),
-    )
 }
 
 /// Solve, or check that a failure is one the method announced.
@@ -113,7 +100,7 @@ fn check_airy(method: Method, ctl: &Controls) {
             continue;
         };
         let ff = efficiencies(&sol);
-        let (r0, t0) = airy(lat.k0, eps, lat.q[0].hypot(lat.q[1]), h);
+        let (r0, t0) = common::airy_power(lat.k0, eps, lat.q[0].hypot(lat.q[1]), h);
         let err = (ff.total_reflectance - r0)
             .abs()
             .max((ff.total_transmittance - t0).abs());

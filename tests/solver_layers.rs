@@ -3,7 +3,7 @@
 use inksim::config::Method;
 use inksim::geometry::{Geometry, GeometryStats, Particle, Sphere};
 use inksim::optics::farfield::efficiencies;
-use inksim::solver::{self, green, Controls, Problem, SolveError};
+use inksim::solver::{self, Controls, Problem, SolveError};
 use num_complex::Complex64 as C64;
 
 mod common;
@@ -138,19 +138,6 @@ fn born_reports_divergence_and_time_marching_converges() {
     assert!((efficiencies(&auto).total_reflectance - ff.total_reflectance).abs() < 1e-6);
 }
 
-/// Airy |r|², |t|² of a homogeneous slab of permittivity `eps`.
-fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
-    let g = green::sqrt_branch(k0 * k0 * eps - kap * kap);
-    let b = green::sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
-    let rho = (g - b) / (g + b);
-    let e = (2.0 * C64::i() * g * h).exp();
-    let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
-    (
-        (a * (1.0 + rho * e) - 1.0).norm_sqr(),
-        (a * (C64::i() * g * h).exp() * (1.0 + rho)).norm_sqr() * 1.0,
-    )
-}
-
 #[test]
 fn shrinking_grains_approach_the_volume_averaged_slab() {
     let size = [480.0, 480.0, 500.0];
@@ -174,7 +161,7 @@ fn shrinking_grains_approach_the_volume_averaged_slab() {
         .expect("solve");
         let ff = efficiencies(&sol);
         let mean = (1.0 - f) * EPS_B + f * n_p * n_p;
-        let (r0, t0) = airy(lat.k0, mean, 0.0, size[2]);
+        let (r0, t0) = common::airy_power(lat.k0, mean, 0.0, size[2]);
         let err = (ff.total_reflectance - r0)
             .abs()
             .max((ff.total_transmittance - t0).abs());

@@ -1,23 +1,12 @@
 //! Homogeneous slab against the Airy formula (METHOD §7).
 use inksim::config::Method;
-use inksim::solver::{self, green, Controls, Problem};
+use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
-const EPS_B: f64 = 1.558 * 1.558;
+mod common;
 
-/// Exact Airy r, t for a slab of permittivity `eps` in vacuum.
-fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (C64, C64) {
-    let g = green::sqrt_branch(k0 * k0 * eps - kap * kap);
-    let b = green::sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
-    let rho = (g - b) / (g + b);
-    let e = (2.0 * C64::i() * g * h).exp();
-    let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
-    (
-        a * (1.0 + rho * e) - 1.0,
-        a * (C64::i() * g * h).exp() * (1.0 + rho),
-    )
-}
+const EPS_B: f64 = 1.558 * 1.558;
 
 fn slab_solve(
     eps: C64,
@@ -45,7 +34,7 @@ fn slab_solve(
     )
     .expect("solve");
     let kap = lat.q[0].hypot(lat.q[1]);
-    let (r, t) = airy(lat.k0, eps, kap, h);
+    let (r, t) = common::airy(lat.k0, eps, kap, h);
     let ff = inksim::optics::farfield::efficiencies(&sol);
     (
         ff.total_reflectance,

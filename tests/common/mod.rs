@@ -1,9 +1,10 @@
-//! Set-up shared by the tests: a layer of one pigment in the binder, and a
-//! brute-force check of particle gaps.
+//! Set-up shared by the tests: a layer of one pigment in the binder, a
+//! brute-force check of particle gaps, and the Airy slab reference.
 #![allow(dead_code)]
 
 use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
 use inksim::raster::{rasterize, Grid};
+use inksim::solver::green;
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -66,4 +67,32 @@ pub fn brute_min_gap(g: &Geometry) -> f64 {
         }
     }
     best
+}
+
+/// Exact Airy amplitudes `(r, t)` of a homogeneous slab of permittivity `eps`
+/// and thickness `h` in vacuum, for vacuum wavenumber `k0` and lateral
+/// wavenumber `kap` (the one independent slab reference of the tests).
+pub fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (C64, C64) {
+    let g = green::sqrt_branch(k0 * k0 * eps - kap * kap);
+    let b = green::sqrt_branch(C64::new(k0 * k0 - kap * kap, 0.0));
+    let rho = (g - b) / (g + b);
+    let e = (2.0 * C64::i() * g * h).exp();
+    let a = 2.0 * b / ((g + b) * (1.0 - rho * rho * e));
+    (
+        a * (1.0 + rho * e) - 1.0,
+        a * (C64::i() * g * h).exp() * (1.0 + rho),
+    )
+}
+
+/// Airy power coefficients `(|r|², |t|²)` of the same slab.
+pub fn airy_power(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
+    let (r, t) = airy(k0, eps, kap, h);
+    (r.norm_sqr(), t.norm_sqr())
+}
+
+/// `(R, T)` of a slab of real permittivity `eps`, thickness `h` (nm), at
+/// wavelength `wl` (nm) and polar angle `polar_deg`.
+pub fn airy_rt(eps: f64, h: f64, wl: f64, polar_deg: f64) -> (f64, f64) {
+    let k0 = 2.0 * std::f64::consts::PI / wl;
+    airy_power(k0, C64::new(eps, 0.0), k0 * polar_deg.to_radians().sin(), h)
 }

@@ -1,4 +1,4 @@
-//! From solves to what a person sees (issue #4): the paper substrate against
+//! From solves to what a person sees: the paper substrate against
 //! closed forms, energy and power preservation of the tables, BRDF
 //! reciprocity within the statistical error, 1/√R convergence of the
 //! ensemble, the plan computing only what a scene asks for, and the MERL

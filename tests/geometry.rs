@@ -312,7 +312,7 @@ fn large_fragment_packs_fully() {
     assert!(g.stats.min_gap_nm >= 0.0);
 }
 
-// ---- Statistics, size distributions, agglomeration, relief (issue 3) ----
+// ---- Statistics, size distributions, agglomeration, relief ----
 
 use inksim::geometry::{analyse, SizeDistribution, SpeciesOptions, StatsParams};
 

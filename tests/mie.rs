@@ -1,5 +1,5 @@
 //! A dilute lattice of small spheres against the single-scattering limit of
-//! the scalar sphere series (METHOD §7, issue #7).
+//! the scalar sphere series (METHOD §7).
 //!
 //! One sphere (radius a, permittivity ε_s) per period L × L in vacuum (the
 //! "binder" has n = 1, so the slab background is plain vacuum). Scalar

@@ -1,4 +1,4 @@
-//! Lamellar grating against an independent RCWA code (METHOD §7, issue 7).
+//! Lamellar grating against an independent RCWA code (METHOD §7).
 //!
 //! A slab whose permittivity depends on x only is exactly TE Maxwell for the
 //! scalar equation, so grcwa's s-polarised order efficiencies

@@ -1,4 +1,4 @@
-//! The effective-medium shortcut (issue #6): a layer of grains fine against
+//! The effective-medium shortcut: a layer of grains fine against
 //! the wavelength is the homogeneous slab of the volume-averaged ε, taken in
 //! closed form when the measured estimate is within the scene's tolerance.
 //! Checked against the same scene forced through the full solve, and the

@@ -1,4 +1,4 @@
-//! Stability suite (issue 6), at CI size: the hard cases users run must
+//! Stability suite, at CI size: the hard cases users run must
 //! finish with no inf/NaN, the residual at tolerance and the energy balance
 //! within 1e-4, with `auto` (which may fall back and says so). The grazing
 //! order, the guided resonance and the 3 µm layer live in tests/traps.rs and

@@ -1,4 +1,4 @@
-//! Explicit-structure input (issue #7): primitives rasterised exactly where
+//! Explicit-structure input: primitives rasterised exactly where
 //! they can be, a buried absorbing slab against an independent transfer
 //! matrix, the HDF5 ε grid giving the same answer as the primitives it
 //! holds, and clear errors.

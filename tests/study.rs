@@ -1,4 +1,4 @@
-//! The study driver end to end (issue #5): sweep expansion, naming and
+//! The study driver end to end: sweep expansion, naming and
 //! seeding; plan figures against what a run does; resume after a kill, and
 //! truncated or mismatched results redone; shards adding up to the
 //! unsharded run bit for bit; bad sweep files rejected before any work;

@@ -29,7 +29,7 @@ pub use crate::config::Measurement;
 
 use super::colours::de00_standard_error;
 use super::proxy::{through_proxy, SlabOnPaper, SpectralProxy};
-use super::{reduce, AppearanceError, AppearanceSpec, Estimate};
+use super::{find_entry, reduce, AppearanceError, AppearanceSpec, Estimate};
 use crate::optics::colour::{self, Observer};
 use crate::optics::farfield::table::{self, Part};
 use crate::optics::farfield::{Side, SolveEntry};
@@ -140,22 +140,7 @@ pub(super) fn measure(
         for r in 0..rr {
             let mut v = Array1::zeros(wl.len());
             for (l, &w) in wl.iter().enumerate() {
-                let at = |polar: f64| {
-                    entries
-                        .iter()
-                        .find(|e| {
-                            e.side == Side::Above
-                                && e.realisation == r
-                                && e.wavelength_nm == w
-                                && e.incidence.polar_deg == polar
-                        })
-                        .ok_or(AppearanceError::Missing {
-                            side: Side::Above,
-                            realisation: r,
-                            wavelength_nm: w,
-                            polar_deg: polar,
-                        })
-                };
+                let at = |polar: f64| find_entry(entries, Side::Above, r, w, polar);
                 let p = paper
                     .as_ref()
                     .map(|p| (p.albedo, p.r_dd_up[r][l], p.t_d[r][l]));

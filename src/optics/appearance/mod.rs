@@ -151,6 +151,31 @@ pub(super) fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
     Estimate { mean, se }
 }
 
+/// The solve of realisation `r` at wavelength `wl` and polar angle `polar`
+/// from `side`.
+pub(super) fn find_entry(
+    entries: &[SolveEntry],
+    side: Side,
+    r: usize,
+    wl: f64,
+    polar: f64,
+) -> Result<&SolveEntry, AppearanceError> {
+    entries
+        .iter()
+        .find(|e| {
+            e.side == side
+                && e.realisation == r
+                && e.wavelength_nm == wl
+                && e.incidence.polar_deg == polar
+        })
+        .ok_or(AppearanceError::Missing {
+            side,
+            realisation: r,
+            wavelength_nm: wl,
+            polar_deg: polar,
+        })
+}
+
 fn index_of(list: &[f64], v: f64) -> Option<usize> {
     list.iter().position(|&x| x == v)
 }
@@ -166,22 +191,7 @@ pub fn assemble(
     let ni = spec.illumination_deg.len();
     let nv = spec.viewing_deg.len();
     let nt = spec.table.n();
-    let find = |side: Side, r: usize, wl: f64, polar: f64| {
-        entries
-            .iter()
-            .find(|e| {
-                e.side == side
-                    && e.realisation == r
-                    && e.wavelength_nm == wl
-                    && e.incidence.polar_deg == polar
-            })
-            .ok_or(AppearanceError::Missing {
-                side,
-                realisation: r,
-                wavelength_nm: wl,
-                polar_deg: polar,
-            })
-    };
+    let find = |side, r, wl, polar| find_entry(entries, side, r, wl, polar);
     let illum_idx: Vec<usize> = spec
         .illumination_deg
         .iter()

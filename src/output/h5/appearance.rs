@@ -213,27 +213,27 @@ fn write_measured(parent: &hdf5::Group, m: &MeasuredColour) -> hdf5::Result<()> 
     let g = parent.create_group(m.geometry.slug())?;
     write_str_attr(&g, "geometry", m.geometry.name())?;
     write_estimate(&g, "reflectance_factor", &m.reflectance)?;
-    let described = |name: &str, data: &[f64], units: &str, desc: &str| {
+    let vector = |name: &str, data: &[f64], units: &str, desc: &str| {
         described(&g, name, ndarray::aview1(data), units, desc)
     };
-    described(
+    vector(
         "spectrum_wavelengths_nm",
         &m.spectrum_wavelengths_nm,
         "nm",
         "wavelengths of the spectrum colour is integrated from",
     )?;
-    described(
+    vector(
         "spectrum",
         &m.spectrum,
         "1",
         "reflectance factor colour is integrated from (through the spectral proxy where there is one)",
     )?;
-    described("xyz", &m.xyz, "1", "CIE XYZ, white Y = 100")?;
-    described("lab", &m.lab, "1", "CIELAB L*, a*, b*")?;
-    described("lch", &m.lch, "1, 1, deg", "CIE LCh(ab): L*, C*ab, h_ab")?;
+    vector("xyz", &m.xyz, "1", "CIE XYZ, white Y = 100")?;
+    vector("lab", &m.lab, "1", "CIELAB L*, a*, b*")?;
+    vector("lch", &m.lch, "1, 1, deg", "CIE LCh(ab): L*, C*ab, h_ab")?;
     if let (Some(se), Some(de)) = (m.lab_se, m.de00_se) {
-        described("lab_se", &se, "1", "standard errors of L*, a*, b*")?;
-        described(
+        vector("lab_se", &se, "1", "standard errors of L*, a*, b*")?;
+        vector(
             "de00_se",
             &[de],
             "1",

@@ -90,16 +90,52 @@ pub(super) struct SlabOnPaper<F: Fn(f64) -> (f64, f64)> {
 }
 
 /// Largest factor by which the ratio layer / proxy may change across one
-/// interval between solved wavelengths for the proxy to be trusted there.
+/// interval between solved wavelengths for the ratio model to be trusted
+/// there.
 pub const PROXY_RATIO_SPREAD: f64 = 10.0;
 
-/// Spectrum on the proxy's fine grid: `ratio(λ) · proxy(λ)` with the ratio
-/// interpolated linearly between the solved wavelengths (held at the ends).
-/// Where the ratio changes by more than [`PROXY_RATIO_SPREAD`] across an
-/// interval, the proxy does not describe the layer there (e.g. a strongly
-/// absorbing layer seen by its surface scattering, while the slab's double
-/// pass through the band is orders of magnitude darker): that interval falls
-/// back to linear interpolation of the layer's own values.
+/// Smallest relative change of the proxy across an interval for the affine
+/// model's slope to be determined by the two solved values.
+pub const AFFINE_MIN_PROXY_CHANGE: f64 = 0.01;
+
+/// How one interval between solved wavelengths is filled in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Fill {
+    /// `a + b·proxy(λ)`, `a ≥ 0`, `b > 0`, through both solved values.
+    Affine { a: f64, b: f64 },
+    /// Linearly interpolated ratio layer / proxy, times the proxy.
+    Ratio,
+    /// Linear interpolation of the layer's own values.
+    Linear,
+}
+
+/// Spectrum on the proxy's fine grid from the layer's `values` at the solved
+/// wavelengths `wl` (each of which is on the fine grid).
+///
+/// Each interval between two solved wavelengths is filled by the first of
+/// three models that fits it:
+///
+/// 1. **Affine**, `layer(λ) = a + b·proxy(λ)` with constant `a ≥ 0`, `b > 0`
+///    fixed by the two solved values, where the proxy changes by at least
+///    [`AFFINE_MIN_PROXY_CHANGE`] across the interval. It is exact when the grains scale the
+///    slab's spectrum (`a = 0`) *and* when they add a smooth, nearly
+///    wavelength-independent surface scattering to it (`b = 1`), the case of
+///    a strongly absorbing layer seen by the light its top grains scatter
+///    back, where the proxy is orders of magnitude darker in the band. With
+///    `a ≥ 0` and `b > 0` the result stays within the proxy's own shape: it
+///    cannot amplify a proxy peak between a dark and a bright solved value
+///    the way an interpolated ratio does (ratio ≫ 1 at the dark end times the
+///    proxy's peak overshoots the bright end).
+/// 2. **Ratio**, where the affine fit needs `a < 0` or `b ≤ 0` or is not
+///    determined: the ratio
+///    layer / proxy interpolated linearly, if it changes by at most
+///    [`PROXY_RATIO_SPREAD`] across the interval.
+/// 3. **Linear** interpolation of the layer's values otherwise: there the
+///    proxy does not describe the layer.
+///
+/// Outside the solved range the nearest interval's affine model is
+/// extended (else the nearest ratio held). At the solved wavelengths the
+/// result equals the solved values.
 pub(super) fn through_proxy(
     wl: &[f64],
     values: &[f64],
@@ -107,84 +143,173 @@ pub(super) fn through_proxy(
     proxy_fine: &[f64],
 ) -> Vec<f64> {
     let at = |x: f64| fine.iter().position(|&f| f == x);
-    let ratio: Vec<f64> = wl
+    let proxy_at: Vec<f64> = wl
         .iter()
-        .zip(values)
-        .map(|(&w, &v)| {
-            let p = at(w).map_or(0.0, |k| proxy_fine[k]);
-            if p > 0.0 {
-                v / p
-            } else {
-                f64::INFINITY
-            }
+        .map(|&w| at(w).map_or(0.0, |k| proxy_fine[k]))
+        .collect();
+    let ratio: Vec<f64> = values
+        .iter()
+        .zip(&proxy_at)
+        .map(|(&v, &p)| if p > 0.0 { v / p } else { f64::INFINITY })
+        .collect();
+    let n = wl.len();
+    let fills: Vec<Fill> = (0..n.saturating_sub(1))
+        .map(|k| {
+            fill_of(
+                values[k],
+                values[k + 1],
+                proxy_at[k],
+                proxy_at[k + 1],
+                ratio[k],
+                ratio[k + 1],
+            )
         })
         .collect();
-    let trusted = |k: usize| {
-        let (a, b) = (ratio[k], ratio[k + 1]);
-        a.is_finite()
-            && b.is_finite()
-            && a > 0.0
-            && b > 0.0
-            && a.max(b) <= PROXY_RATIO_SPREAD * a.min(b)
-    };
-    let n = wl.len();
-    let held = |k: usize, p: f64| {
-        if ratio[k].is_finite() {
-            ratio[k] * p
-        } else {
-            values[k]
-        }
+    // Beyond the solved range: the nearest interval's affine model, else
+    // the nearest ratio held.
+    let held = |k: usize, fill: Option<&Fill>, p: f64| match fill {
+        Some(&Fill::Affine { a, b }) => a + b * p,
+        _ if ratio[k].is_finite() => ratio[k] * p,
+        _ => values[k],
     };
     fine.iter()
         .zip(proxy_fine)
         .map(|(&x, &p)| {
             if x <= wl[0] || n == 1 {
-                return held(0, p);
+                return held(0, fills.first(), p);
             }
             if x >= wl[n - 1] {
-                return held(n - 1, p);
+                return held(n - 1, fills.last(), p);
             }
             let k = wl.windows(2).position(|w| x < w[1]).unwrap_or(0);
             let t = (x - wl[k]) / (wl[k + 1] - wl[k]);
-            if trusted(k) {
-                (ratio[k] * (1.0 - t) + ratio[k + 1] * t) * p
-            } else {
-                values[k] * (1.0 - t) + values[k + 1] * t
+            match fills[k] {
+                Fill::Affine { a, b } => a + b * p,
+                Fill::Ratio => (ratio[k] * (1.0 - t) + ratio[k + 1] * t) * p,
+                Fill::Linear => values[k] * (1.0 - t) + values[k + 1] * t,
             }
         })
         .collect()
+}
+
+/// The model for one interval: solved values `v0`, `v1`, proxy `p0`, `p1`
+/// and ratios `r0`, `r1` at its ends.
+fn fill_of(v0: f64, v1: f64, p0: f64, p1: f64, r0: f64, r1: f64) -> Fill {
+    let dp = p1 - p0;
+    // With nearly equal proxy values at both ends, `b` is a ratio of
+    // differences of nearly equal numbers: no longer determined.
+    if dp.abs() >= AFFINE_MIN_PROXY_CHANGE * p0.max(p1) && p0 >= 0.0 && p1 >= 0.0 {
+        let b = (v1 - v0) / dp;
+        let a = v0 - b * p0;
+        // Round-off: a layer that is exactly c × proxy gives a ≈ 0 of
+        // either sign.
+        let tiny = 1e-12 * v0.abs().max(v1.abs());
+        if b > 0.0 && b.is_finite() && a >= -tiny {
+            return Fill::Affine { a: a.max(0.0), b };
+        }
+    }
+    let ratio_fits = r0.is_finite()
+        && r1.is_finite()
+        && r0 > 0.0
+        && r1 > 0.0
+        && r0.max(r1) <= PROXY_RATIO_SPREAD * r0.min(r1);
+    if ratio_fits {
+        Fill::Ratio
+    } else {
+        Fill::Linear
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn proxy_shapes_between_solves_and_falls_back_where_it_does_not_fit() {
-        let fine: Vec<f64> = (0..=20).map(|i| 400.0 + 10.0 * i as f64).collect();
-        let wl = [400.0, 500.0, 600.0];
-        // A proxy with a band at 450 nm and a deep one at 600 nm.
-        let proxy: Vec<f64> = fine
+    /// A fine grid of 10 nm, solves every 100 nm, and a proxy with a band at
+    /// 430 nm, a deep band at 600 nm and a peak above its 700 nm value at
+    /// 670 nm.
+    fn setup() -> (Vec<f64>, [f64; 4], Vec<f64>) {
+        let fine: Vec<f64> = (0..=30).map(|i| 400.0 + 10.0 * i as f64).collect();
+        let proxy = fine
             .iter()
             .map(|&x| {
-                0.5 - 0.3 * (-((x - 450.0) / 20.0).powi(2)).exp()
+                0.5 - 0.3 * (-((x - 430.0) / 20.0).powi(2)).exp()
                     - 0.4999 * (-((x - 600.0) / 20.0).powi(2)).exp()
+                    + 0.4 * (-((x - 670.0) / 15.0).powi(2)).exp()
             })
             .collect();
-        let p_at = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
-        // Layer = 0.8 × proxy at 400 and 500 nm (the proxy fits there), but
-        // a flat 0.1 at 600 nm where the proxy's band darkens it 5000-fold.
-        let values = [0.8 * p_at(400.0), 0.8 * p_at(500.0), 0.1];
+        (fine, [400.0, 500.0, 600.0, 700.0], proxy)
+    }
+
+    #[test]
+    fn a_layer_that_scales_the_proxy_is_reproduced_everywhere() {
+        let (fine, wl, proxy) = setup();
+        let p = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
+        let values = wl.iter().map(|&w| 0.8 * p(w)).collect::<Vec<_>>();
         let out = through_proxy(&wl, &values, &fine, &proxy);
-        let at = |x: f64| out[fine.iter().position(|&f| f == x).unwrap()];
-        for (w, v) in wl.iter().zip(values) {
-            assert!((at(*w) - v).abs() < 1e-15, "solved wavelengths are exact");
+        for (o, q) in out.iter().zip(&proxy) {
+            assert!((o - 0.8 * q).abs() < 1e-12, "{o} vs {}", 0.8 * q);
         }
-        // 400–500 nm: constant ratio, so the band at 450 nm is reproduced.
-        assert!((at(450.0) - 0.8 * p_at(450.0)).abs() < 1e-12);
-        assert!(at(450.0) < 0.8 * 0.21, "the band is there");
-        // 500–600 nm: the ratio jumps far beyond the spread; linear values.
+    }
+
+    #[test]
+    fn surface_scattering_over_a_dark_band_is_reproduced_without_overshoot() {
+        // The layer is the proxy scaled by 0.9 plus 0.02 of flat surface
+        // scattering: in the 600 nm band the proxy is 5000× darker than the
+        // layer, and the ratio layer / proxy runs from ≈ 40 to ≈ 1. The
+        // ratio model would carry that 40 onto the 670 nm peak.
+        let (fine, wl, proxy) = setup();
+        let p = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
+        let layer = |q: f64| 0.02 + 0.9 * q;
+        let values = wl.iter().map(|&w| layer(p(w))).collect::<Vec<_>>();
+        let out = through_proxy(&wl, &values, &fine, &proxy);
+        for (o, q) in out.iter().zip(&proxy) {
+            assert!((o - layer(*q)).abs() < 1e-12, "{o} vs {}", layer(*q));
+        }
+        let peak = out.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            peak < 0.9,
+            "peak {peak}: no overshoot above the proxy's own shape"
+        );
+        // The ratio model on the 600–700 nm interval, for contrast.
+        let (r0, r1) = (values[2] / p(600.0), values[3] / p(700.0));
+        let t = 0.7;
+        let ratio_model = ((1.0 - t) * r0 + t * r1) * p(670.0);
+        assert!(
+            ratio_model > 4.0,
+            "the ratio model overshoots: {ratio_model}"
+        );
+    }
+
+    #[test]
+    fn a_layer_against_the_proxy_falls_back_to_the_ratio_or_to_linear() {
+        let (fine, wl, proxy) = setup();
+        let p = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
+        let at = |out: &[f64], x: f64| out[fine.iter().position(|&f| f == x).unwrap()];
+        // 400–500 nm: the proxy rises (0.47 → 0.50) while the layer falls
+        // (0.4 → 0.35): b < 0, the ratio changes by 1.2× → ratio model.
+        // 500–600 nm: the layer rises as the proxy falls 5000× → b < 0, the
+        // ratio spreads far beyond 10× → linear.
+        let values = [0.4, 0.35, 0.5, 0.8 * p(700.0)];
+        let out = through_proxy(&wl, &values, &fine, &proxy);
+        for (w, v) in wl.iter().zip(values) {
+            assert!(
+                (at(&out, *w) - v).abs() < 1e-15,
+                "solved wavelengths are exact"
+            );
+        }
+        let (r0, r1) = (values[0] / p(400.0), values[1] / p(500.0));
+        let t = 0.3;
+        let ratio_430 = ((1.0 - t) * r0 + t * r1) * p(430.0);
+        assert!((at(&out, 430.0) - ratio_430).abs() < 1e-12);
+        assert!(
+            at(&out, 430.0) < 0.2,
+            "the 430 nm band is carried by the ratio"
+        );
         let lin = 0.5 * (values[1] + values[2]);
-        assert!((at(550.0) - lin).abs() < 1e-12, "{} vs {lin}", at(550.0));
+        assert!(
+            (at(&out, 550.0) - lin).abs() < 1e-12,
+            "{} vs {lin}",
+            at(&out, 550.0)
+        );
     }
 }

@@ -168,6 +168,7 @@ fn set<'a>(g: &'a Geo, e: &'a [SolveEntry], hash: &'a str, png: Option<&'a [u8]>
         entries: e,
         picture_png: png,
         realisations: &[(7, 0.3)],
+        realisation_stop: None,
         appearance: None,
         tile_png: None,
     }

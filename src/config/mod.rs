@@ -321,6 +321,17 @@ pub struct Appearance {
     pub measurements: Vec<Measurement>,
 }
 
+/// `realisations = { target_de00, max, min }`: realisations are added (at
+/// least `min`, at most the scene's `realisations`) until the standard error
+/// of ΔE00 to the mean colour is at most `de00` for every measured colour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RealisationTarget {
+    /// Target standard error of ΔE00 to the mean colour.
+    pub de00: f64,
+    /// Fewest realisations (≥ 2, for a standard error to exist).
+    pub min: usize,
+}
+
 /// A validated scene: every value is in range and every material covers every
 /// requested wavelength.
 #[derive(Debug, Clone)]
@@ -328,8 +339,10 @@ pub struct Scene {
     pub provenance: Provenance,
     pub seed: u64,
     /// Independent random fragments averaged (seed of realisation k derived
-    /// from `seed` and k).
+    /// from `seed` and k); with a target, the most a run may make.
     pub realisations: usize,
+    /// Stop adding realisations once the colour is this certain.
+    pub realisation_target: Option<RealisationTarget>,
     pub layer: Layer,
     pub species: Vec<Species>,
     pub grid: GridSpec,

@@ -14,7 +14,7 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct RawConfig {
     pub seed: Option<i64>,
-    pub realisations: Option<i64>,
+    pub realisations: Option<RawRealisations>,
     pub layer: RawLayer,
     #[serde(default)]
     pub pigment: Vec<RawPigment>,
@@ -25,6 +25,49 @@ pub struct RawConfig {
     pub appearance: Option<RawAppearance>,
     pub substrate: Option<RawSubstrate>,
     pub structure: Option<RawStructure>,
+}
+
+/// `realisations = 4`, or `realisations = { target_de00 = 0.5, max = 16 }`:
+/// a count, or a target uncertainty of the colour with the most
+/// realisations it may take.
+#[derive(Debug)]
+pub enum RawRealisations {
+    Count(i64),
+    Target(RawRealisationTarget),
+}
+
+/// `{ target_de00, max, min }`: realisations are added until the standard
+/// error of every measured colour's ΔE00 to the mean is at most
+/// `target_de00`, from `min` (default 3) up to `max`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRealisationTarget {
+    pub target_de00: f64,
+    pub max: i64,
+    pub min: Option<i64>,
+}
+
+impl<'de> Deserialize<'de> for RawRealisations {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawRealisations;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a count, or a table { target_de00 = …, max = … }")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<RawRealisations, E> {
+                Ok(RawRealisations::Count(v))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<RawRealisations, E> {
+                Ok(RawRealisations::Count(i64::try_from(v).unwrap_or(i64::MAX)))
+            }
+            fn visit_map<A: de::MapAccess<'de>>(self, map: A) -> Result<RawRealisations, A::Error> {
+                RawRealisationTarget::deserialize(de::value::MapAccessDeserializer::new(map))
+                    .map(RawRealisations::Target)
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 /// `[structure]`: the layer given explicitly instead of generated grains.

@@ -86,7 +86,15 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
             lookup(&CELL_NM, cell, true),
         ));
         rows.push((format!("z cell {zc:.1} nm"), lookup(&Z_CELL_NM, zc, true)));
-        rows.push((format!("realisations {}", scene.realisations), de_real));
+        match scene.realisation_target {
+            // Realisations are added until the colour's ΔE00 standard error
+            // is at most the target (or the most allowed are run).
+            Some(t) => rows.push((
+                format!("realisations up to {} (target s.e.)", scene.realisations),
+                t.de00,
+            )),
+            None => rows.push((format!("realisations {}", scene.realisations), de_real)),
+        }
         rows.push((
             format!("tolerance {:.0e}", scene.solver.tolerance),
             lookup(&TOLERANCE, scene.solver.tolerance, true),

@@ -4,13 +4,17 @@
 //! packed grains, one particle set per realisation. Each gives its solves
 //! and what the result file records of the layer.
 
-use crate::config::{Scene, Structure};
+use crate::config::{RealisationTarget, Scene, Structure};
 use crate::geometry::Geometry;
+use crate::optics::appearance;
+use crate::optics::colour::Observer;
 use crate::optics::farfield::SolveEntry;
+use crate::output::h5::RealisationStop;
 use crate::output::progress::Progress;
 use crate::raster::structure::{self, EpsGrid};
 use crate::raster::{self, Raster};
 
+use super::appearance::appearance_spec;
 use super::grains::{build_geometry_seeded, grid_of};
 use super::plan::RunPlan;
 use super::solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
@@ -26,6 +30,8 @@ pub struct SolvedLayer {
     pub geometry: Option<Geometry>,
     /// The raster of realisation 0, or of explicit primitives.
     pub raster: Option<Raster>,
+    /// Why the realisations stopped, for a scene with a target.
+    pub stop: Option<RealisationStop>,
 }
 
 /// Make and solve the layer the plan calls for.
@@ -54,6 +60,7 @@ fn homogeneous(
         realisations: vec![(scene.seed, scene.total_pvc())],
         geometry: None,
         raster: None,
+        stop: None,
     })
 }
 
@@ -76,6 +83,7 @@ fn explicit(
                 realisations: vec![(scene.seed, f)],
                 geometry: None,
                 raster: Some(raster),
+                stop: None,
             })
         }
         Structure::Hdf5(path) => {
@@ -86,6 +94,7 @@ fn explicit(
                 realisations: vec![(scene.seed, 0.0)],
                 geometry: None,
                 raster: None,
+                stop: None,
             })
         }
     }
@@ -104,6 +113,7 @@ fn grains(
         realisations: Vec::new(),
         geometry: None,
         raster: None,
+        stop: None,
     };
     for (r, &seed) in plan.seeds.iter().enumerate() {
         let geometry = build_geometry_seeded(scene, seed)?;
@@ -139,6 +149,46 @@ fn grains(
             layer.geometry = Some(geometry);
             layer.raster = Some(raster);
         }
+        if let Some(target) = scene.realisation_target {
+            let n = r + 1;
+            if n >= target.min {
+                let stop = colour_uncertainty(scene, plan, &layer.entries, n, target)?;
+                progress.log(&format!(
+                    "realisations: {n} done, ΔE00 standard error {:.3} (target {})",
+                    stop.de00_se, target.de00
+                ));
+                layer.stop = Some(stop);
+                if stop.target_met {
+                    break;
+                }
+            }
+        }
     }
     Ok(layer)
+}
+
+/// The colour uncertainty after the first `n` realisations: the largest
+/// standard error of ΔE00 to the mean over the measured colours, against the
+/// target.
+fn colour_uncertainty(
+    scene: &Scene,
+    plan: &RunPlan,
+    entries: &[SolveEntry],
+    n: usize,
+    target: RealisationTarget,
+) -> Result<RealisationStop, PipelineError> {
+    let mut so_far = plan.clone();
+    so_far.realisations = n;
+    let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
+    let a = appearance::assemble(&appearance_spec(scene, &so_far), entries, &obs)?;
+    let de00_se = a
+        .measured
+        .iter()
+        .map(|m| m.de00_se.unwrap_or(f64::INFINITY))
+        .fold(0.0, f64::max);
+    Ok(RealisationStop {
+        target_de00: target.de00,
+        de00_se,
+        target_met: de00_se <= target.de00,
+    })
 }

@@ -183,6 +183,12 @@ fn realisations_of(scene: &Scene, analytic: bool, explicit: bool) -> (usize, Str
                 "an explicit structure"
             }
         )
+    } else if let Some(t) = scene.realisation_target {
+        format!(
+            "realisations: {} to {realisations}, added until every measured colour's ΔE00 \
+             standard error is ≤ {}",
+            t.min, t.de00
+        )
     } else {
         format!(
             "realisations: {realisations}{}",

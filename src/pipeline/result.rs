@@ -8,7 +8,7 @@ use crate::config::{Scene, Structure};
 use crate::geometry::{self, Geometry, StatsParams};
 use crate::optics::appearance::Appearance;
 use crate::optics::farfield::SolveEntry;
-use crate::output::h5::{self, GeometrySummary, ResultSet};
+use crate::output::h5::{self, GeometrySummary, RealisationStop, ResultSet};
 use crate::raster::Raster;
 
 use super::grains::{fragment_nm, grid_of};
@@ -25,6 +25,8 @@ pub struct ResultParts<'a> {
     pub entries: &'a [SolveEntry],
     /// Seed and achieved PVC of each realisation.
     pub realisations: &'a [(u64, f64)],
+    /// Why the realisations stopped, for a scene with a target.
+    pub realisation_stop: Option<RealisationStop>,
     /// The plan as stored ([`super::plan_text`]).
     pub plan: &'a str,
     /// The orders picture (or the geometry picture of `inksim geometry`).
@@ -42,6 +44,7 @@ impl ResultParts<'_> {
             raster,
             entries,
             realisations,
+            realisation_stop,
             plan,
             orders_png,
             tile_png,
@@ -121,6 +124,7 @@ impl ResultParts<'_> {
             entries,
             picture_png: Some(orders_png),
             realisations,
+            realisation_stop,
             appearance,
             tile_png,
         };

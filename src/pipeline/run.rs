@@ -10,6 +10,7 @@ use crate::optics::appearance::{self, Appearance};
 use crate::optics::colour::Observer;
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::output::atomic;
+use crate::output::h5::RealisationStop;
 use crate::output::merl;
 use crate::output::progress::Progress;
 use crate::output::render;
@@ -50,7 +51,7 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
         .dir
         .join(format!("{}-orders.png", scene.output.name));
     check_output_dir(&scene.output.dir)?;
-    let plan = RunPlan::of(scene);
+    let mut plan = RunPlan::of(scene);
     let total = plan.solves(scene) as u64;
     let progress = if quiet {
         Progress::hidden(total, &scene.output.name)
@@ -61,6 +62,13 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
         progress.log(l);
     }
     let layer = layer::solve(scene, &plan, &progress)?;
+    if let Some(stop) = layer.stop {
+        let line = realisations_done_line(plan.realisations, layer.realisations.len(), stop);
+        progress.log(&line);
+        plan.lines.push(line);
+        plan.realisations = layer.realisations.len();
+        plan.seeds.truncate(plan.realisations);
+    }
     progress.finish("all solves done");
 
     let pictures = assemble_products(scene, &plan, &layer.entries)?;
@@ -75,6 +83,7 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
         raster: layer.raster.as_ref(),
         entries: &layer.entries,
         realisations: &layer.realisations,
+        realisation_stop: layer.stop,
         plan: &plan_text(&plan, &layer.entries),
         orders_png: &pictures.orders_png,
         tile_png: pictures.tile_png.as_deref(),
@@ -89,6 +98,23 @@ pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> 
         entries: layer.entries,
         appearance: pictures.appearance,
     })
+}
+
+/// What a run with a target uncertainty did: how many realisations it took
+/// of the most allowed, and why it stopped.
+fn realisations_done_line(max: usize, used: usize, stop: RealisationStop) -> String {
+    if stop.target_met {
+        format!(
+            "realisations: {used} of at most {max} — ΔE00 standard error {:.3} ≤ target {}",
+            stop.de00_se, stop.target_de00
+        )
+    } else {
+        format!(
+            "realisations: {used}, the most allowed — ΔE00 standard error {:.3} is still above \
+             the target {} (raise realisations.max or the target)",
+            stop.de00_se, stop.target_de00
+        )
+    }
 }
 
 /// The appearance products of a run and its pictures.
@@ -275,6 +301,7 @@ fn write_geometry_only(
         raster: Some(raster),
         entries: &[],
         realisations: &[(scene.seed, pvc)],
+        realisation_stop: None,
         plan: &plan_text(&RunPlan::of(scene), &[]),
         orders_png: &png,
         tile_png: None,

@@ -2,8 +2,10 @@
 //! against every wavelength, the input hash, and the output folder and name.
 
 use super::Checker;
-use crate::config::raw::{RawConfig, RawOutput};
-use crate::config::{ConfigError, Material, OutputSpec, Provenance, Scene, Structure};
+use crate::config::raw::{RawConfig, RawOutput, RawRealisations};
+use crate::config::{
+    ConfigError, Material, OutputSpec, Provenance, RealisationTarget, Scene, Structure,
+};
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -23,16 +25,7 @@ impl Checker<'_> {
             Some(s) if s >= 0 => s as u64,
             Some(s) => return Err(self.invalid("seed", format!("must be >= 0, got {s}"))),
         };
-        let realisations = match raw.realisations {
-            None => 1,
-            Some(r) if (1..=MAX_REALISATIONS).contains(&r) => r as usize,
-            Some(r) => {
-                return Err(self.invalid(
-                    "realisations",
-                    format!("must be in [1, {MAX_REALISATIONS}], got {r}"),
-                ))
-            }
-        };
+        let (realisations, realisation_target) = self.realisations(raw.realisations.as_ref())?;
         let layer = self.layer(&raw.layer)?;
         let structure = match &raw.structure {
             None => None,
@@ -55,6 +48,12 @@ impl Checker<'_> {
         let solver = self.solver(raw.solver.as_ref())?;
         let output = self.output(path, raw.output.as_ref())?;
         let appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
+        if realisation_target.is_some() && !appearance.products.tile {
+            return Err(self.invalid(
+                "realisations.target_de00",
+                "a target uncertainty of colour needs the colours: add \"tile\" to appearance.outputs, or give a count",
+            ));
+        }
         let substrate = self.substrate(raw.substrate.as_ref())?;
 
         let mut materials: Vec<(&Material, String)> = species
@@ -103,6 +102,7 @@ impl Checker<'_> {
             },
             seed,
             realisations,
+            realisation_target,
             layer,
             species,
             grid,
@@ -114,6 +114,47 @@ impl Checker<'_> {
             substrate,
             structure,
         })
+    }
+
+    /// `realisations`: a count, or a target ΔE00 standard error with the
+    /// fewest and most realisations it may take. Returns the most
+    /// realisations a run may make and the target, if any.
+    fn realisations(
+        &self,
+        raw: Option<&RawRealisations>,
+    ) -> Result<(usize, Option<RealisationTarget>), ConfigError> {
+        let count = |key: &str, r: i64, lo: i64| {
+            if (lo..=MAX_REALISATIONS).contains(&r) {
+                Ok(r as usize)
+            } else {
+                Err(self.invalid(
+                    key,
+                    format!("must be in [{lo}, {MAX_REALISATIONS}], got {r}"),
+                ))
+            }
+        };
+        match raw {
+            None => Ok((1, None)),
+            Some(RawRealisations::Count(r)) => Ok((count("realisations", *r, 1)?, None)),
+            Some(RawRealisations::Target(t)) => {
+                let de00 = t.target_de00;
+                if !(de00.is_finite() && de00 > 0.0) {
+                    return Err(self.invalid(
+                        "realisations.target_de00",
+                        format!("must be a ΔE00 standard error > 0, got {de00}"),
+                    ));
+                }
+                let min = count("realisations.min", t.min.unwrap_or(3), 2)?;
+                let max = count("realisations.max", t.max, 2)?;
+                if max < min {
+                    return Err(self.invalid(
+                        "realisations.max",
+                        format!("must be at least realisations.min = {min}, got {max}"),
+                    ));
+                }
+                Ok((max, Some(RealisationTarget { de00, min })))
+            }
+        }
     }
 
     /// Every material has data at every wavelength: the first gap (in

@@ -43,7 +43,9 @@
 //!   centres), `cluster_sizes` (u64, largest first); see `geometry::stats`.
 //!
 //! `/realisations` (group): `seed` (R u64), `achieved_pvc` (R f64), the
-//! geometry of each random fragment (`/geometry` holds realisation 0's).
+//! geometry of each random fragment (`/geometry` holds realisation 0's);
+//! with a target uncertainty the attributes `target_de00_se`,
+//! `achieved_de00_se` and `stopped_because`.
 //!
 //! `/solves/NNNN` (one group per solve, `NNNN` = zero-padded index 0000, 0001, …
 //! in the order given), attributes:
@@ -92,7 +94,7 @@ mod summary;
 
 pub use crate::output::error::IoError;
 pub use appearance::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
-pub use result::{write_result, GeometrySummary, ResultSet};
+pub use result::{write_result, GeometrySummary, RealisationStop, ResultSet};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 
 /// Version of the layout described in the module docs, stored as `format_version`.

@@ -38,9 +38,22 @@ pub struct ResultSet<'a> {
     pub picture_png: Option<&'a [u8]>,
     /// Seed and achieved PVC of each realisation.
     pub realisations: &'a [(u64, f64)],
+    /// Why the realisations stopped, when the scene gave a target.
+    pub realisation_stop: Option<RealisationStop>,
     pub appearance: Option<&'a Appearance>,
     /// The tile PNG (stored in `/appearance`).
     pub tile_png: Option<&'a [u8]>,
+}
+
+/// A run with `realisations = { target_de00, … }`: the target, the standard
+/// error reached, and whether the target was met (else the most realisations
+/// allowed were run).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RealisationStop {
+    pub target_de00: f64,
+    /// Largest standard error of ΔE00 to the mean over the measured colours.
+    pub de00_se: f64,
+    pub target_met: bool,
 }
 
 /// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
@@ -228,6 +241,19 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     real.new_dataset_builder()
         .with_data(&pvc[..])
         .create("achieved_pvc")?;
+    if let Some(stop) = set.realisation_stop {
+        write_scalar_attr(&real, "target_de00_se", stop.target_de00)?;
+        write_scalar_attr(&real, "achieved_de00_se", stop.de00_se)?;
+        write_str_attr(
+            &real,
+            "stopped_because",
+            if stop.target_met {
+                "target standard error reached"
+            } else {
+                "most realisations allowed reached"
+            },
+        )?;
+    }
 
     let solves = file.create_group("solves")?;
     let mut rows = Vec::with_capacity(set.entries.len());

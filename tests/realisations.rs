@@ -1,0 +1,190 @@
+//! `realisations = { target_de00, max, min }`: realisations are added until
+//! the colour is as certain as asked, or the most allowed are run; the run
+//! says how many it took and why, in its plan and its result file.
+
+use inksim::config::parse_scene;
+use inksim::output::h5::read_measured;
+use inksim::pipeline::{self, RunReport};
+use std::path::Path;
+
+/// A small layer of blue grains with realisations given by `realisations`
+/// (a TOML value) and `outputs`.
+fn scene(dir: &Path, realisations: &str, outputs: &str) -> String {
+    format!(
+        r#"
+seed = 11
+realisations = {realisations}
+[layer]
+thickness_nm = 300.0
+fragment_nm = [600.0, 600.0]
+[[pigment]]
+name = "blue"
+material = {{ builtin = "blue" }}
+pvc = 0.15
+diameter_nm = 120.0
+[grid]
+nx = 12
+ny = 12
+nz = 8
+[illumination]
+wavelengths_nm = [450.0, 550.0, 650.0]
+polar_deg = [0.0]
+[solver]
+tolerance = 1e-6
+[appearance]
+outputs = {outputs}
+measurements = ["45/0"]
+quadrature_points = 2
+[output]
+dir = "{}"
+name = "r"
+"#,
+        dir.display()
+    )
+}
+
+fn run(dir: &Path, text: &str) -> RunReport {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    pipeline::run(&parse_scene(&path, text).unwrap()).unwrap()
+}
+
+fn check_error(dir: &Path, text: &str) -> String {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    parse_scene(&path, text).unwrap_err().to_string()
+}
+
+/// Seeds, the stored attributes of `/realisations` and the stored plan.
+fn stored(path: &Path) -> (usize, f64, f64, String, String) {
+    let f = hdf5::File::open(path).unwrap();
+    let g = f.group("realisations").unwrap();
+    let seeds = g.dataset("seed").unwrap().read_raw::<u64>().unwrap().len();
+    let scalar = |n: &str| g.attr(n).unwrap().read_scalar::<f64>().unwrap();
+    let why = g
+        .attr("stopped_because")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap()
+        .to_string();
+    let plan = f
+        .dataset("plan")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap()
+        .to_string();
+    (
+        seeds,
+        scalar("target_de00_se"),
+        scalar("achieved_de00_se"),
+        why,
+        plan,
+    )
+}
+
+#[test]
+fn a_loose_target_stops_at_the_fewest_realisations() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scene(dir.path(), "{ target_de00 = 50.0, max = 6 }", r#"["tile"]"#);
+    let rep = run(dir.path(), &text);
+    let (seeds, target, achieved, why, plan) = stored(&rep.result_path);
+    assert_eq!(seeds, 3, "the default minimum is 3");
+    assert!(
+        plan.contains("realisations: 3 to 6, added until")
+            && plan.contains("realisations: 3 of at most 6"),
+        "{plan}"
+    );
+    assert_eq!(target, 50.0);
+    assert!(achieved > 0.0 && achieved <= 50.0, "{achieved}");
+    assert_eq!(why, "target standard error reached");
+    // The stored standard error is the measured colour's.
+    let (measured, _, _) = read_measured(&rep.result_path).unwrap().unwrap();
+    let se = measured
+        .iter()
+        .map(|m| m.de00_se.unwrap())
+        .fold(0.0, f64::max);
+    assert!((se - achieved).abs() < 1e-12, "{se} vs {achieved}");
+    let a = rep.appearance.unwrap();
+    assert_eq!(a.spec.realisations, 3);
+}
+
+#[test]
+fn an_unreachable_target_runs_the_most_allowed_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = scene(
+        dir.path(),
+        "{ target_de00 = 1e-9, min = 2, max = 4 }",
+        r#"["tile"]"#,
+    );
+    let rep = run(dir.path(), &text);
+    let (seeds, _, achieved, why, plan) = stored(&rep.result_path);
+    assert_eq!(seeds, 4);
+    assert!(plan.contains("realisations: 4, the most allowed"), "{plan}");
+    assert!(achieved > 1e-9);
+    assert_eq!(why, "most realisations allowed reached");
+    // Every solve of the four realisations is in the result.
+    let realisations: std::collections::BTreeSet<usize> =
+        rep.entries.iter().map(|e| e.realisation).collect();
+    assert_eq!(realisations.len(), 4);
+}
+
+#[test]
+fn a_count_and_a_target_agree_where_the_target_stops() {
+    // The target run that stops after its minimum of 2 realisations is the
+    // same computation as a run of 2 realisations: same seeds, same colour.
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    let ra = run(
+        &a,
+        &scene(
+            &a,
+            "{ target_de00 = 50.0, min = 2, max = 5 }",
+            r#"["tile"]"#,
+        ),
+    );
+    let rb = run(&b, &scene(&b, "2", r#"["tile"]"#));
+    let la = ra.appearance.unwrap().measured[0].lab;
+    let lb = rb.appearance.unwrap().measured[0].lab;
+    assert_eq!(la, lb);
+}
+
+#[test]
+fn bad_targets_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cases = [
+        (
+            "{ target_de00 = 0.0, max = 4 }",
+            r#"["tile"]"#,
+            "realisations.target_de00",
+        ),
+        (
+            "{ target_de00 = 0.5, min = 5, max = 4 }",
+            r#"["tile"]"#,
+            "realisations.max",
+        ),
+        (
+            "{ target_de00 = 0.5, min = 1, max = 4 }",
+            r#"["tile"]"#,
+            "realisations.min",
+        ),
+        (
+            "{ target_de00 = 0.5, max = 4, maximum = 3 }",
+            r#"["tile"]"#,
+            "maximum",
+        ),
+        (
+            "{ target_de00 = 0.5, max = 4 }",
+            r#"["brdf"]"#,
+            "realisations.target_de00",
+        ),
+        ("0", r#"["tile"]"#, "realisations"),
+    ];
+    for (value, outputs, key) in cases {
+        let msg = check_error(d, &scene(d, value, outputs));
+        assert!(msg.contains(key), "{value}: {msg}");
+        assert!(!msg.contains('\n'), "one line: {msg}");
+    }
+}

@@ -306,3 +306,43 @@ fn geometry_command_draws_an_explicit_structure() {
     assert!(rep.lines[0].ends_with("0.2000 in all"), "{:?}", rep.lines);
     assert!(rep.picture_path.is_file() && rep.result_path.is_file());
 }
+
+/// The slab scene with a conformal binder surface of film `film_nm`.
+fn conformal_slab_scene(dir: &Path, z_cell: f64, film_nm: f64) -> String {
+    slab_scene(dir, z_cell).replace(
+        "fragment_nm = [200.0, 200.0]\n",
+        &format!(
+            "fragment_nm = [200.0, 200.0]\nsurface = {{ kind = \"conformal\", film_nm = {film_nm} }}\n"
+        ),
+    )
+}
+
+#[test]
+fn conformal_film_over_a_slab_is_the_three_layer_airy_problem() {
+    // The slab's top is at 300 nm; a 50 nm conformal film puts the binder
+    // surface at 250 nm: air, 50 nm binder, 200 nm slab, 500 nm binder.
+    let dir = tempfile::tempdir().unwrap();
+    let eps_b = C64::new(1.558f64.powi(2), 0.0);
+    let eps_s = C64::new(2.0, 0.1).powi(2);
+    let stack = [(eps_b, 50.0), (eps_s, 200.0), (eps_b, 500.0)];
+    let flat = [(eps_b, 300.0), (eps_s, 200.0), (eps_b, 500.0)];
+    let mut worst = [0.0f64; 2];
+    let mut apart = 0.0f64;
+    for (k, z) in [10.0, 5.0].into_iter().enumerate() {
+        let rep = run(dir.path(), &conformal_slab_scene(dir.path(), z, 50.0));
+        for e in &rep.entries {
+            let (r, t) = tmm(&stack, e.wavelength_nm, e.incidence.polar_deg);
+            let eff = &e.efficiencies;
+            worst[k] = worst[k]
+                .max((eff.total_reflectance - r).abs())
+                .max((eff.total_transmittance - t).abs());
+            assert!(eff.energy_balance.abs() < 1e-8);
+            let (r_flat, _) = tmm(&flat, e.wavelength_nm, e.incidence.polar_deg);
+            apart = apart.max((r - r_flat).abs());
+        }
+    }
+    assert!(worst[1] < 1e-3 && worst[1] < 0.35 * worst[0], "{worst:?}");
+    // The film is not the flat layer's 300 nm skin, by far more than the
+    // discretisation error.
+    assert!(apart > 10.0 * worst[1], "{apart} vs {worst:?}");
+}

@@ -78,7 +78,32 @@ pub struct Layer {
     /// `[0, MAX_EQUILIBRATE_SWEEPS]`, one sweep = one attempted move per
     /// grain; 0 (default): none.
     pub equilibrate_sweeps: u64,
+    /// The binder's top surface.
+    pub surface: Surface,
 }
+
+/// The binder's top surface (METHOD §3): where the binder ends and air
+/// begins above the grains.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Surface {
+    /// A plane at `z = 0` (a glossy, levelled binder): the grains stay below
+    /// it, leaving a grain-poor binder skin at the same depth everywhere.
+    Flat,
+    /// The binder drapes over the topmost material at a film thickness
+    /// `film_nm` (a binder-starved layer above the critical PVC): the
+    /// surface is the grains' upper envelope offset by a ball of radius
+    /// `film_nm`, and below it the binder fills every column.
+    Conformal { film_nm: f64 },
+    /// A random surface around `z = 0`: Gaussian heights of RMS `rms_nm`
+    /// with a Gaussian correlation of length `correlation_nm`
+    /// (`⟨h(0)h(r)⟩ = σ² e^{−r²/ℓ²}`), drawn anew for each realisation.
+    Rough { rms_nm: f64, correlation_nm: f64 },
+}
+
+/// Largest `surface.film_nm`, as a fraction of the layer thickness.
+pub const MAX_FILM_FRACTION: f64 = 0.5;
+/// Largest `surface.rms_nm`, as a fraction of the layer thickness.
+pub const MAX_ROUGH_RMS_FRACTION: f64 = 0.25;
 
 /// Largest `layer.equilibrate_sweeps`.
 pub const MAX_EQUILIBRATE_SWEEPS: u64 = 100_000;

@@ -137,6 +137,18 @@ pub struct RawLayer {
     /// Hard-sphere Monte Carlo sweeps after packing (Brownian settling of
     /// the grains in the wet ink; one sweep = one attempted move per grain).
     pub equilibrate_sweeps: Option<i64>,
+    /// The binder's top surface.
+    pub surface: Option<RawSurface>,
+}
+
+/// `surface = { kind = "flat" }`, `{ kind = "conformal", film_nm }` or
+/// `{ kind = "rough", rms_nm, correlation_nm }`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum RawSurface {
+    Flat,
+    Conformal { film_nm: f64 },
+    Rough { rms_nm: f64, correlation_nm: f64 },
 }
 
 #[derive(Debug, Deserialize)]

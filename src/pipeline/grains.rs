@@ -12,6 +12,7 @@ use crate::geometry::{
 };
 use crate::raster::Grid;
 
+use super::surface::surface_top_nm;
 use super::PipelineError;
 
 /// Total PVC up to which random sequential addition of spheres is used: RSA
@@ -164,7 +165,8 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
 /// The raster grid of a scene: the configured cells over the layer, plus,
 /// with surface relief, whole cells above it reaching the highest point a
 /// grain may have (relief fraction × largest possible diameter, +1 % for
-/// the packer's overlap tolerance), the same for every realisation.
+/// the packer's overlap tolerance) and the binder surface above them, the
+/// same for every realisation.
 pub fn grid_of(scene: &Scene) -> Grid {
     let grid = Grid {
         nx: scene.grid.nx,
@@ -172,5 +174,6 @@ pub fn grid_of(scene: &Scene) -> Grid {
         nz: scene.grid.nz,
         size_nm: fragment_nm(scene),
     };
-    grid.with_top_nm(1.01 * scene.layer.relief_fraction * largest_grain_nm(scene))
+    let relief = 1.01 * scene.layer.relief_fraction * largest_grain_nm(scene);
+    grid.with_top_nm(relief.max(surface_top_nm(scene, relief)))
 }

@@ -12,12 +12,13 @@ use crate::optics::farfield::SolveEntry;
 use crate::output::h5::RealisationStop;
 use crate::output::progress::Progress;
 use crate::raster::structure::{self, EpsGrid};
-use crate::raster::{self, Raster};
+use crate::raster::{self, Grid, Raster};
 
 use super::appearance::appearance_spec;
-use super::grains::{build_geometry_seeded, grid_of};
+use super::grains::{build_geometry_seeded, fragment_nm, grid_of};
 use super::plan::RunPlan;
 use super::solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
+use super::surface::apply_surface;
 use super::{PipelineError, SUPERSAMPLE};
 
 /// A solved layer.
@@ -75,7 +76,18 @@ fn explicit(
     let grid = grid_of(scene);
     match st {
         Structure::Primitives(ps) => {
-            let raster = structure::rasterize_primitives(ps, &grid);
+            // Primitives lie in the layer; cells above it are added empty.
+            let layer_grid = Grid {
+                nz: scene.grid.nz,
+                size_nm: fragment_nm(scene),
+                ..grid
+            };
+            let raster = apply_surface(
+                scene,
+                structure::rasterize_primitives(ps, &layer_grid)
+                    .with_top_cells(grid.nz - layer_grid.nz),
+                scene.seed,
+            );
             let f: f64 = raster.mean_fractions().iter().sum();
             let entries = solve_layer(scene, plan, LayerEps::Raster(&raster), 0, progress)?;
             Ok(SolvedLayer {
@@ -134,7 +146,11 @@ fn grains(
                 .map(|o| format!(", order parameter S = {o:.3}"))
                 .unwrap_or_default()
         ));
-        let raster = raster::rasterize(&geometry, &grid, SUPERSAMPLE);
+        let raster = apply_surface(
+            scene,
+            raster::rasterize(&geometry, &grid, SUPERSAMPLE),
+            seed,
+        );
         if r == 0 {
             progress.log(&format!(
                 "raster: {} × {} × {} voxels",

@@ -33,6 +33,7 @@ mod plan;
 mod result;
 mod run;
 mod solve;
+mod surface;
 
 use std::path::{Path, PathBuf};
 

@@ -5,7 +5,7 @@
 //! which appearance products. Every decision is one line of the plan that is
 //! logged and stored with the results.
 
-use crate::config::{GrainShape, Incidence, Scene, Structure, Substrate};
+use crate::config::{GrainShape, Incidence, Scene, Structure, Substrate, Surface};
 use crate::optics::effective_medium::{self, GrainClass, WorstError};
 use crate::optics::farfield::table::TableSpec;
 use crate::optics::farfield::{Side, SolveEntry};
@@ -13,6 +13,7 @@ use crate::optics::substrate::Hemisphere;
 
 use super::eps::species_eps;
 use super::grains::{largest_grain_nm, Packer, RSA_MAX_PVC};
+use super::surface::surface_line;
 
 /// Seed of realisation `r`: the scene's seed for r = 0 (so a
 /// one-realisation run equals the plain scene), else SplitMix64 of
@@ -141,12 +142,13 @@ fn grain_lines(scene: &Scene) -> Vec<String> {
     lines.push(if rf > 0.0 {
         format!(
             "surface relief: grains may protrude up to {:.0} % of their size through the top; \
-             the grid extends above the binder (vacuum around the grains, binder surface flat)",
+             the grid extends above the binder (vacuum around the grains above the binder surface)",
             rf * 100.0
         )
     } else {
         "surface relief: none (grains stay inside the binder)".to_string()
     });
+    lines.push(surface_line(scene));
     if scene.layer.equilibrate_sweeps > 0 {
         lines.push(format!(
             "equilibration: {} hard-particle Monte Carlo sweeps after packing \
@@ -336,6 +338,9 @@ fn effective_medium_shortcut(scene: &Scene, polar_deg: &[f64]) -> Result<String,
     }
     if scene.layer.relief_fraction > 0.0 {
         return Err("surface relief: grains protruding through the top are not a flat slab".into());
+    }
+    if scene.layer.surface != Surface::Flat {
+        return Err("the binder surface is not flat, so the layer is not a flat slab".into());
     }
     if let Some(s) = scene.species.iter().find(|s| s.shape != GrainShape::Sphere) {
         return Err(format!(

@@ -39,9 +39,10 @@
 //! half of it); parts outside the grid (`z₀ ≤ z ≤ H`) are not rasterised.
 
 pub mod structure;
+pub mod surface;
 
 use crate::geometry::{Geometry, Sphere};
-use ndarray::{Array3, ArrayViewMut2, Axis};
+use ndarray::{Array2, Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64;
 use rayon::prelude::*;
 
@@ -168,9 +169,12 @@ impl Grid {
 pub struct Raster {
     pub grid: Grid,
     pub fractions: Vec<Array3<f64>>,
-    /// Top z-slices lying above the binder surface `z = 0` (vacuum
-    /// background; 0 without relief).
+    /// Top z-slices lying above the plane `z = 0` (0 without relief or a
+    /// surface reaching above it).
     pub top_cells: usize,
+    /// The binder surface's depth below `z = 0` per column, `(ny, nx)`
+    /// ([`surface`]); None: the plane `z = 0`, the top cells vacuum.
+    pub surface_nm: Option<Array2<f64>>,
 }
 
 /// A particle ready for rasterising: its spheres unwrapped next to the first
@@ -452,14 +456,16 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         grid: *grid,
         fractions,
         top_cells,
+        surface_nm: None,
     }
 }
 
 impl Raster {
     /// `ε = (1 − Σ f_s) ε_bg + Σ f_s ε_s` per voxel, written into `out`
     /// (shape `(nz, ny, nx)`); allocates nothing. The background `ε_bg` is
-    /// `eps_binder`, or vacuum (1) in the [`Raster::top_cells`] slices above
-    /// the binder. Evaluated left to right as `ε_bg·(1 − F) + ε_0·f_0 +
+    /// `eps_binder` below the binder surface and vacuum (1) above it (the
+    /// [`Raster::top_cells`] slices above the plane `z = 0`, or the surface
+    /// map, which mixes the two in the voxel it cuts). Evaluated left to right as `ε_bg·(1 − F) + ε_0·f_0 +
     /// ε_1·f_1 + …` with `F = f_0 + f_1 + …`.
     ///
     /// # Panics
@@ -488,11 +494,6 @@ impl Raster {
             Some(o) if contiguous && plane > 0 => {
                 o.par_chunks_mut(plane).enumerate().for_each(|(iz, chunk)| {
                     let range = iz * plane..(iz + 1) * plane;
-                    let eps_bg = if iz < self.top_cells {
-                        Complex64::new(1.0, 0.0)
-                    } else {
-                        eps_binder
-                    };
                     // The real part holds F until the binder term replaces it.
                     chunk.fill(Complex64::new(0.0, 0.0));
                     for f in &self.fractions {
@@ -501,8 +502,18 @@ impl Raster {
                             e.re += v;
                         }
                     }
-                    for e in chunk.iter_mut() {
-                        *e = eps_bg * (1.0 - e.re);
+                    match &self.surface_nm {
+                        None => {
+                            let eps_bg = self.background(eps_binder, iz, 1.0);
+                            for e in chunk.iter_mut() {
+                                *e = eps_bg * (1.0 - e.re);
+                            }
+                        }
+                        Some(s) => {
+                            for (e, &depth) in chunk.iter_mut().zip(s.iter()) {
+                                *e = self.background(eps_binder, iz, depth) * (1.0 - e.re);
+                            }
+                        }
                     }
                     for (f, &es) in self.fractions.iter().zip(eps_species) {
                         let Some(fs) = f.as_slice() else { continue };
@@ -515,12 +526,8 @@ impl Raster {
             _ => {
                 for ((iz, iy, ix), e) in out.indexed_iter_mut() {
                     let total: f64 = self.fractions.iter().map(|f| f[[iz, iy, ix]]).sum();
-                    let eps_bg = if iz < self.top_cells {
-                        Complex64::new(1.0, 0.0)
-                    } else {
-                        eps_binder
-                    };
-                    *e = eps_bg * (1.0 - total);
+                    let depth = self.surface_nm.as_ref().map_or(1.0, |s| s[[iy, ix]]);
+                    *e = self.background(eps_binder, iz, depth) * (1.0 - total);
                     for (f, &es) in self.fractions.iter().zip(eps_species) {
                         *e += es * f[[iz, iy, ix]];
                     }
@@ -539,6 +546,65 @@ impl Raster {
             .iter()
             .map(|f| if n == 0 { 0.0 } else { f.sum() / n as f64 })
             .collect()
+    }
+
+    /// The non-grain permittivity of slice `iz` in a column whose binder
+    /// surface lies at `depth` (nm below `z = 0`; without a surface map the
+    /// plane, and `depth` is ignored): binder below the surface, vacuum
+    /// above, mixed by volume in the voxel the surface cuts.
+    #[inline]
+    fn background(&self, eps_binder: Complex64, iz: usize, depth: f64) -> Complex64 {
+        let one = Complex64::new(1.0, 0.0);
+        match self.surface_nm {
+            None if iz < self.top_cells => one,
+            None => eps_binder,
+            Some(_) => {
+                let dz = self.grid.cell_nm()[2];
+                let z_lo = (iz as f64 - self.top_cells as f64) * dz;
+                let b = surface::binder_share(z_lo, dz, depth);
+                one + (eps_binder - one) * b
+            }
+        }
+    }
+
+    /// This raster under `k` more slices of vacuum on top (a grid extended
+    /// by [`Grid::with_top_nm`] for a surface above `z = 0`).
+    pub fn with_top_cells(self, k: usize) -> Raster {
+        if k == 0 {
+            return self;
+        }
+        let g = self.grid;
+        let grid = Grid {
+            nz: g.nz + k,
+            size_nm: [
+                g.size_nm[0],
+                g.size_nm[1],
+                g.size_nm[2] * (g.nz + k) as f64 / g.nz as f64,
+            ],
+            ..g
+        };
+        let fractions = self
+            .fractions
+            .into_iter()
+            .map(|f| {
+                let mut padded = Array3::zeros((g.nz + k, g.ny, g.nx));
+                padded.slice_mut(ndarray::s![k.., .., ..]).assign(&f);
+                padded
+            })
+            .collect();
+        Raster {
+            grid,
+            fractions,
+            top_cells: self.top_cells + k,
+            surface_nm: self.surface_nm,
+        }
+    }
+
+    /// Mean depth of the binder surface below `z = 0`, nm (0 for the plane).
+    pub fn mean_surface_depth_nm(&self) -> f64 {
+        self.surface_nm
+            .as_ref()
+            .map_or(0.0, |s| s.mean().unwrap_or(0.0))
     }
 
     /// Height of the grid above the binder surface, nm.

@@ -210,6 +210,7 @@ pub fn rasterize_primitives(primitives: &[Primitive], grid: &Grid) -> Raster {
         grid: *grid,
         fractions,
         top_cells: 0,
+        surface_nm: None,
     }
 }
 

@@ -2,8 +2,11 @@
 //! `[grid]` (from a cell size or explicit FFT-friendly counts).
 
 use super::{Checker, REL_EPS};
-use crate::config::raw::{RawGrid, RawLayer};
-use crate::config::{ConfigError, GridSpec, Layer, MAX_EQUILIBRATE_SWEEPS, MAX_RELIEF_FRACTION};
+use crate::config::raw::{RawGrid, RawLayer, RawSurface};
+use crate::config::{
+    ConfigError, GridSpec, Layer, Surface, MAX_EQUILIBRATE_SWEEPS, MAX_FILM_FRACTION,
+    MAX_RELIEF_FRACTION, MAX_ROUGH_RMS_FRACTION,
+};
 
 const MAX_THICKNESS_NM: f64 = 20_000.0;
 const MAX_FRAGMENT_NM: f64 = 100_000.0;
@@ -60,6 +63,7 @@ impl Checker<'_> {
                 ),
             ));
         }
+        let surface = self.surface(raw.surface.as_ref(), thickness_nm, frag)?;
         Ok(Layer {
             thickness_nm,
             fragment_x_nm: frag[0],
@@ -67,6 +71,54 @@ impl Checker<'_> {
             binder_index,
             relief_fraction,
             equilibrate_sweeps: sweeps as u64,
+            surface,
+        })
+    }
+
+    /// `layer.surface`: the film within half the layer, the roughness within
+    /// a quarter of it, its correlation length within the fragment.
+    fn surface(
+        &self,
+        raw: Option<&RawSurface>,
+        thickness_nm: f64,
+        fragment_nm: [f64; 2],
+    ) -> Result<Surface, ConfigError> {
+        Ok(match raw {
+            None | Some(RawSurface::Flat) => Surface::Flat,
+            Some(&RawSurface::Conformal { film_nm }) => {
+                let max = MAX_FILM_FRACTION * thickness_nm;
+                Surface::Conformal {
+                    film_nm: self.range(
+                        "layer.surface.film_nm",
+                        film_nm,
+                        film_nm > 0.0 && film_nm <= max,
+                        &format!("(0, {max}] nm (half the layer)"),
+                    )?,
+                }
+            }
+            Some(&RawSurface::Rough {
+                rms_nm,
+                correlation_nm,
+            }) => {
+                let max = MAX_ROUGH_RMS_FRACTION * thickness_nm;
+                let rms_nm = self.range(
+                    "layer.surface.rms_nm",
+                    rms_nm,
+                    rms_nm > 0.0 && rms_nm <= max,
+                    &format!("(0, {max}] nm (a quarter of the layer)"),
+                )?;
+                let lmax = fragment_nm[0].min(fragment_nm[1]);
+                let correlation_nm = self.range(
+                    "layer.surface.correlation_nm",
+                    correlation_nm,
+                    correlation_nm > 0.0 && correlation_nm <= lmax,
+                    &format!("(0, {lmax}] nm (the fragment's shorter side)"),
+                )?;
+                Surface::Rough {
+                    rms_nm,
+                    correlation_nm,
+                }
+            }
         })
     }
 

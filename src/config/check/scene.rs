@@ -4,7 +4,8 @@
 use super::Checker;
 use crate::config::raw::{RawConfig, RawOutput, RawRealisations};
 use crate::config::{
-    ConfigError, Material, OutputSpec, Provenance, RealisationTarget, Scene, Structure,
+    ConfigError, GrainShape, Material, OutputSpec, Provenance, RealisationTarget, Scene, Structure,
+    Surface,
 };
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
@@ -55,6 +56,20 @@ impl Checker<'_> {
             ));
         }
         let substrate = self.substrate(raw.substrate.as_ref())?;
+        if layer.surface != Surface::Flat {
+            let molecular =
+                !species.is_empty() && species.iter().all(|s| s.shape == GrainShape::Molecular);
+            if molecular || matches!(structure, Some(Structure::Hdf5(_))) {
+                return Err(self.invalid(
+                    "layer.surface",
+                    if molecular {
+                        "a molecular mixture is a homogeneous slab solved in closed form, whose surface is flat: remove layer.surface"
+                    } else {
+                        "an ε grid read from a file carries its own surface: remove layer.surface"
+                    },
+                ));
+            }
+        }
 
         let mut materials: Vec<(&Material, String)> = species
             .iter()

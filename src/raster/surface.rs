@@ -196,8 +196,9 @@ mod tests {
             let n = s.len() as f64;
             let mean = s.sum() / n;
             let rms = (s.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt();
+            // Exact before the ±4σ limit, which moves a few columns.
             assert!(
-                mean.abs() < 1e-12 && (rms - sigma).abs() < 1e-9,
+                mean.abs() < 1e-2 * sigma && (rms - sigma).abs() < 1e-2 * sigma,
                 "{mean} {rms}"
             );
             let lag = |l: usize| {

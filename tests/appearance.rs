@@ -459,6 +459,47 @@ fn merl_export_of_bare_paper_is_albedo_over_pi_everywhere() {
 }
 
 #[test]
+fn merl_export_stays_bounded_at_grazing_angles() {
+    // The BRDF is the table's density over its coverage, finite up to the
+    // horizon: no bin at grazing angles may exceed the largest value seen
+    // at moderate angles by more than the BRDF's own variation (a division
+    // by cos θo put spikes of 100/sr and more there).
+    use inksim::output::merl;
+    let dir = tempfile::tempdir().unwrap();
+    let text = grains_scene(
+        dir.path(),
+        2,
+        "[appearance]\nquadrature_points = 4\noutputs = [\"tile\", \"merl\"]",
+    );
+    run_text(dir.path(), &text);
+    let bytes = std::fs::read(dir.path().join("grains.binary")).unwrap();
+    let (mut moderate, mut grazing) = (0.0f64, 0.0f64);
+    for ih in (0..90).step_by(3) {
+        for id in (0..90).step_by(3) {
+            for ip in (0..180).step_by(9) {
+                let (ti, to, _) = merl::bin_angles(ih, id, ip);
+                if ti >= 90.0 || to >= 90.0 {
+                    continue;
+                }
+                let v = merl::lookup(&bytes, ih, id, ip).unwrap();
+                let m = v.iter().cloned().fold(0.0, f64::max);
+                assert!(m.is_finite() && m >= 0.0);
+                if ti.max(to) <= 60.0 {
+                    moderate = moderate.max(m);
+                } else if ti.max(to) >= 85.0 {
+                    grazing = grazing.max(m);
+                }
+            }
+        }
+    }
+    assert!(moderate > 0.0 && grazing > 0.0);
+    assert!(
+        grazing < 1.5 * moderate,
+        "grazing {grazing} vs moderate {moderate}"
+    );
+}
+
+#[test]
 fn colour_between_solved_wavelengths_follows_the_proxy() {
     // For a clear binder layer the spectral proxy (the molecular-mixture
     // slab) is the layer itself, so the colour from 3 solved wavelengths must

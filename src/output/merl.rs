@@ -16,7 +16,9 @@
 //! - the layer's BRDF is known at the illumination angles solved; between them
 //!   it is interpolated linearly in θi, beyond the largest it is held at the
 //!   last solved angle (likewise T(θ) for the paper term); the table in
-//!   outgoing directions is the ensemble-mean density table (bilinear);
+//!   outgoing directions is the ensemble-mean density table, read as the
+//!   BRDF over each node's coverage (bilinear; `optics::farfield::table`),
+//!   so it stays bounded at grazing angles;
 //! - the layer is taken as isotropic in azimuth (the ensemble is).
 //!
 //! Bin centres are used for every (θh, θd, φd); directions below the horizon
@@ -24,6 +26,7 @@
 
 use crate::optics::appearance::Appearance;
 use crate::optics::colour::{self, Observer};
+use crate::optics::farfield::table;
 use std::f64::consts::PI;
 
 const N_TH: usize = 90;
@@ -139,6 +142,11 @@ pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
             .collect()
     });
     let (cell, half) = (sp.table.cell, sp.table.half as f64);
+    // Node coverage (share of each node's kernel above the horizon): the
+    // BRDF is the density over it (optics::farfield::table).
+    let coverage: Vec<f64> = (0..nt * nt)
+        .map(|k| table::node_coverage(sp.table, k % nt, k / nt))
+        .collect();
     let density = |i: usize, sx: f64, sy: f64| -> [f64; 3] {
         let (x, y) = (sx / cell + half, sy / cell + half);
         let max = (nt - 1) as f64;
@@ -150,13 +158,24 @@ pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
             (y.floor() as usize).min(nt - 2),
         );
         let (fx, fy) = (x - q as f64, y - j as f64);
-        let at = |jj: usize, qq: usize| rgb_tab[i * nt * nt + jj * nt + qq];
-        let (a, b, c, d) = (at(j, q), at(j, q + 1), at(j + 1, q), at(j + 1, q + 1));
+        let w = [
+            (j, q, (1.0 - fx) * (1.0 - fy)),
+            (j, q + 1, fx * (1.0 - fy)),
+            (j + 1, q, (1.0 - fx) * fy),
+            (j + 1, q + 1, fx * fy),
+        ];
+        let cov: f64 = w
+            .iter()
+            .map(|&(jj, qq, wt)| coverage[jj * nt + qq] * wt)
+            .sum();
+        if cov <= 0.0 {
+            return [0.0; 3];
+        }
         std::array::from_fn(|ch| {
-            a[ch] * (1.0 - fx) * (1.0 - fy)
-                + b[ch] * fx * (1.0 - fy)
-                + c[ch] * (1.0 - fx) * fy
-                + d[ch] * fx * fy
+            w.iter()
+                .map(|&(jj, qq, wt)| rgb_tab[i * nt * nt + jj * nt + qq][ch] * wt)
+                .sum::<f64>()
+                / cov
         })
     };
     let n = N_TH * N_TD * N_PD;
@@ -180,10 +199,9 @@ pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
                 let (k, f) = bracket(&sp.illumination_deg, theta_i);
                 let d0 = density(k, sx, sy);
                 let d1 = if ni > 1 { density(k + 1, sx, sy) } else { d0 };
-                let cos_o = wo[2];
                 let mut rgb = [0.0; 3];
                 for ch in 0..3 {
-                    rgb[ch] = (d0[ch] * (1.0 - f) + d1[ch] * f) / cos_o;
+                    rgb[ch] = d0[ch] * (1.0 - f) + d1[ch] * f;
                 }
                 if let Some(pk) = &paper {
                     for l in 0..nl {

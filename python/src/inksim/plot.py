@@ -82,6 +82,12 @@ def _table(result: Result, which: str) -> xr.DataArray:
     return tab
 
 
+def _coverage(result: Result) -> np.ndarray:
+    """Each table node's share of its kernel above the horizon
+    (``/appearance/table_coverage``): the BRDF is the density over it."""
+    return np.asarray(result.appearance["table_coverage"].values, dtype=float)
+
+
 def _interp(density: np.ndarray, cell: float, sx: np.ndarray, sy: np.ndarray) -> np.ndarray:
     """Bilinear interpolation of a node table ``density[j, i]`` at ``(sx, sy)``
     (as the Rust ``AngularTable::density_at``; NaN outside the table)."""
@@ -113,8 +119,9 @@ def _select(tab: xr.DataArray, wavelength: Optional[float], illumination: Option
 def brdf_in_plane(result: Result, wavelength: Optional[float] = None,
                   illumination: Optional[float] = None, which: str = "brdf",
                   theta_deg: Optional[np.ndarray] = None) -> xr.DataArray:
-    """The diffuse BRDF (or BTDF) f = D / cos θ in the plane of incidence,
-    read off the angular table by bilinear interpolation, over a signed
+    """The diffuse BRDF (or BTDF) f = D / C in the plane of incidence (D the
+    table's density, C its nodes' coverage above the horizon), read off the
+    angular table by bilinear interpolation, over a signed
     viewing angle ``theta_deg`` (positive: specular side, φ = azimuth;
     negative: back towards the source). Dims (illumination_deg, theta_deg)
     or (theta_deg) when one illumination angle is chosen."""
@@ -124,13 +131,13 @@ def brdf_in_plane(result: Result, wavelength: Optional[float] = None,
     th = np.linspace(-80.0, 80.0, 321) if theta_deg is None else np.asarray(theta_deg, dtype=float)
     s = np.sin(np.radians(th))
     sx, sy = s * np.cos(az), s * np.sin(az)
-    cos = np.cos(np.radians(th))
+    cov = _interp(_coverage(result), cell, sx, sy)
     data = tab.values
     if data.ndim == 2:
-        vals = _interp(data, cell, sx, sy) / cos
+        vals = _interp(data, cell, sx, sy) / cov
         dims = ("theta_deg",)
     else:
-        vals = np.stack([_interp(data[k], cell, sx, sy) / cos for k in range(data.shape[0])])
+        vals = np.stack([_interp(data[k], cell, sx, sy) / cov for k in range(data.shape[0])])
         dims = ("illumination_deg", "theta_deg")
     coords = {"theta_deg": ("theta_deg", th, {"units": "deg",
                                               "long_name": "signed viewing angle in the plane of incidence"})}
@@ -145,7 +152,7 @@ def brdf_in_plane(result: Result, wavelength: Optional[float] = None,
 def brdf_on_grid(result: Result, wavelength: Optional[float] = None,
                  illumination: Optional[float] = None, which: str = "brdf",
                  theta_max_deg: float = 80.0, n_theta: int = 81, n_phi: int = 181) -> xr.DataArray:
-    """f = D / cos θ on a regular (θ, φ) grid, for one wavelength and one
+    """f = D / C on a regular (θ, φ) grid, for one wavelength and one
     illumination angle (default: the largest)."""
     tab = _table(result, which)
     if illumination is None:
@@ -156,7 +163,7 @@ def brdf_on_grid(result: Result, wavelength: Optional[float] = None,
     ph = np.linspace(-180.0, 180.0, n_phi)
     T, P = np.meshgrid(np.radians(th), np.radians(ph), indexing="ij")
     sx, sy = np.sin(T) * np.cos(P), np.sin(T) * np.sin(P)
-    vals = _interp(t.values, cell, sx, sy) / np.cos(T)
+    vals = _interp(t.values, cell, sx, sy) / _interp(_coverage(result), cell, sx, sy)
     return xr.DataArray(
         vals, dims=("theta_deg", "phi_deg"),
         coords={"theta_deg": ("theta_deg", th, {"units": "deg", "long_name": "polar angle"}),

@@ -220,7 +220,7 @@ class Result:
 
     @property
     def brdf(self) -> Optional[xr.DataArray]:
-        """``brdf_table`` (density f cos θ, sr⁻¹) over (wavelength_nm,
+        """``brdf_table`` (density per projected solid angle, sr⁻¹; f = density / ``table_coverage``) over (wavelength_nm,
         illumination_deg, sy, sx) with node directions ``sx``, ``sy``,
         ``theta_deg``, ``phi_deg``."""
         if self.appearance is None or "brdf_table" not in self.appearance:

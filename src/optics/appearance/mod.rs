@@ -96,7 +96,8 @@ pub struct Appearance {
     pub specular_incoherent: Array2<f64>,
     pub direct_coherent: Array2<f64>,
     pub direct_incoherent: Array2<f64>,
-    /// Density tables `f cos θ`, (wavelength, illumination, j, i).
+    /// Density tables (power per projected solid angle; the BRDF is the
+    /// density over the node coverage), (wavelength, illumination, j, i).
     pub brdf_table: Estimate<Ix4>,
     pub btdf_table: Option<Estimate<Ix4>>,
     /// Layer-only diffuse BRDF in the plane of incidence, (wavelength,

@@ -127,6 +127,18 @@ pub(super) fn write_appearance(
         g.new_dataset_builder().with_data(v.view()).create(name)?;
     }
     write_estimate(&g, "brdf_table", &a.brdf_table)?;
+    let nt = sp.table.n();
+    let coverage = ndarray::Array2::from_shape_fn((nt, nt), |(j, i)| {
+        crate::optics::farfield::table::node_coverage(sp.table, i, j)
+    });
+    described(
+        &g,
+        "table_coverage",
+        coverage.view(),
+        "1",
+        "share of each table node's bilinear kernel above the horizon; the BRDF/BTDF is \
+         bilinear(table) / bilinear(table_coverage)",
+    )?;
     write_estimate(&g, "brdf_diffuse", &a.brdf_diffuse)?;
     if let Some(t) = &a.btdf_table {
         write_estimate(&g, "btdf_table", t)?;

@@ -77,8 +77,9 @@
 //! - `reflectance`, `transmittance`, `absorption` (L × A);
 //!   `specular_coherent`, `specular_incoherent`, `direct_coherent`,
 //!   `direct_incoherent` (L × A: |⟨r00⟩|², ⟨|r00|²⟩ − |⟨r00⟩|², same for t00);
-//! - `brdf_table` (L × I × N × N: density f cos θ on nodes
-//!   s = (i − N/2, j − N/2)·cell, row j along sin θ sin φ), `brdf_diffuse`
+//! - `brdf_table` (L × I × N × N: density per projected solid angle on nodes
+//!   s = (i − N/2, j − N/2)·cell, row j along sin θ sin φ; the BRDF is the
+//!   density over `table_coverage`, N × N), `brdf_diffuse`
 //!   (L × I × V, 1/sr, plane of incidence, specular side); `btdf_table`,
 //!   `btdf_diffuse` likewise when requested;
 //! - with paper: attribute `paper_albedo`, `r_dd_up`, `t_d` (L);

@@ -2,7 +2,8 @@
 //! packer, checked by brute force (all pairs, 3×3 periodic images).
 
 mod common;
-use common::brute_min_gap;
+use common::layers::brute_min_gap;
+use common::threads::on_threads;
 use inksim::geometry::{
     analyse, axis_from_uniforms, order_parameter, pack_dynamics, particle_axis, union_volume,
     DynParams, DynSpecies, Geometry, GeometryError, Orientation, Shape, ShapeTemplate,
@@ -573,13 +574,7 @@ fn relief_lets_grains_protrude_and_raster_covers_them() {
 /// bit-identical particles after the same number of steps, and returns the
 /// packing.
 fn pack_thread_independent(params: &DynParams, seed: u64) -> Geometry {
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| pack_dynamics(params, seed).unwrap())
-    };
+    let run = |threads| on_threads(threads, || pack_dynamics(params, seed).unwrap());
     let (a, b) = (run(1), run(2));
     assert_eq!(a.particles, b.particles);
     assert_eq!(a.stats.relax_steps, b.stats.relax_steps);

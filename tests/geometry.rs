@@ -2,7 +2,7 @@
 //! against brute-force O(N²) references.
 
 mod common;
-use common::brute_min_gap;
+use common::layers::brute_min_gap;
 use inksim::geometry::{
     min_gap_nm, pack_rsa, sphere_volume, Geometry, GeometryError, PackParams, Particle,
     SpeciesParams, Sphere,

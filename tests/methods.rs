@@ -11,7 +11,7 @@ use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{layer_eps, packed_rsa, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-9,
     max_iterations: 20000,
@@ -100,7 +100,7 @@ fn check_airy(method: Method, ctl: &Controls) {
             continue;
         };
         let ff = efficiencies(&sol);
-        let (r0, t0) = common::airy_power(lat.k0, eps, lat.q[0].hypot(lat.q[1]), h);
+        let (r0, t0) = common::airy::airy_power(lat.k0, eps, lat.q[0].hypot(lat.q[1]), h);
         let err = (ff.total_reflectance - r0)
             .abs()
             .max((ff.total_transmittance - t0).abs());

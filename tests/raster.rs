@@ -9,6 +9,9 @@ use num_complex::Complex64;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
+mod common;
+use common::threads::on_threads;
+
 const SIZE: [f64; 3] = [1000.0, 1000.0, 500.0];
 
 fn geometry(size_nm: [f64; 3], particles: Vec<Particle>, n_species: usize) -> Geometry {
@@ -284,12 +287,8 @@ fn thread_count_does_not_change_the_raster() {
     );
     let g = pack_rsa(&params, 4).unwrap();
     let grid = Grid::new(50, 48, 24, g.size_nm).unwrap();
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+    let run = |threads| {
+        on_threads(threads, || {
             let r = rasterize(&g, &grid, 5);
             let mut eps = Array3::zeros((24, 48, 50));
             r.epsilon_into(

@@ -13,7 +13,7 @@ use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{layer_eps, packed_rsa, EPS_B};
 
 #[test]
 fn reflected_orders_are_reciprocal() {

@@ -7,7 +7,8 @@ use inksim::solver::{self, Controls, Problem, SolveError};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::{layer_eps, packed_rsa as packed, EPS_B};
+use common::layers::{layer_eps, packed_rsa as packed, EPS_B};
+use common::threads::on_threads;
 const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
@@ -161,7 +162,7 @@ fn shrinking_grains_approach_the_volume_averaged_slab() {
         .expect("solve");
         let ff = efficiencies(&sol);
         let mean = (1.0 - f) * EPS_B + f * n_p * n_p;
-        let (r0, t0) = common::airy_power(lat.k0, mean, 0.0, size[2]);
+        let (r0, t0) = common::airy::airy_power(lat.k0, mean, 0.0, size[2]);
         let err = (ff.total_reflectance - r0)
             .abs()
             .max((ff.total_transmittance - t0).abs());
@@ -184,12 +185,8 @@ fn same_result_for_one_and_two_threads() {
     let geom = packed(size, 150.0, 0.2, 5);
     let cells = [24, 24, 30];
     let (eps, _) = layer_eps(&geom, cells, C64::new(1.4, 0.6));
-    let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+    let run = |threads| {
+        on_threads(threads, || {
             let lat = Problem::lattice([24, 24, 30], size, 500.0, 30.0, 10.0);
             let s = solver::solve(
                 &Problem {

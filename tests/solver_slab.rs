@@ -34,7 +34,7 @@ fn slab_solve(
     )
     .expect("solve");
     let kap = lat.q[0].hypot(lat.q[1]);
-    let (r, t) = common::airy(lat.k0, eps, kap, h);
+    let (r, t) = common::airy::airy(lat.k0, eps, kap, h);
     let ff = inksim::optics::farfield::efficiencies(&sol);
     (
         ff.total_reflectance,

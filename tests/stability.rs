@@ -13,7 +13,7 @@ use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::{layer_eps, EPS_B};
+use common::layers::{layer_eps, EPS_B};
 const CTL: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20_000,

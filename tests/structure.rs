@@ -11,6 +11,9 @@ use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use std::path::Path;
 
+mod common;
+use common::airy::tmm;
+
 fn material() -> Material {
     Material::from_csv_text("m", "wavelength_nm,n,k\n1,2,0.1\n1000000,2,0.1\n").unwrap()
 }
@@ -80,38 +83,6 @@ fn boxes_are_exact_and_curved_bodies_keep_their_volume() {
             "{body:?}: {vol} vs {exact}"
         );
     }
-}
-
-/// Transfer matrix of a stack of homogeneous layers (ε, thickness) in
-/// vacuum: power reflectance and transmittance (an independent derivation).
-fn tmm(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
-    let k0 = 2.0 * PI / wl;
-    let kx = k0 * polar.to_radians().sin();
-    let kz = |eps: C64| {
-        let g = (eps * k0 * k0 - kx * kx).sqrt();
-        if g.im < 0.0 {
-            -g
-        } else {
-            g
-        }
-    };
-    // Field (u, u'/i) propagated from the bottom (transmitted wave t = 1).
-    let b = kz(C64::new(1.0, 0.0));
-    let (mut u, mut du) = (C64::new(1.0, 0.0), b);
-    for &(eps, d) in layers.iter().rev() {
-        let g = kz(eps);
-        let (c, s) = ((g * d).cos(), (g * d).sin());
-        let (u2, du2) = (
-            c * u - C64::i() * s * du / g,
-            -C64::i() * g * s * u + c * du,
-        );
-        u = u2;
-        du = du2;
-    }
-    // Above: u = a + r, du = b (a − r).
-    let a = (u + du / b) / 2.0;
-    let r = (u - du / b) / 2.0;
-    ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
 }
 
 fn slab_scene(dir: &Path, z_cell: f64) -> String {

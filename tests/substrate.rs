@@ -8,7 +8,7 @@ use inksim::solver::{self, Controls, Problem};
 use ndarray::{s, Array3};
 
 mod common;
-use common::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{layer_eps, packed_rsa, EPS_B};
 use num_complex::Complex64 as C64;
 
 #[test]

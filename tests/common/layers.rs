@@ -1,0 +1,68 @@
+//! A layer of one pigment in the binder, from packing to ε, and a
+//! brute-force check of particle gaps.
+
+use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
+use inksim::raster::{rasterize, Grid};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
+
+/// Binder permittivity of the reference data (n = 1.558).
+pub const EPS_B: f64 = 1.558 * 1.558;
+
+/// Spheres of diameter `d` by random sequential addition.
+pub fn packed_rsa(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {
+    let params = PackParams {
+        size_nm: size,
+        species: vec![SpeciesParams {
+            diameter_nm: d,
+            volume_fraction: pvc,
+        }],
+        ..PackParams::default()
+    };
+    pack_rsa(&params, seed).expect("packing")
+}
+
+/// ε on a `[nx, ny, nz]` grid for grains of index `n` in the binder, and the
+/// rasterised pigment fraction.
+pub fn layer_eps(geom: &Geometry, cells: [usize; 3], n: C64) -> (Array3<C64>, f64) {
+    let grid = Grid {
+        nx: cells[0],
+        ny: cells[1],
+        nz: cells[2],
+        size_nm: geom.size_nm,
+    };
+    let raster = rasterize(geom, &grid, 4);
+    let mut eps = Array3::zeros((cells[2], cells[1], cells[0]));
+    raster.epsilon_into(C64::new(EPS_B, 0.0), &[n * n], &mut eps);
+    (eps, raster.mean_fractions()[0])
+}
+
+/// Smallest surface gap over all pairs of particles, brute force, checking
+/// the 3×3 periodic images explicitly (not just the nearest one).
+pub fn brute_min_gap(g: &Geometry) -> f64 {
+    let [lx, ly, _] = g.size_nm;
+    let all: Vec<(usize, Sphere)> = g
+        .particles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, p)| p.spheres.iter().map(move |s| (i, *s)))
+        .collect();
+    let mut best = f64::INFINITY;
+    for (a, (pa, sa)) in all.iter().enumerate() {
+        for (pb, sb) in &all[a + 1..] {
+            if pa == pb {
+                continue;
+            }
+            for ix in -1..=1 {
+                for iy in -1..=1 {
+                    let dx = sa.center[0] - sb.center[0] + ix as f64 * lx;
+                    let dy = sa.center[1] - sb.center[1] + iy as f64 * ly;
+                    let dz = sa.center[2] - sb.center[2];
+                    let gap = (dx * dx + dy * dy + dz * dz).sqrt() - sa.radius - sb.radius;
+                    best = best.min(gap);
+                }
+            }
+        }
+    }
+    best
+}

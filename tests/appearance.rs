@@ -14,6 +14,7 @@ use std::path::Path;
 
 mod common;
 use common::airy::{airy_power, airy_rt};
+use common::scene::{PigmentToml, SceneToml};
 
 /// A CSV material of constant index n + 0i over 380–780 nm.
 fn constant_material(dir: &Path, name: &str, n: f64) -> String {
@@ -25,45 +26,20 @@ fn constant_material(dir: &Path, name: &str, n: f64) -> String {
     format!("{name}.csv")
 }
 
-fn run_text(dir: &Path, text: &str) -> RunReport {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    let scene = parse_scene(&path, text).unwrap();
-    pipeline::run(&scene).unwrap()
-}
-
 /// A homogeneous (molecular) layer of index `n` in a binder of the same
 /// index: a plain slab, on paper of albedo 0.9.
-fn slab_scene(dir: &Path, binder: f64, quadrature: usize) -> String {
+fn slab_scene(dir: &Path, binder: f64, quadrature: i64) -> SceneToml {
     let csv = constant_material(dir, "plain", binder);
-    format!(
-        r#"
-seed = 3
-[layer]
-thickness_nm = 1000.0
-fragment_nm = [1000.0, 1000.0]
-binder_index = {binder}
-[[pigment]]
-name = "dissolved"
-material = {{ csv = "{csv}" }}
-pvc = 0.2
-shape = {{ kind = "molecular" }}
-[grid]
-cell_nm = 50.0
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0, 20.0, 40.0, 60.0]
-[appearance]
-quadrature_points = {quadrature}
-[substrate]
-kind = "paper"
-albedo = 0.9
-[output]
-dir = "{}"
-name = "slab"
-"#,
-        dir.display()
-    )
+    SceneToml::slab()
+        .seed(3)
+        .fragment_nm(1000.0)
+        .binder_index(binder)
+        .pigment(PigmentToml::csv("dissolved", &csv).pvc(0.2).molecular())
+        .cell_nm(50.0)
+        .polar_deg(&[0.0, 20.0, 40.0, 60.0])
+        .quadrature_points(quadrature)
+        .paper(0.9)
+        .output(dir, "slab")
 }
 
 #[test]
@@ -71,7 +47,7 @@ fn bare_paper_renders_its_albedo_as_grey() {
     // A vacuum "layer" (binder and pigment of index 1) transmits everything:
     // what is seen is the paper alone, 0.9 at every angle and wavelength.
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.0, 6));
+    let rep = slab_scene(dir.path(), 1.0, 6).run(dir.path());
     let a = rep.appearance.unwrap();
     let grey = (inksim::optics::colour::srgb_encode(0.9) * 255.0).round() as u8;
     assert_eq!(grey, 243);
@@ -121,7 +97,7 @@ fn clear_binder_on_paper_matches_the_closed_form_at_every_angle() {
     let dir = tempfile::tempdir().unwrap();
     let eps = 1.558f64.powi(2);
     for (nodes, tol) in [(32, 1e-9), (12, 1e-3), (6, 2.5e-2)] {
-        let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.558, nodes));
+        let rep = slab_scene(dir.path(), 1.558, nodes).run(dir.path());
         let a = rep.appearance.unwrap();
         let sp = &a.spec;
         let total = a.brdf_total.as_ref().unwrap();
@@ -153,42 +129,25 @@ fn clear_binder_on_paper_matches_the_closed_form_at_every_angle() {
     }
 }
 
-/// A small random layer of absorbing spheres; `extra` is appended.
-fn grains_scene(dir: &Path, realisations: usize, extra: &str) -> String {
-    format!(
-        r#"
-seed = 11
-realisations = {realisations}
-[layer]
-thickness_nm = 300.0
-fragment_nm = [800.0, 800.0]
-[[pigment]]
-name = "blue"
-material = {{ builtin = "blue" }}
-pvc = 0.15
-diameter_nm = 120.0
-[grid]
-nx = 16
-ny = 16
-nz = 10
-[illumination]
-wavelengths_nm = [500.0, 620.0]
-polar_deg = [0.0, 25.0, 50.0]
-[solver]
-tolerance = 1e-8
-[output]
-dir = "{}"
-name = "grains"
-{extra}
-"#,
-        dir.display()
-    )
+/// A small random layer of absorbing spheres.
+fn grains_scene(dir: &Path, realisations: i64) -> SceneToml {
+    SceneToml::grains()
+        .seed(11)
+        .realisations(realisations)
+        .thickness_nm(300.0)
+        .fragment_nm(800.0)
+        .pigment(PigmentToml::builtin("blue").pvc(0.15).diameter_nm(120.0))
+        .grid_n([16, 16, 10])
+        .wavelengths_nm(&[500.0, 620.0])
+        .polar_deg(&[0.0, 25.0, 50.0])
+        .tolerance(1e-8)
+        .output(dir, "grains")
 }
 
 #[test]
 fn ensemble_balances_energy_and_tables_preserve_power() {
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(dir.path(), &grains_scene(dir.path(), 3, ""));
+    let rep = grains_scene(dir.path(), 3).run(dir.path());
     let a = rep.appearance.as_ref().unwrap();
     let sum = &a.reflectance.mean + &a.transmittance.mean + &a.absorption.mean;
     assert!(sum.iter().all(|v| (v - 1.0).abs() < 1e-6), "{sum:?}");
@@ -249,10 +208,7 @@ fn diffuse_brdf_is_reciprocal_within_its_standard_error() {
     // f(θi → θo) = f(θo → θi) in the plane of incidence holds for the
     // ensemble (reciprocity plus statistical isotropy), not per fragment.
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(
-        dir.path(),
-        &grains_scene(dir.path(), 8, "[substrate]\nkind = \"none\"\n"),
-    );
+    let rep = grains_scene(dir.path(), 8).no_substrate().run(dir.path());
     let a = rep.appearance.unwrap();
     let (f, se) = (&a.brdf_diffuse.mean, a.brdf_diffuse.se.as_ref().unwrap());
     let n = a.spec.illumination_deg.len();
@@ -283,10 +239,9 @@ fn standard_errors_follow_one_over_root_r() {
     // wider than the χ²₇ 98 % band). Equal seeds or correlated
     // realisations would make the batch means collapse or spread.
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(
-        dir.path(),
-        &grains_scene(dir.path(), 32, "[appearance]\noutputs = [\"brdf\"]\n"),
-    );
+    let rep = grains_scene(dir.path(), 32)
+        .outputs(&["brdf"])
+        .run(dir.path());
     let a = rep.appearance.as_ref().unwrap();
     let x: Vec<f64> = (0..32)
         .map(|r| {
@@ -316,12 +271,11 @@ fn standard_errors_follow_one_over_root_r() {
 #[test]
 fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
     let dir = tempfile::tempdir().unwrap();
-    let full_text = grains_scene(
-        dir.path(),
-        2,
-        "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\nquadrature_points = 4\nmeasurements = []\n",
-    );
-    let full = run_text(dir.path(), &full_text);
+    let full = grains_scene(dir.path(), 2)
+        .viewing_deg(&[0.0, 10.0, 25.0, 50.0])
+        .quadrature_points(4)
+        .measurements(&[])
+        .run(dir.path());
     let s = scene_of(dir.path());
     let plan = RunPlan::of(&s);
     // From above: illumination ∪ viewing; from below: the 4 nodes.
@@ -329,14 +283,11 @@ fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
     assert_eq!(full.entries.len(), 2 * 2 * (4 + 4));
 
     // No substrate: no solves from below, same layer BRDF bit for bit.
-    let bare = run_text(
-        dir.path(),
-        &grains_scene(
-            dir.path(),
-            2,
-            "[appearance]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\nmeasurements = []\n[substrate]\nkind = \"none\"\n",
-        ),
-    );
+    let bare = grains_scene(dir.path(), 2)
+        .viewing_deg(&[0.0, 10.0, 25.0, 50.0])
+        .measurements(&[])
+        .no_substrate()
+        .run(dir.path());
     assert!(bare.entries.iter().all(|e| e.side == Side::Above));
     assert_eq!(bare.entries.len(), 2 * 2 * 4);
     let plan_text = &RunPlan::of(&scene_of(dir.path())).lines.join("\n");
@@ -346,14 +297,10 @@ fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
     );
 
     // BRDF only: illumination angles only, no colours.
-    let brdf = run_text(
-        dir.path(),
-        &grains_scene(
-            dir.path(),
-            2,
-            "[appearance]\noutputs = [\"brdf\"]\nviewing_deg = [0.0, 10.0, 25.0, 50.0]\n",
-        ),
-    );
+    let brdf = grains_scene(dir.path(), 2)
+        .outputs(&["brdf"])
+        .viewing_deg(&[0.0, 10.0, 25.0, 50.0])
+        .run(dir.path());
     assert_eq!(brdf.entries.len(), 2 * 2 * 3);
     let b = brdf.appearance.unwrap();
     assert!(b.colours.is_none() && b.natural.is_none() && b.paper.is_none());
@@ -369,35 +316,19 @@ fn a_scene_that_asks_for_less_runs_less_and_gets_the_same_answer() {
 #[test]
 fn molecular_mixture_is_the_airy_slab_of_the_mean_permittivity() {
     let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        r#"
-realisations = 4
-[layer]
-thickness_nm = 800.0
-fragment_nm = [1000.0, 1000.0]
-pvc = 0.3
-[[pigment]]
-name = "yellow"
-material = {{ builtin = "yellow" }}
-shape = {{ kind = "molecular" }}
-[[pigment]]
-name = "blue"
-material = {{ builtin = "blue" }}
-shape = {{ kind = "molecular" }}
-[grid]
-cell_nm = 50.0
-[illumination]
-wavelengths_nm = [450.0, 600.0]
-polar_deg = [0.0, 45.0]
-[appearance]
-outputs = ["brdf"]
-[output]
-dir = "{}"
-name = "mol"
-"#,
-        dir.path().display()
-    );
-    let rep = run_text(dir.path(), &text);
+    let rep = SceneToml::slab()
+        .realisations(4)
+        .thickness_nm(800.0)
+        .fragment_nm(1000.0)
+        .layer_pvc(0.3)
+        .pigment(PigmentToml::builtin("yellow").molecular())
+        .add_pigment(PigmentToml::builtin("blue").molecular())
+        .cell_nm(50.0)
+        .wavelengths_nm(&[450.0, 600.0])
+        .polar_deg(&[0.0, 45.0])
+        .outputs(&["brdf"])
+        .output(dir.path(), "mol")
+        .run(dir.path());
     let s = scene_of(dir.path());
     assert!(RunPlan::of(&s).lines[1].contains("1 of 4 requested"));
     assert_eq!(rep.entries.len(), 4);
@@ -425,11 +356,9 @@ name = "mol"
 fn merl_export_of_bare_paper_is_albedo_over_pi_everywhere() {
     use inksim::output::merl;
     let dir = tempfile::tempdir().unwrap();
-    let text = slab_scene(dir.path(), 1.0, 4).replace(
-        "quadrature_points = 4",
-        "quadrature_points = 4\noutputs = [\"tile\", \"merl\"]",
-    );
-    run_text(dir.path(), &text);
+    slab_scene(dir.path(), 1.0, 4)
+        .outputs(&["tile", "merl"])
+        .run(dir.path());
     let bytes = std::fs::read(dir.path().join("slab.binary")).unwrap();
     assert_eq!(&bytes[..12], &[90, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0]);
     let mut valid = 0;
@@ -502,7 +431,7 @@ fn colour_between_solved_wavelengths_follows_the_proxy() {
     // equal the colour of the closed-form spectrum on the proxy's 5 nm grid
     // (where linear interpolation of 3 samples would not).
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(dir.path(), &slab_scene(dir.path(), 1.558, 32));
+    let rep = slab_scene(dir.path(), 1.558, 32).run(dir.path());
     let a = rep.appearance.unwrap();
     let eps = 1.558f64.powi(2);
     let (ill, so) = a.colour_conditions.unwrap();
@@ -552,10 +481,9 @@ fn colour_standard_errors_agree_with_batch_means() {
     use inksim::optics::appearance::assemble;
     use inksim::optics::colour::{delta_e2000, Observer};
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(
-        dir.path(),
-        &grains_scene(dir.path(), 32, "[appearance]\nquadrature_points = 4\n"),
-    );
+    let rep = grains_scene(dir.path(), 32)
+        .quadrature_points(4)
+        .run(dir.path());
     let a = rep.appearance.as_ref().unwrap();
     let c = a.colours.as_ref().unwrap();
     let spread = c.spread.as_ref().expect("32 realisations have a spread");
@@ -614,7 +542,7 @@ fn colour_standard_errors_agree_with_batch_means() {
     assert!((0.6..1.5).contains(&r_lab), "L*a*b* ratio {r_lab}");
     assert!((0.6..1.5).contains(&r_de), "ΔE00 ratio {r_de}");
     // One realisation has no spread.
-    let one = run_text(dir.path(), &grains_scene(dir.path(), 1, ""));
+    let one = grains_scene(dir.path(), 1).run(dir.path());
     assert!(one.appearance.unwrap().colours.unwrap().spread.is_none());
 }
 
@@ -636,11 +564,9 @@ fn measured(
 fn bare_paper_measures_its_albedo_in_every_geometry_and_illuminant() {
     use inksim::optics::colour::{Illuminant, Observer, StandardObserver};
     let dir = tempfile::tempdir().unwrap();
-    let text = slab_scene(dir.path(), 1.0, 6).replace(
-        "polar_deg = [0.0, 20.0, 40.0, 60.0]",
-        "polar_deg = [0.0, 8.0, 45.0]",
-    );
-    let rep = run_text(dir.path(), &text);
+    let rep = slab_scene(dir.path(), 1.0, 6)
+        .polar_deg(&[0.0, 8.0, 45.0])
+        .run(dir.path());
     let l_star = 116.0 * 0.9f64.cbrt() - 16.0;
     for ill in Illuminant::ALL {
         for so in StandardObserver::ALL {
@@ -679,11 +605,9 @@ fn clear_binder_on_paper_measures_as_the_closed_form() {
     use inksim::optics::colour::Observer;
     let dir = tempfile::tempdir().unwrap();
     let eps = 1.558f64.powi(2);
-    let text = slab_scene(dir.path(), 1.558, 32).replace(
-        "polar_deg = [0.0, 20.0, 40.0, 60.0]",
-        "polar_deg = [0.0, 8.0, 45.0]",
-    );
-    let rep = run_text(dir.path(), &text);
+    let rep = slab_scene(dir.path(), 1.558, 32)
+        .polar_deg(&[0.0, 8.0, 45.0])
+        .run(dir.path());
     let m = measured(&rep, &Observer::cie1931_d65());
     let wls = &rep.appearance.as_ref().unwrap().spec.wavelengths_nm;
     for c in &m {
@@ -718,7 +642,7 @@ fn clear_binder_on_paper_measures_as_the_closed_form() {
 fn measurement_geometries_run_by_default_and_reach_the_result_file() {
     use inksim::config::{Illuminant, StandardObserver};
     let dir = tempfile::tempdir().unwrap();
-    let rep = run_text(dir.path(), &grains_scene(dir.path(), 2, ""));
+    let rep = grains_scene(dir.path(), 2).run(dir.path());
     let a = rep.appearance.as_ref().unwrap();
     assert_eq!(a.spec.above_deg, [0.0, 8.0, 25.0, 45.0, 50.0]);
     assert_eq!(

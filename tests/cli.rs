@@ -4,27 +4,24 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const TINY: &str = r#"
-seed = 3
-[layer]
-thickness_nm = 400.0
-fragment_nm = [500.0, 500.0]
-[[pigment]]
-name = "red"
-material = { builtin = "red" }
-pvc = 0.15
-diameter_nm = 150.0
-[grid]
-cell_nm = 25.0
-z_cell_nm = 20.0
-[illumination]
-wavelengths_nm = [500.0, 600.0]
-polar_deg = [0.0, 40.0]
-[solver]
-tolerance = 1e-7
-[output]
-name = "tiny"
-"#;
+mod common;
+use common::scene::SceneToml;
+
+/// Red spheres, 15 % PVC of 150 nm, in a 400 nm layer: 20 × 20 × 20 cells,
+/// two wavelengths, two angles.
+fn tiny() -> SceneToml {
+    SceneToml::grains()
+        .seed(3)
+        .thickness_nm(400.0)
+        .fragment_nm(500.0)
+        .pvc(0.15)
+        .diameter_nm(150.0)
+        .z_cell_nm(20.0)
+        .wavelengths_nm(&[500.0, 600.0])
+        .polar_deg(&[0.0, 40.0])
+        .tolerance(1e-7)
+        .output_name("tiny")
+}
 
 fn inksim(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
@@ -38,16 +35,10 @@ fn inksim(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-fn write_config(dir: &Path, text: &str) -> PathBuf {
-    let p = dir.join("scene.toml");
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
 /// `inksim run` on `text` written into `dir`, results in `dir/out`:
 /// (success, stderr, config path, output folder).
-fn run_scene(dir: &Path, text: &str) -> (bool, String, PathBuf, PathBuf) {
-    let cfg = write_config(dir, text);
+fn run_scene(dir: &Path, scene: &SceneToml) -> (bool, String, PathBuf, PathBuf) {
+    let cfg = scene.write(dir);
     let out = dir.join("out");
     let (ok, _, err) = inksim(&[
         "run",
@@ -60,9 +51,9 @@ fn run_scene(dir: &Path, text: &str) -> (bool, String, PathBuf, PathBuf) {
 
 /// Run a broken config; expect failure with one error line mentioning `needle`
 /// and nothing written to the output folder.
-fn expect_error(text: &str, needle: &str) {
+fn expect_error(scene: SceneToml, needle: &str) {
     let dir = tempfile::tempdir().unwrap();
-    let (ok, err, _, out) = run_scene(dir.path(), text);
+    let (ok, err, _, out) = run_scene(dir.path(), &scene);
     assert!(!ok, "should fail: {needle}");
     assert!(!err.contains("panicked"), "{err}");
     let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
@@ -77,31 +68,28 @@ fn expect_error(text: &str, needle: &str) {
 
 #[test]
 fn unknown_key_is_named() {
-    expect_error(&TINY.replace("seed = 3", "seed = 3\ncolour = 1"), "colour");
+    expect_error(tiny().set("colour", 1), "colour");
 }
 
 #[test]
 fn negative_thickness_is_named() {
-    expect_error(
-        &TINY.replace("thickness_nm = 400.0", "thickness_nm = -5.0"),
-        "layer.thickness_nm",
-    );
+    expect_error(tiny().thickness_nm(-5.0), "layer.thickness_nm");
 }
 
 #[test]
 fn pvc_beyond_packer_is_named() {
-    expect_error(&TINY.replace("pvc = 0.15", "pvc = 0.6"), "0.55");
+    expect_error(tiny().pvc(0.6), "0.55");
 }
 
 #[test]
 fn wavelength_outside_pigment_data_is_named() {
-    expect_error(&TINY.replace("[500.0, 600.0]", "[500.0, 900.0]"), "900");
+    expect_error(tiny().wavelengths_nm(&[500.0, 900.0]), "900");
 }
 
 #[test]
 fn unwritable_output_folder_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let blocker = dir.path().join("file");
     std::fs::write(&blocker, b"x").unwrap();
     let out = blocker.join("sub");
@@ -128,7 +116,7 @@ fn missing_config_file_is_named() {
 #[test]
 fn run_writes_results_identical_for_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let mut summaries = vec![];
     for threads in ["1", "2"] {
         let out = dir.path().join(format!("t{threads}"));
@@ -184,11 +172,11 @@ fn run_writes_results_identical_for_one_and_two_threads() {
 #[test]
 fn grain_longer_than_half_the_fragment_is_named_once() {
     let dir = tempfile::tempdir().unwrap();
-    let text = TINY.replace(
-        "diameter_nm = 150.0",
-        "diameter_nm = 200.0\nshape = { kind = \"rice\", aspect = 3.0, spheres = 3 }",
+    let scene = tiny().diameter_nm(200.0).raw(
+        "pigment.0.shape",
+        "{ kind = \"rice\", aspect = 3.0, spheres = 3 }",
     );
-    let (ok, err, _, out) = run_scene(dir.path(), &text);
+    let (ok, err, _, out) = run_scene(dir.path(), &scene);
     assert!(!ok, "{err}");
     assert!(!err.contains("panicked"), "{err}");
     let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
@@ -206,15 +194,15 @@ fn grain_longer_than_half_the_fragment_is_named_once() {
 #[test]
 fn dense_rice_layer_uses_dynamics_and_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let text = TINY
-        .replace("pvc = 0.15", "pvc = 0.45")
-        .replace(
-            "diameter_nm = 150.0",
-            "diameter_nm = 80.0\nshape = { kind = \"rice\" }\norientation = \"in-plane\"\nalignment_field = 1.0",
-        )
-        .replace("wavelengths_nm = [500.0, 600.0]", "wavelengths_nm = [550.0]")
-        .replace("polar_deg = [0.0, 40.0]", "polar_deg = [20.0]");
-    let (ok, err, cfg, out) = run_scene(dir.path(), &text);
+    let scene = tiny()
+        .pvc(0.45)
+        .diameter_nm(80.0)
+        .raw("pigment.0.shape", "{ kind = \"rice\" }")
+        .set("pigment.0.orientation", "in-plane")
+        .set("pigment.0.alignment_field", 1.0)
+        .wavelengths_nm(&[550.0])
+        .polar_deg(&[20.0]);
+    let (ok, err, cfg, out) = run_scene(dir.path(), &scene);
     assert!(ok, "{err}");
     assert!(err.contains("geometry: dynamics"), "{err}");
     let s_value: f64 = err
@@ -233,7 +221,7 @@ fn dense_rice_layer_uses_dynamics_and_runs() {
 #[test]
 fn sparse_spheres_use_random_addition() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let (ok, out, err) = inksim(&["check", cfg.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.contains("geometry: rsa"), "{out}");
@@ -242,7 +230,7 @@ fn sparse_spheres_use_random_addition() {
 #[test]
 fn geometry_command_writes_particles_and_picture() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let out = dir.path().join("geo");
     let (ok, stdout, err) = inksim(&[
         "geometry",

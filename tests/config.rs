@@ -6,46 +6,31 @@ use num_complex::Complex64;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
-/// A small valid scene; tests change one thing with [`edit`].
-const BASE: &str = r#"
-[layer]
-thickness_nm = 1000.0
-fragment_nm = [2000.0, 2000.0]
+mod common;
+use common::scene::{PigmentToml, SceneToml};
 
-[[pigment]]
-name = "red"
-material = { builtin = "red" }
-pvc = 0.2
-diameter_nm = 200.0
-
-[grid]
-cell_nm = 25.0
-
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0, 30.0]
-"#;
-
-const SECOND_PIGMENT: &str = r#"
-[[pigment]]
-name = "yellow"
-material = { builtin = "yellow" }
-pvc = 0.2
-diameter_nm = 200.0
-"#;
-
-fn edit(from: &str, to: &str) -> String {
-    assert!(BASE.contains(from), "test bug: `{from}` not in BASE");
-    BASE.replacen(from, to, 1)
+/// A small valid scene (one red pigment in a 1 µm layer); tests change one
+/// thing.
+fn base() -> SceneToml {
+    SceneToml::grains()
 }
 
-fn parse(text: &str) -> Result<Scene, ConfigError> {
+/// A second pigment beside the red one.
+fn second_pigment() -> PigmentToml {
+    PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(200.0)
+}
+
+fn parse_text(text: &str) -> Result<Scene, ConfigError> {
     parse_scene(Path::new("cfg/test.toml"), text)
 }
 
-/// Parses `text`, expects `ConfigError::Invalid`, returns (key, full message).
-fn invalid(text: &str) -> (String, String) {
-    match parse(text) {
+fn parse(scene: &SceneToml) -> Result<Scene, ConfigError> {
+    parse_text(&scene.toml())
+}
+
+/// Parses `scene`, expects `ConfigError::Invalid`, returns (key, full message).
+fn invalid(scene: &SceneToml) -> (String, String) {
+    match parse(scene) {
         Err(e @ ConfigError::Invalid { .. }) => {
             let shown = e.to_string();
             assert!(shown.starts_with("cfg/test.toml: "), "{shown}");
@@ -100,9 +85,53 @@ fn demo_parses_with_expected_values() {
         .all(|c| c.is_ascii_hexdigit() && !c.is_ascii_uppercase()));
 }
 
+/// The base scene as a user would write it: the builder that the tests
+/// here vary emits exactly these keys and values, and its edits (a key
+/// replaced, a pigment added, a key dropped) land where they are meant to.
+#[test]
+fn scene_builder_writes_what_a_user_would() {
+    let by_hand: toml::Table = r#"
+[layer]
+thickness_nm = 1000.0
+fragment_nm = [2000.0, 2000.0]
+
+[[pigment]]
+name = "red"
+material = { builtin = "red" }
+pvc = 0.2
+diameter_nm = 200.0
+
+[grid]
+cell_nm = 25.0
+
+[illumination]
+wavelengths_nm = [450.0, 550.0, 650.0]
+polar_deg = [0.0, 30.0]
+"#
+    .parse()
+    .unwrap();
+    assert_eq!(base().table(), &by_hand);
+    let edited: toml::Table = base()
+        .grid_n([8, 8, 4])
+        .add_pigment(second_pigment())
+        .without("illumination.polar_deg")
+        .toml()
+        .parse()
+        .unwrap();
+    assert_eq!(edited["grid"].to_string(), "{ nx = 8, ny = 8, nz = 4 }");
+    let pigments = edited["pigment"].as_array().unwrap();
+    assert_eq!(pigments.len(), 2);
+    assert_eq!(pigments[0], by_hand["pigment"][0]);
+    assert_eq!(pigments[1]["material"]["builtin"].as_str(), Some("yellow"));
+    assert!(!edited["illumination"]
+        .as_table()
+        .unwrap()
+        .contains_key("polar_deg"));
+}
+
 #[test]
 fn defaults_apply() {
-    let s = parse(BASE).unwrap();
+    let s = parse(&base()).unwrap();
     assert_eq!(s.seed, 1);
     assert_eq!(s.layer.binder_index, 1.558);
     assert_eq!(s.solver.method, Method::Auto);
@@ -133,50 +162,44 @@ fn solver_methods_parse() {
         ("time-marching", Method::TimeMarching),
         ("auto", Method::Auto),
     ] {
-        let text = format!("{BASE}\n[solver]\nmethod = \"{word}\"\nmax_iterations = 7\n");
-        let s = parse(&text).unwrap();
+        let s = parse(&base().method(word).max_iterations(7)).unwrap();
         assert_eq!(s.solver.method, want);
         assert_eq!(s.solver.max_iterations, 7);
     }
-    let err = parse(&format!("{BASE}\n[solver]\nmethod = \"cg\"\n")).unwrap_err();
+    let err = parse(&base().method("cg")).unwrap_err();
     assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
     assert!(err.to_string().contains("cg"), "{err}");
 }
 
 #[test]
 fn solver_precision_parses_and_limits_the_tolerance() {
-    assert_eq!(parse(BASE).unwrap().solver.precision, Precision::F64);
+    assert_eq!(parse(&base()).unwrap().solver.precision, Precision::F64);
     for (word, want) in [("f64", Precision::F64), ("f32", Precision::F32)] {
-        let s = parse(&format!("{BASE}\n[solver]\nprecision = \"{word}\"\n")).unwrap();
+        let s = parse(&base().precision(word)).unwrap();
         assert_eq!(s.solver.precision, want);
     }
     // f32 fields cannot hold a residual below 1e-6; f64 can.
-    let tight = "[solver]\nprecision = \"{p}\"\ntolerance = 1e-9\n";
-    assert!(parse(&format!("{BASE}\n{}", tight.replace("{p}", "f64"))).is_ok());
-    let (key, msg) = invalid(&format!("{BASE}\n{}", tight.replace("{p}", "f32")));
+    let tight = |p| base().precision(p).tolerance(1e-9);
+    assert!(parse(&tight("f64")).is_ok());
+    let (key, msg) = invalid(&tight("f32"));
     assert_eq!(key, "solver.tolerance");
     assert!(msg.contains("f32") && msg.contains("1e-6"), "{msg}");
-    let err = parse(&format!("{BASE}\n[solver]\nprecision = \"f16\"\n")).unwrap_err();
+    let err = parse(&base().precision("f16")).unwrap_err();
     assert!(err.to_string().contains("f16"), "{err}");
 }
 
 #[test]
 fn effective_medium_tolerance_defaults_and_is_limited() {
-    assert_eq!(parse(BASE).unwrap().solver.effective_medium_tolerance, 1e-3);
-    for v in ["0.0", "0.02", "0.1"] {
-        let s = parse(&format!(
-            "{BASE}\n[solver]\neffective_medium_tolerance = {v}\n"
-        ))
-        .unwrap();
-        assert_eq!(
-            s.solver.effective_medium_tolerance,
-            v.parse::<f64>().unwrap()
-        );
+    assert_eq!(
+        parse(&base()).unwrap().solver.effective_medium_tolerance,
+        1e-3
+    );
+    for v in [0.0, 0.02, 0.1] {
+        let s = parse(&base().effective_medium_tolerance(v)).unwrap();
+        assert_eq!(s.solver.effective_medium_tolerance, v);
     }
-    for v in ["-1e-3", "0.2", "nan"] {
-        let (key, msg) = invalid(&format!(
-            "{BASE}\n[solver]\neffective_medium_tolerance = {v}\n"
-        ));
+    for v in [-1e-3, 0.2, f64::NAN] {
+        let (key, msg) = invalid(&base().effective_medium_tolerance(v));
         assert_eq!(key, "solver.effective_medium_tolerance");
         assert!(msg.contains("[0, 0.1]"), "{msg}");
     }
@@ -184,11 +207,27 @@ fn effective_medium_tolerance_defaults_and_is_limited() {
 
 #[test]
 fn unknown_key_is_named_on_one_line() {
-    let text = edit(
-        "thickness_nm = 1000.0",
-        "thickness_nm = 1000.0\nthicknes_nm = 5.0",
-    );
-    let err = parse(&text).unwrap_err();
+    // The literal text is the point: the typo sits on line 4, column 1.
+    let text = r#"
+[layer]
+thickness_nm = 1000.0
+thicknes_nm = 5.0
+fragment_nm = [2000.0, 2000.0]
+
+[[pigment]]
+name = "red"
+material = { builtin = "red" }
+pvc = 0.2
+diameter_nm = 200.0
+
+[grid]
+cell_nm = 25.0
+
+[illumination]
+wavelengths_nm = [450.0, 550.0, 650.0]
+polar_deg = [0.0, 30.0]
+"#;
+    let err = parse_text(text).unwrap_err();
     assert!(matches!(err, ConfigError::Parse { .. }), "{err:?}");
     let shown = err.to_string();
     assert!(
@@ -201,7 +240,7 @@ fn unknown_key_is_named_on_one_line() {
 
 #[test]
 fn negative_thickness_names_key_and_range() {
-    let (key, shown) = invalid(&edit("thickness_nm = 1000.0", "thickness_nm = -5.0"));
+    let (key, shown) = invalid(&base().thickness_nm(-5.0));
     assert_eq!(key, "layer.thickness_nm");
     assert!(shown.contains("(0, 20000] nm"), "{shown}");
     assert!(shown.contains("got -5"), "{shown}");
@@ -210,68 +249,38 @@ fn negative_thickness_names_key_and_range() {
 #[test]
 fn other_ranges_are_checked() {
     let cases = [
+        (base().binder_index(0.9), "layer.binder_index"),
         (
-            edit("[2000.0, 2000.0]", "[2000.0, 2000.0]\nbinder_index = 0.9"),
-            "layer.binder_index",
-        ),
-        (
-            edit(
-                "fragment_nm = [2000.0, 2000.0]",
-                "fragment_nm = [2000.0, 0.0]",
-            ),
+            base().raw("layer.fragment_nm", "[2000.0, 0.0]"),
             "layer.fragment_nm[1]",
         ),
         (
-            edit("fragment_nm = [2000.0, 2000.0]", "fragment_nm = [2000.0]"),
+            base().raw("layer.fragment_nm", "[2000.0]"),
             "layer.fragment_nm",
         ),
-        (edit("pvc = 0.2", "pvc = 0.0"), "pigment[0].pvc"),
+        (base().pvc(0.0), "pigment[0].pvc"),
+        (base().diameter_nm(1200.0), "pigment[0].diameter_nm"),
+        (base().cell_nm(0.0), "grid.cell_nm"),
+        (base().cell_nm(0.1), "grid.cell_nm"),
+        (base().polar_deg(&[0.0, 90.0]), "illumination.polar_deg[1]"),
+        (base().polar_deg(&[30.0, 0.0]), "illumination.polar_deg[1]"),
+        (base().polar_deg(&[]), "illumination.polar_deg"),
         (
-            edit("diameter_nm = 200.0", "diameter_nm = 1200.0"),
-            "pigment[0].diameter_nm",
-        ),
-        (edit("cell_nm = 25.0", "cell_nm = 0.0"), "grid.cell_nm"),
-        (edit("cell_nm = 25.0", "cell_nm = 0.1"), "grid.cell_nm"),
-        (
-            edit("polar_deg = [0.0, 30.0]", "polar_deg = [0.0, 90.0]"),
-            "illumination.polar_deg[1]",
-        ),
-        (
-            edit("polar_deg = [0.0, 30.0]", "polar_deg = [30.0, 0.0]"),
-            "illumination.polar_deg[1]",
-        ),
-        (
-            edit("polar_deg = [0.0, 30.0]", "polar_deg = []"),
-            "illumination.polar_deg",
-        ),
-        (
-            edit(
-                "polar_deg = [0.0, 30.0]",
-                "polar_deg = [0.0]\nazimuth_deg = 400.0",
-            ),
+            base().polar_deg(&[0.0]).azimuth_deg(400.0),
             "illumination.azimuth_deg",
         ),
         (
-            edit("[450.0, 550.0, 650.0]", "[450.0, 450.0]"),
+            base().wavelengths_nm(&[450.0, 450.0]),
             "illumination.wavelengths_nm[1]",
         ),
+        (base().wavelengths_nm(&[]), "illumination.wavelengths_nm"),
+        (base().seed(-1), "seed"),
+        (base().tolerance(0.5), "solver.tolerance"),
+        (base().max_iterations(0), "solver.max_iterations"),
+        (base().output_name("a/b"), "output.name"),
+        (base().set("output.dir", ""), "output.dir"),
         (
-            edit("[450.0, 550.0, 650.0]", "[]"),
-            "illumination.wavelengths_nm",
-        ),
-        (format!("seed = -1\n{BASE}"), "seed"),
-        (
-            format!("{BASE}[solver]\ntolerance = 0.5\n"),
-            "solver.tolerance",
-        ),
-        (
-            format!("{BASE}[solver]\nmax_iterations = 0\n"),
-            "solver.max_iterations",
-        ),
-        (format!("{BASE}[output]\nname = \"a/b\"\n"), "output.name"),
-        (format!("{BASE}[output]\ndir = \"\"\n"), "output.dir"),
-        (
-            edit("{ builtin = \"red\" }", "{ builtin = \"purple\" }"),
+            base().set("pigment.0.material.builtin", "purple"),
             "pigment[0].material.builtin",
         ),
     ];
@@ -284,18 +293,18 @@ fn other_ranges_are_checked() {
 
 #[test]
 fn pvc_above_packer_limit_is_rejected() {
-    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.4", 2);
+    let text = base().pvc(0.4).add_pigment(second_pigment().pvc(0.4));
     let (key, shown) = invalid(&text);
     assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
     assert!(shown.contains("0.55"), "{shown}");
     assert_eq!(MAX_PVC, 0.55);
 
     // A single species above the limit, too.
-    let (key, _) = invalid(&edit("pvc = 0.2", "pvc = 0.56"));
+    let (key, _) = invalid(&base().pvc(0.56));
     assert!(key.starts_with("pigment") && key.ends_with("pvc"), "{key}");
 
     // Exactly at the limit (0.35 + 0.2 = 0.5499999999999999 or so in f64) passes.
-    let text = format!("{BASE}{SECOND_PIGMENT}").replacen("pvc = 0.2", "pvc = 0.35", 1);
+    let text = base().pvc(0.35).add_pigment(second_pigment());
     let s = parse(&text).unwrap();
     assert_eq!(s.species.len(), 2);
     assert!((s.total_pvc() - 0.55).abs() < 1e-15);
@@ -303,10 +312,13 @@ fn pvc_above_packer_limit_is_rejected() {
 
 #[test]
 fn grain_shapes_and_orientation_are_read_and_checked() {
-    let rice = edit(
-        "diameter_nm = 200.0",
-        "diameter_nm = 200.0\nshape = { kind = \"rice\", aspect = 4.0, spheres = 9 }\norientation = \"in-plane\"\nalignment_field = 0.5",
-    );
+    let rice = base()
+        .raw(
+            "pigment.0.shape",
+            "{ kind = \"rice\", aspect = 4.0, spheres = 9 }",
+        )
+        .set("pigment.0.orientation", "in-plane")
+        .set("pigment.0.alignment_field", 0.5);
     let s = parse(&rice).unwrap();
     assert_eq!(
         s.species[0].shape,
@@ -318,10 +330,7 @@ fn grain_shapes_and_orientation_are_read_and_checked() {
     assert_eq!(s.species[0].orientation, GrainOrientation::InPlane);
     assert_eq!(s.species[0].alignment_field, 0.5);
     // Defaults: a cylinder of length 6 radii (aspect 3) with 5 spheres.
-    let cyl = edit(
-        "diameter_nm = 200.0",
-        "diameter_nm = 200.0\nshape = { kind = \"cylinder\" }",
-    );
+    let cyl = base().raw("pigment.0.shape", "{ kind = \"cylinder\" }");
     assert_eq!(
         parse(&cyl).unwrap().species[0].shape,
         GrainShape::Cylinder {
@@ -330,40 +339,40 @@ fn grain_shapes_and_orientation_are_read_and_checked() {
         }
     );
     // Spheres by default, random orientation, no field.
-    let s = parse(BASE).unwrap();
+    let s = parse(&base()).unwrap();
     assert_eq!(
         (s.species[0].shape, s.species[0].orientation),
         (GrainShape::Sphere, GrainOrientation::Random)
     );
     // Errors name the key.
+    let shape = |text| base().raw("pigment.0.shape", text);
     let bad = [
-        ("shape = { kind = \"banana\" }", "pigment[0].shape"),
+        (shape("{ kind = \"banana\" }"), "pigment[0].shape"),
         (
-            "shape = { kind = \"rice\", spheres = 1 }",
+            shape("{ kind = \"rice\", spheres = 1 }"),
             "pigment[0].shape.spheres",
         ),
         (
-            "shape = { kind = \"cylinder\", aspect = 8.0, spheres = 4 }",
+            shape("{ kind = \"cylinder\", aspect = 8.0, spheres = 4 }"),
             "pigment[0].shape.spheres",
         ),
         (
-            "shape = { kind = \"rice\", aspect = 0.5 }",
+            shape("{ kind = \"rice\", aspect = 0.5 }"),
             "pigment[0].shape.aspect",
         ),
         (
-            "shape = { kind = \"rice\" }\nalignment_field = 1.0",
+            shape("{ kind = \"rice\" }").set("pigment.0.alignment_field", 1.0),
             "pigment[0].alignment_field",
         ),
         (
-            "alignment_field = 1.0\norientation = \"in-plane\"",
+            base()
+                .set("pigment.0.alignment_field", 1.0)
+                .set("pigment.0.orientation", "in-plane"),
             "pigment[0].alignment_field",
         ),
     ];
-    for (extra, want) in bad {
-        let text = edit(
-            "diameter_nm = 200.0",
-            &format!("diameter_nm = 200.0\n{extra}"),
-        );
+    for (text, want) in bad {
+        let extra = text.table()["pigment"].to_string();
         match parse(&text) {
             Err(ConfigError::Invalid { key, .. }) => assert_eq!(key, want, "{extra}"),
             Err(ConfigError::Parse { message, .. }) => assert!(
@@ -377,41 +386,34 @@ fn grain_shapes_and_orientation_are_read_and_checked() {
 
 #[test]
 fn duplicate_pigment_names_are_rejected() {
-    let text = format!("{BASE}{SECOND_PIGMENT}")
-        .replace("name = \"yellow\"", "name = \"red\"")
-        .replacen("pvc = 0.2", "pvc = 0.1", 2);
+    let text = base()
+        .pvc(0.1)
+        .add_pigment(second_pigment().named("red").pvc(0.1));
     let (key, shown) = invalid(&text);
     assert_eq!(key, "pigment[1].name");
     assert!(
         shown.contains("duplicate") && shown.contains("`red`"),
         "{shown}"
     );
-    let (key, _) = invalid(&edit("name = \"red\"", "name = \" \""));
+    let (key, _) = invalid(&base().set("pigment.0.name", " "));
     assert_eq!(key, "pigment[0].name");
 }
 
 #[test]
 fn missing_pigments_are_rejected() {
-    let start = BASE.find("[[pigment]]").unwrap();
-    let end = BASE.find("[grid]").unwrap();
-    let text = format!("{}{}", &BASE[..start], &BASE[end..]);
-    let (key, _) = invalid(&text);
+    let (key, _) = invalid(&base().without("pigment"));
     assert_eq!(key, "pigment");
 }
 
 #[test]
 fn wavelength_outside_material_range_is_rejected() {
-    let (key, shown) = invalid(&edit("[450.0, 550.0, 650.0]", "[350.0, 450.0]"));
+    let (key, shown) = invalid(&base().wavelengths_nm(&[350.0, 450.0]));
     assert_eq!(key, "illumination.wavelengths_nm");
     assert!(shown.contains("350 nm"), "{shown}");
     assert!(shown.contains("`red`"), "{shown}");
     assert!(shown.contains("[380, 780] nm"), "{shown}");
 
-    let text = edit(
-        "wavelengths_nm = [450.0, 550.0, 650.0]",
-        "wavelength_range_nm = { start = 400.0, stop = 800.0, step = 100.0 }",
-    );
-    let (key, shown) = invalid(&text);
+    let (key, shown) = invalid(&base().wavelength_range_nm(400.0, 800.0, 100.0));
     assert_eq!(key, "illumination.wavelength_range_nm");
     assert!(shown.contains("800 nm"), "{shown}");
 }
@@ -419,103 +421,87 @@ fn wavelength_outside_material_range_is_rejected() {
 #[test]
 fn grid_forms() {
     // both
-    let (key, shown) = invalid(&edit("cell_nm = 25.0", "cell_nm = 25.0\nnx = 80"));
+    let (key, shown) = invalid(&base().set("grid.nx", 80));
     assert_eq!(key, "grid");
     assert!(shown.contains("not both"), "{shown}");
     // neither
-    let (key, _) = invalid(&edit("cell_nm = 25.0", ""));
+    let (key, _) = invalid(&base().set("grid", toml::Table::new()));
     assert_eq!(key, "grid");
     // incomplete explicit form
-    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 80\nny = 80"));
+    let (key, _) = invalid(&base().grid_n([80, 80, 1]).without("grid.nz"));
     assert_eq!(key, "grid.nz");
     // nx must be FFT-friendly
-    let (key, shown) = invalid(&edit("cell_nm = 25.0", "nx = 7\nny = 8\nnz = 10"));
+    let (key, shown) = invalid(&base().grid_n([7, 8, 10]));
     assert_eq!(key, "grid.nx");
     assert!(
         shown.contains("2^a 3^b 5^c") && shown.contains("8"),
         "{shown}"
     );
-    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 8\nny = 8\nnz = 1"));
+    let (key, _) = invalid(&base().grid_n([8, 8, 1]));
     assert_eq!(key, "grid.nz");
-    let (key, _) = invalid(&edit("cell_nm = 25.0", "nx = 8192\nny = 8\nnz = 2"));
+    let (key, _) = invalid(&base().grid_n([8192, 8, 2]));
     assert_eq!(key, "grid.nx");
     // valid explicit form; nz needs no factorisation
-    let g = parse(&edit("cell_nm = 25.0", "nx = 90\nny = 1\nnz = 7"))
-        .unwrap()
-        .grid;
+    let g = parse(&base().grid_n([90, 1, 7])).unwrap().grid;
     assert_eq!((g.nx, g.ny, g.nz), (90, 1, 7));
     // from a cell: 2000/30 = 66.7 -> 67 -> 72 = 2^3 3^2; z cell defaults to 10 nm -> 100
-    let g = parse(&edit("cell_nm = 25.0", "cell_nm = 30.0"))
-        .unwrap()
-        .grid;
+    let g = parse(&base().cell_nm(30.0)).unwrap().grid;
     assert_eq!((g.nx, g.ny, g.nz), (72, 72, 100));
     // explicit z cell: 1000/30 -> 34
-    let g = parse(&edit("cell_nm = 25.0", "cell_nm = 30.0\nz_cell_nm = 30.0"))
-        .unwrap()
-        .grid;
+    let g = parse(&base().cell_nm(30.0).z_cell_nm(30.0)).unwrap().grid;
     assert_eq!((g.nx, g.ny, g.nz), (72, 72, 34));
     // z_cell_nm only goes with cell_nm
-    let (key, _) = invalid(&edit(
-        "cell_nm = 25.0",
-        "nx = 8\nny = 8\nnz = 4\nz_cell_nm = 5.0",
-    ));
+    let (key, _) = invalid(&base().grid_n([8, 8, 4]).z_cell_nm(5.0));
     assert_eq!(key, "grid.z_cell_nm");
     // rounding noise does not add a cell: 1.1/0.1 = 11.000000000000002 in f64
-    let text = BASE
-        .replace("thickness_nm = 1000.0", "thickness_nm = 1.1")
-        .replace("[2000.0, 2000.0]", "[1.1, 1.1]")
-        .replace("diameter_nm = 200.0", "diameter_nm = 1.0")
-        .replace("cell_nm = 25.0", "cell_nm = 0.1");
+    let text = base()
+        .thickness_nm(1.1)
+        .fragment_nm(1.1)
+        .diameter_nm(1.0)
+        .cell_nm(0.1);
     let g = parse(&text).unwrap().grid;
     assert_eq!((g.nx, g.ny, g.nz), (12, 12, 11));
 }
 
 #[test]
 fn wavelength_range_expansion() {
-    let range = |r: &str| {
-        let text = edit(
-            "wavelengths_nm = [450.0, 550.0, 650.0]",
-            &format!("wavelength_range_nm = {{ {r} }}"),
-        );
-        parse(&text).map(|s| s.wavelengths_nm)
+    let range = |start, stop, step| {
+        parse(&base().wavelength_range_nm(start, stop, step)).map(|s| s.wavelengths_nm)
     };
     assert_eq!(
-        range("start = 400.0, stop = 700.0, step = 50.0").unwrap(),
+        range(400.0, 700.0, 50.0).unwrap(),
         [400.0, 450.0, 500.0, 550.0, 600.0, 650.0, 700.0]
     );
     // stop off the step grid is not included
     assert_eq!(
-        range("start = 400.0, stop = 690.0, step = 50.0").unwrap(),
+        range(400.0, 690.0, 50.0).unwrap(),
         [400.0, 450.0, 500.0, 550.0, 600.0, 650.0]
     );
-    assert_eq!(
-        range("start = 500.0, stop = 500.0, step = 10.0").unwrap(),
-        [500.0]
-    );
+    assert_eq!(range(500.0, 500.0, 10.0).unwrap(), [500.0]);
     // 0.1 is inexact in binary; stop is still included, exactly
-    let w = range("start = 400.0, stop = 401.0, step = 0.1").unwrap();
+    let w = range(400.0, 401.0, 0.1).unwrap();
     assert_eq!(w.len(), 11);
     assert_eq!(w[10], 401.0);
-    assert!(range("start = 500.0, stop = 400.0, step = 10.0").is_err());
-    assert!(range("start = 400.0, stop = 500.0, step = 0.0").is_err());
+    assert!(range(500.0, 400.0, 10.0).is_err());
+    assert!(range(400.0, 500.0, 0.0).is_err());
     // both forms at once
-    let text = edit(
-        "wavelengths_nm = [450.0, 550.0, 650.0]",
-        "wavelengths_nm = [450.0]\nwavelength_range_nm = { start = 400.0, stop = 700.0, step = 50.0 }",
+    let text = base().wavelengths_nm(&[450.0]).raw(
+        "illumination.wavelength_range_nm",
+        "{ start = 400.0, stop = 700.0, step = 50.0 }",
     );
     let (key, _) = invalid(&text);
     assert_eq!(key, "illumination");
 }
 
-/// Writes `config.toml` (BASE with a CSV pigment) and `data/ink.csv` into a
+/// Writes `config.toml` (the base scene with a CSV pigment) and `data/ink.csv` into a
 /// temporary folder; returns the folder and the config path.
 fn csv_scene(csv: &str) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("data")).unwrap();
     std::fs::write(dir.path().join("data/ink.csv"), csv).unwrap();
-    let text = edit("{ builtin = \"red\" }", "{ csv = \"data/ink.csv\" }");
+    let text = base().raw("pigment.0.material", "{ csv = \"data/ink.csv\" }");
     let cfg = dir.path().join("config.toml");
-    std::fs::write(&cfg, text).unwrap();
+    std::fs::write(&cfg, text.toml()).unwrap();
     (dir, cfg)
 }
 
@@ -562,11 +548,8 @@ fn bad_csv_error_names_file_and_line() {
     // a missing file names the resolved path
     let dir = tempfile::tempdir().unwrap();
     let cfg = dir.path().join("c.toml");
-    std::fs::write(
-        &cfg,
-        edit("{ builtin = \"red\" }", "{ csv = \"nope.csv\" }"),
-    )
-    .unwrap();
+    let text = base().raw("pigment.0.material", "{ csv = \"nope.csv\" }");
+    std::fs::write(&cfg, text.toml()).unwrap();
     let shown = load_scene(&cfg).unwrap_err().to_string();
     assert!(shown.contains("nope.csv: cannot read"), "{shown}");
 }
@@ -582,8 +565,9 @@ fn hash_covers_config_and_tables() {
     assert_eq!(h1, h2, "same inputs, same hash");
     assert_ne!(h1, h3, "changed table, changed hash");
     // config text alone changes the hash too
-    let a = parse(BASE).unwrap().provenance.input_hash;
-    let b = parse(&format!("{BASE}\n# comment\n"))
+    let text = base().toml();
+    let a = parse_text(&text).unwrap().provenance.input_hash;
+    let b = parse_text(&format!("{text}\n# comment\n"))
         .unwrap()
         .provenance
         .input_hash;
@@ -592,7 +576,7 @@ fn hash_covers_config_and_tables() {
     let red_csv =
         std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/pigments/red.csv")).unwrap();
     let mut h = Sha256::new();
-    h.update(BASE.as_bytes());
+    h.update(text.as_bytes());
     h.update(&red_csv);
     let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
     assert_eq!(a, want);
@@ -613,8 +597,9 @@ fn read_and_parse_errors() {
         .to_string()
         .starts_with("/nonexistent/dir/scene.toml: cannot read"));
     // malformed TOML and wrong types are parse errors on one line
-    for text in ["[layer\n", &edit("1000.0", "\"thick\"")] {
-        let shown = parse(text).unwrap_err().to_string();
+    let thick = base().set("layer.thickness_nm", "thick").toml();
+    for text in ["[layer\n", &thick] {
+        let shown = parse_text(text).unwrap_err().to_string();
         assert!(shown.starts_with("cfg/test.toml: line "), "{shown}");
         assert!(!shown.contains('\n'), "{shown}");
     }
@@ -622,23 +607,18 @@ fn read_and_parse_errors() {
 
 #[test]
 fn size_agglomeration_and_relief_keys() {
-    let text = edit(
-        "diameter_nm = 200.0",
-        "diameter_nm = 200.0\nsize = { kind = \"log-normal\", sigma = 0.2 }\nagglomeration = { cluster_size = 8 }",
-    )
-    .replacen("[layer]", "[layer]\nrelief_fraction = 0.3", 1);
+    let pig = |key: &str, text: &str| base().raw(&format!("pigment.0.{key}"), text);
+    let text = pig("size", "{ kind = \"log-normal\", sigma = 0.2 }")
+        .raw("pigment.0.agglomeration", "{ cluster_size = 8 }")
+        .relief_fraction(0.3);
     let s = parse(&text).unwrap();
     assert_eq!(s.species[0].size, GrainSize::LogNormal { sigma: 0.2 });
     assert_eq!(s.species[0].cluster_size, 8);
     assert_eq!(s.layer.relief_fraction, 0.3);
-    let s = parse(&edit(
-        "diameter_nm = 200.0",
-        "diameter_nm = 200.0\nsize = { kind = \"normal\", sigma = 0.1 }",
-    ))
-    .unwrap();
+    let s = parse(&pig("size", "{ kind = \"normal\", sigma = 0.1 }")).unwrap();
     assert_eq!(s.species[0].size, GrainSize::Normal { sigma: 0.1 });
     // Defaults: fixed size, no clusters, flat top.
-    let s = parse(BASE).unwrap();
+    let s = parse(&base()).unwrap();
     assert_eq!(s.species[0].size, GrainSize::Fixed);
     assert_eq!(s.species[0].cluster_size, 1);
     assert_eq!(s.layer.relief_fraction, 0.0);
@@ -654,40 +634,27 @@ fn size_agglomeration_and_relief_keys() {
     assert_eq!(MAX_CLUSTER_SIZE, inksim::geometry::MAX_CLUSTER_SIZE);
     assert_eq!(MAX_RELIEF_FRACTION, inksim::geometry::MAX_RELIEF_FRACTION);
 
-    let pig = |extra: &str| {
-        edit(
-            "diameter_nm = 200.0",
-            &format!("diameter_nm = 200.0\n{extra}"),
-        )
-    };
     for (text, want, range) in [
         (
-            pig("size = { kind = \"normal\", sigma = 0.4 }"),
+            pig("size", "{ kind = \"normal\", sigma = 0.4 }"),
             "pigment[0].size.sigma",
             "0.3",
         ),
         (
-            pig("size = { kind = \"log-normal\", sigma = -0.1 }"),
+            pig("size", "{ kind = \"log-normal\", sigma = -0.1 }"),
             "pigment[0].size.sigma",
             "0.5",
         ),
         (
-            pig("agglomeration = { cluster_size = 0 }"),
+            pig("agglomeration", "{ cluster_size = 0 }"),
             "pigment[0].agglomeration.cluster_size",
             "10000",
         ),
-        (
-            BASE.replacen("[layer]", "[layer]\nrelief_fraction = 0.7", 1),
-            "layer.relief_fraction",
-            "0.5",
-        ),
+        (base().relief_fraction(0.7), "layer.relief_fraction", "0.5"),
         // Largest draw (3 σ) thicker than the 1000 nm layer: grain larger
         // than the layer.
         (
-            edit(
-                "diameter_nm = 200.0",
-                "diameter_nm = 600.0\nsize = { kind = \"log-normal\", sigma = 0.3 }",
-            ),
+            pig("size", "{ kind = \"log-normal\", sigma = 0.3 }").diameter_nm(600.0),
             "pigment[0].size",
             "1000",
         ),
@@ -697,37 +664,33 @@ fn size_agglomeration_and_relief_keys() {
         assert!(shown.contains(range), "{shown}");
     }
     // Unknown keys and kinds are parse errors naming them.
-    for (extra, word) in [
-        ("size = { kind = \"uniform\" }", "uniform"),
+    for (key, extra, word) in [
+        ("size", "{ kind = \"uniform\" }", "uniform"),
         (
-            "size = { kind = \"normal\", sigma = 0.1, mean = 3 }",
+            "size",
+            "{ kind = \"normal\", sigma = 0.1, mean = 3 }",
             "mean",
         ),
-        ("agglomeration = { size = 3 }", "size"),
+        ("agglomeration", "{ size = 3 }", "size"),
     ] {
-        match parse(&pig(extra)) {
+        match parse(&pig(key, extra)) {
             Err(ConfigError::Parse { message, .. }) => assert!(message.contains(word), "{message}"),
-            other => panic!("{extra}: expected a parse error, got {other:?}"),
+            other => panic!("{key} = {extra}: expected a parse error, got {other:?}"),
         }
     }
 }
 
 #[test]
 fn equilibrate_sweeps_key() {
-    let text = BASE.replacen("[layer]", "[layer]\nequilibrate_sweeps = 200", 1);
+    let text = base().equilibrate_sweeps(200);
     assert_eq!(parse(&text).unwrap().layer.equilibrate_sweeps, 200);
-    assert_eq!(parse(BASE).unwrap().layer.equilibrate_sweeps, 0);
+    assert_eq!(parse(&base()).unwrap().layer.equilibrate_sweeps, 0);
     assert_eq!(
         inksim::config::MAX_EQUILIBRATE_SWEEPS,
         inksim::geometry::mc::MAX_SWEEPS
     );
-    for bad in ["-1", "100001"] {
-        let text = BASE.replacen(
-            "[layer]",
-            &format!("[layer]\nequilibrate_sweeps = {bad}"),
-            1,
-        );
-        let (key, shown) = invalid(&text);
+    for bad in [-1, 100001] {
+        let (key, shown) = invalid(&base().equilibrate_sweeps(bad));
         assert_eq!(key, "layer.equilibrate_sweeps", "{shown}");
         assert!(shown.contains("100000"), "{shown}");
     }
@@ -735,42 +698,43 @@ fn equilibrate_sweeps_key() {
 
 #[test]
 fn colour_conditions_and_measurement_geometries() {
-    let s = parse(BASE).unwrap();
+    let s = parse(&base()).unwrap();
     assert_eq!(s.appearance.illuminant, Illuminant::D50);
     assert_eq!(s.appearance.observer, StandardObserver::TwoDegree);
     assert_eq!(s.appearance.measurements, Measurement::ALL.to_vec());
-    let text = format!(
-        "{BASE}[appearance]\nilluminant = \"a\"\nobserver_deg = 10\nmeasurements = [\"d/8 SCE\"]\n"
-    );
+    let text = base()
+        .illuminant("a")
+        .observer_deg(10)
+        .measurements(&["d/8 SCE"]);
     let s = parse(&text).unwrap();
     assert_eq!(s.appearance.illuminant, Illuminant::A);
     assert_eq!(s.appearance.observer, StandardObserver::TenDegree);
     assert_eq!(s.appearance.measurements, [Measurement::DiffuseEightSce]);
-    let s = parse(&format!("{BASE}[appearance]\nmeasurements = []\n")).unwrap();
+    let s = parse(&base().measurements(&[])).unwrap();
     assert!(s.appearance.measurements.is_empty());
-    for (line, key, says) in [
+    for (text, key, says) in [
         (
-            "illuminant = \"F2\"",
+            base().illuminant("F2"),
             "appearance.illuminant",
             "allowed: \"D50\", \"D65\", \"A\"",
         ),
         (
-            "observer_deg = 5",
+            base().observer_deg(5),
             "appearance.observer_deg",
             "must be 2 (CIE 1931) or 10 (CIE 1964), got 5",
         ),
         (
-            "measurements = [\"0/45\"]",
+            base().measurements(&["0/45"]),
             "appearance.measurements",
             "allowed: \"45/0\", \"d/8 SCI\"",
         ),
         (
-            "measurements = [\"45/0\", \"45/0\"]",
+            base().measurements(&["45/0", "45/0"]),
             "appearance.measurements",
             "listed twice",
         ),
     ] {
-        let (k, shown) = invalid(&format!("{BASE}[appearance]\n{line}\n"));
+        let (k, shown) = invalid(&text);
         assert_eq!(k, key);
         assert!(shown.contains(says), "{shown}");
     }

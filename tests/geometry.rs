@@ -3,6 +3,7 @@
 
 mod common;
 use common::layers::brute_min_gap;
+use common::scene::SceneToml;
 use inksim::geometry::{
     min_gap_nm, pack_rsa, sphere_volume, Geometry, GeometryError, PackParams, Particle,
     SpeciesParams, Sphere,
@@ -684,29 +685,17 @@ fn rsa_relief_lets_grains_protrude_by_the_fraction() {
 /// plan says so, the grains move, and they still do not overlap.
 #[test]
 fn equilibration_key_moves_the_grains_through_the_pipeline() {
-    let text = |sweeps: u64| {
-        format!(
-            r#"
-seed = 4
-[layer]
-thickness_nm = 400.0
-fragment_nm = [600.0, 600.0]
-equilibrate_sweeps = {sweeps}
-[[pigment]]
-name = "red"
-material = {{ builtin = "red" }}
-pvc = 0.2
-diameter_nm = 80.0
-[grid]
-cell_nm = 25.0
-[illumination]
-wavelengths_nm = [550.0]
-polar_deg = [0.0]
-"#
-        )
-    };
     let scene = |sweeps| {
-        inksim::config::parse_scene(std::path::Path::new("eq.toml"), &text(sweeps)).unwrap()
+        SceneToml::grains()
+            .seed(4)
+            .thickness_nm(400.0)
+            .fragment_nm(600.0)
+            .equilibrate_sweeps(sweeps)
+            .diameter_nm(80.0)
+            .wavelengths_nm(&[550.0])
+            .polar_deg(&[0.0])
+            .parse(std::path::Path::new("eq.toml"))
+            .unwrap()
     };
     let (plain, settled) = (scene(0), scene(30));
     let line = |s: &inksim::config::Scene| {

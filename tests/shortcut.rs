@@ -4,10 +4,10 @@
 //! Checked against the same scene forced through the full solve, and the
 //! estimate against full solves of a few layers (docs/ACCURACY.md).
 
-use inksim::config::{parse_scene, Material, Method, Precision, Scene};
+use inksim::config::{Material, Method, Precision};
 use inksim::geometry::{pack_rsa, PackParams, SpeciesParams};
 use inksim::optics::farfield::efficiencies;
-use inksim::pipeline::{self, RunPlan, RunReport};
+use inksim::pipeline::RunPlan;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::airy::{self, GrainTerm};
 use inksim::solver::{self, Controls, Problem};
@@ -15,49 +15,24 @@ use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::path::Path;
 
+mod common;
+use common::scene::{PigmentToml, SceneToml};
+
 /// Red grains of `d` nm at 10 % PVC in a 400 nm layer on paper, tile only.
-fn scene_text(dir: &Path, d: f64, extra_solver: &str) -> String {
-    format!(
-        r#"
-seed = 5
-[layer]
-thickness_nm = 400.0
-fragment_nm = [400.0, 400.0]
-pvc = 0.1
-[[pigment]]
-name = "red"
-material = {{ builtin = "red" }}
-diameter_nm = {d:.1}
-[grid]
-cell_nm = 12.5
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0, 40.0]
-[appearance]
-outputs = ["tile"]
-quadrature_points = 2
-[substrate]
-kind = "paper"
-albedo = 0.9
-[solver]
-tolerance = 1e-7
-{extra_solver}
-[output]
-dir = "{}"
-name = "grains"
-"#,
-        dir.display()
-    )
-}
-
-fn scene(dir: &Path, text: &str) -> Scene {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    parse_scene(&path, text).unwrap()
-}
-
-fn run(dir: &Path, text: &str) -> RunReport {
-    pipeline::run(&scene(dir, text)).unwrap()
+fn grains_scene(dir: &Path, d: f64) -> SceneToml {
+    SceneToml::grains()
+        .seed(5)
+        .thickness_nm(400.0)
+        .fragment_nm(400.0)
+        .layer_pvc(0.1)
+        .pigment(PigmentToml::builtin("red").diameter_nm(d))
+        .cell_nm(12.5)
+        .polar_deg(&[0.0, 40.0])
+        .outputs(&["tile"])
+        .quadrature_points(2)
+        .paper(0.9)
+        .tolerance(1e-7)
+        .output(dir, "grains")
 }
 
 /// The estimate the plan reports (`estimated error in R/T/A <e> (…`).
@@ -75,12 +50,8 @@ fn planned_estimate(plan: &RunPlan) -> f64 {
 fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
     let dir = tempfile::tempdir().unwrap();
     let tol = 1e-2;
-    let text = scene_text(
-        dir.path(),
-        6.0,
-        &format!("effective_medium_tolerance = {tol}"),
-    );
-    let s = scene(dir.path(), &text);
+    let text = grains_scene(dir.path(), 6.0).effective_medium_tolerance(tol);
+    let s = text.scene(dir.path());
     let plan = RunPlan::of(&s);
     assert!(plan.analytic, "{:#?}", plan.lines);
     assert!(
@@ -90,7 +61,7 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
     );
     let estimate = planned_estimate(&plan);
     assert!(estimate > 0.0 && estimate <= tol, "{estimate}");
-    let short = run(dir.path(), &text);
+    let short = text.run(dir.path());
     assert!(short.geometry.is_none());
     assert!(short
         .entries
@@ -103,14 +74,14 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
 
     // The same scene with the shortcut disabled: packed, rasterised, solved.
     let full_dir = tempfile::tempdir().unwrap();
-    let full_text = scene_text(full_dir.path(), 6.0, "effective_medium_tolerance = 0.0");
-    let full_plan = RunPlan::of(&scene(full_dir.path(), &full_text));
+    let full_text = grains_scene(full_dir.path(), 6.0).effective_medium_tolerance(0.0);
+    let full_plan = RunPlan::of(&full_text.scene(full_dir.path()));
     assert!(!full_plan.analytic);
     assert!(full_plan
         .lines
         .iter()
         .any(|l| l.contains("refused — solver.effective_medium_tolerance = 0")));
-    let full = run(full_dir.path(), &full_text);
+    let full = full_text.run(full_dir.path());
     assert!(full.geometry.is_some());
     assert_eq!(full.entries.len(), short.entries.len());
     let mut worst: f64 = 0.0;
@@ -175,15 +146,12 @@ fn fine_grains_take_the_slab_and_agree_with_the_full_solve() {
 fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
     let dir = tempfile::tempdir().unwrap();
     // 15 nm grains (λ/30): the estimate is above the default tolerance.
-    let text = scene_text(dir.path(), 15.0, "")
-        .replace("[450.0, 550.0, 650.0]", "[550.0]")
-        .replace("polar_deg = [0.0, 40.0]", "polar_deg = [0.0]")
-        .replace(
-            "quadrature_points = 2",
-            "quadrature_points = 2\nmeasurements = []",
-        )
-        .replace("kind = \"paper\"\nalbedo = 0.9", "kind = \"none\"");
-    let s = scene(dir.path(), &text);
+    let text = grains_scene(dir.path(), 15.0)
+        .wavelengths_nm(&[550.0])
+        .polar_deg(&[0.0])
+        .measurements(&[])
+        .no_substrate();
+    let s = text.scene(dir.path());
     let plan = RunPlan::of(&s);
     assert!(!plan.analytic);
     let line = plan
@@ -196,7 +164,7 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
         "{line}"
     );
     assert!(planned_estimate(&plan) > 1e-3);
-    let rep = run(dir.path(), &text);
+    let rep = text.run(dir.path());
     assert!(rep.geometry.is_some());
     assert_eq!(rep.entries.len(), 1);
     let e = &rep.entries[0];
@@ -204,29 +172,24 @@ fn coarse_grains_and_what_the_slab_cannot_show_refuse_it() {
     assert!(e.efficiencies.energy_balance.abs() < 1e-5);
 
     // Fine grains, but something the slab cannot represent: refused, and why.
-    let fine = scene_text(dir.path(), 6.0, "effective_medium_tolerance = 1e-2");
+    let fine = grains_scene(dir.path(), 6.0).effective_medium_tolerance(1e-2);
     for (edit, why) in [
         (
-            fine.replace("outputs = [\"tile\"]", "outputs = [\"brdf\", \"tile\"]"),
+            fine.clone().outputs(&["brdf", "tile"]),
             "the BRDF table is the grains' diffuse scattering",
         ),
         (
-            scene_text(dir.path(), 30.0, "effective_medium_tolerance = 0.1"),
+            grains_scene(dir.path(), 30.0).effective_medium_tolerance(0.1),
             "beyond λ/20 at 450 nm",
         ),
+        (fine.clone().relief_fraction(0.3), "surface relief"),
         (
-            fine.replace("pvc = 0.1", "pvc = 0.1\nrelief_fraction = 0.3"),
-            "surface relief",
-        ),
-        (
-            fine.replace(
-                "diameter_nm = 6.0",
-                "diameter_nm = 6.0\nagglomeration = { cluster_size = 4 }",
-            ),
+            fine.clone()
+                .raw("pigment.0.agglomeration", "{ cluster_size = 4 }"),
             "agglomerate",
         ),
     ] {
-        let plan = RunPlan::of(&scene(dir.path(), &edit));
+        let plan = RunPlan::of(&edit.scene(dir.path()));
         assert!(!plan.analytic, "{why}");
         assert!(
             plan.lines

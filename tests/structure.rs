@@ -3,7 +3,7 @@
 //! matrix, the HDF5 ε grid giving the same answer as the primitives it
 //! holds, and clear errors.
 
-use inksim::config::{parse_scene, Body, Material, Primitive};
+use inksim::config::{Body, Material, Primitive};
 use inksim::pipeline;
 use inksim::raster::structure::rasterize_primitives;
 use inksim::raster::Grid;
@@ -13,6 +13,7 @@ use std::path::Path;
 
 mod common;
 use common::airy::tmm;
+use common::scene::{PigmentToml, PrimitiveToml, SceneToml};
 
 fn material() -> Material {
     Material::from_csv_text("m", "wavelength_nm,n,k\n1,2,0.1\n1000000,2,0.1\n").unwrap()
@@ -85,52 +86,28 @@ fn boxes_are_exact_and_curved_bodies_keep_their_volume() {
     }
 }
 
-fn slab_scene(dir: &Path, z_cell: f64) -> String {
-    format!(
-        r#"
-[layer]
-thickness_nm = 1000.0
-fragment_nm = [200.0, 200.0]
-[structure]
-kind = "primitives"
-[[structure.primitive]]
-shape = {{ kind = "slab", z_nm = [300.0, 500.0] }}
-material = {{ index = [2.0, 0.1] }}
-[grid]
-cell_nm = 50.0
-z_cell_nm = {z_cell}
-[illumination]
-wavelengths_nm = [450.0, 600.0]
-polar_deg = [0.0, 40.0]
-[appearance]
-outputs = []
-[solver]
-tolerance = 1e-10
-[output]
-dir = "{}"
-name = "slab"
-"#,
-        dir.display()
-    )
+/// A 200 nm slab of n = 2 + 0.1i buried 300 nm deep.
+fn buried_slab() -> PrimitiveToml {
+    PrimitiveToml::slab(300.0, 500.0).index(2.0, 0.1)
 }
 
-/// The slab scene with its primitive replaced by an ε grid file.
-fn with_hdf5(slab_scene: &str, file: &str) -> String {
-    let text = slab_scene.replace(
-        "kind = \"primitives\"\n[[structure.primitive]]\nshape = { kind = \"slab\", z_nm = [300.0, 500.0] }\nmaterial = { index = [2.0, 0.1] }",
-        &format!("kind = \"hdf5\"\nfile = \"{file}\""),
-    );
-    assert!(
-        text.contains("kind = \"hdf5\""),
-        "the primitive block was not found"
-    );
-    text
+/// `bodies` in a 1 µm layer on a 200 nm fragment, z cells of `z_cell`,
+/// results in `dir`.
+fn bodies_scene(dir: &Path, z_cell: f64, bodies: &[PrimitiveToml]) -> SceneToml {
+    SceneToml::structure(bodies)
+        .fragment_nm(200.0)
+        .cell_nm(50.0)
+        .z_cell_nm(z_cell)
+        .wavelengths_nm(&[450.0, 600.0])
+        .polar_deg(&[0.0, 40.0])
+        .outputs(&[])
+        .tolerance(1e-10)
+        .output(dir, "slab")
 }
 
-fn run(dir: &Path, text: &str) -> pipeline::RunReport {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    pipeline::run(&parse_scene(&path, text).unwrap()).unwrap()
+/// The buried slab alone.
+fn slab_scene(dir: &Path, z_cell: f64) -> SceneToml {
+    bodies_scene(dir, z_cell, &[buried_slab()])
 }
 
 #[test]
@@ -141,7 +118,7 @@ fn buried_slab_matches_the_transfer_matrix() {
     let stack = [(eps_b, 300.0), (eps_s, 200.0), (eps_b, 500.0)];
     let mut worst = [0.0f64; 2];
     for (k, z) in [10.0, 5.0].into_iter().enumerate() {
-        let rep = run(dir.path(), &slab_scene(dir.path(), z));
+        let rep = slab_scene(dir.path(), z).run(dir.path());
         assert_eq!(rep.entries.len(), 4);
         for e in &rep.entries {
             let (r, t) = tmm(&stack, e.wavelength_nm, e.incidence.polar_deg);
@@ -161,12 +138,17 @@ fn buried_slab_matches_the_transfer_matrix() {
 #[test]
 fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
     let dir = tempfile::tempdir().unwrap();
-    let text = slab_scene(dir.path(), 10.0)
-        .replace("[[structure.primitive]]", "[[structure.primitive]]\nshape = { kind = \"sphere\", center_nm = [60.0, 90.0, 700.0], radius_nm = 80.0 }\nmaterial = { builtin = \"blue\" }\n[[structure.primitive]]");
-    let prim = run(dir.path(), &text);
+    let text = bodies_scene(
+        dir.path(),
+        10.0,
+        &[
+            PrimitiveToml::sphere([60.0, 90.0, 700.0], 80.0).builtin("blue"),
+            buried_slab(),
+        ],
+    );
+    let prim = text.run(dir.path());
     // The same ε, written to a file, per wavelength.
-    let path = dir.path().join("scene.toml");
-    let scene = parse_scene(&path, &text).unwrap();
+    let scene = text.scene(dir.path());
     let g = pipeline::grid_of(&scene);
     let ps = match scene.structure.as_ref().unwrap() {
         inksim::config::Structure::Primitives(ps) => ps.clone(),
@@ -204,9 +186,10 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
             .create("wavelengths_nm")
             .unwrap();
     }
-    let file_text = with_hdf5(&slab_scene(dir.path(), 10.0), "eps.h5")
-        .replace("name = \"slab\"", "name = \"file\"");
-    let from_file = run(dir.path(), &file_text);
+    let file_text = slab_scene(dir.path(), 10.0)
+        .structure_file("eps.h5")
+        .output_name("file");
+    let from_file = file_text.run(dir.path());
     for (a, b) in prim.entries.iter().zip(&from_file.entries) {
         assert_eq!(
             a.efficiencies.total_reflectance.to_bits(),
@@ -219,10 +202,10 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
     }
 
     // A grid of the wrong shape or without a wavelength is refused clearly.
-    let bad = file_text.replace("cell_nm = 50.0", "cell_nm = 40.0");
+    let bad = file_text.clone().cell_nm(40.0);
     let p = dir.path().join("bad.toml");
-    std::fs::write(&p, &bad).unwrap();
-    let err = pipeline::run(&parse_scene(&p, &bad).unwrap())
+    std::fs::write(&p, bad.toml()).unwrap();
+    let err = pipeline::run(&bad.parse(&p).unwrap())
         .err()
         .unwrap()
         .to_string();
@@ -230,8 +213,8 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
         err.contains("eps.h5") && err.contains("scene's grid"),
         "{err}"
     );
-    let bad = file_text.replace("[450.0, 600.0]", "[450.0, 650.0]");
-    let err = pipeline::run(&parse_scene(&p, &bad).unwrap())
+    let bad = file_text.wavelengths_nm(&[450.0, 650.0]);
+    let err = pipeline::run(&bad.parse(&p).unwrap())
         .err()
         .unwrap()
         .to_string();
@@ -245,14 +228,27 @@ fn structure_input_errors_name_the_key() {
     let base = slab_scene(dir.path(), 10.0);
     for (text, key) in [
         (
-            base.replace("[structure]", "[[pigment]]\nname = \"r\"\nmaterial = { builtin = \"red\" }\npvc = 0.1\ndiameter_nm = 100.0\n[structure]"),
+            base.clone().pigment(
+                PigmentToml::builtin("red")
+                    .named("r")
+                    .pvc(0.1)
+                    .diameter_nm(100.0),
+            ),
             "structure",
         ),
-        (base.replace("z_nm = [300.0, 500.0]", "z_nm = [300.0, 1500.0]"), "z_nm"),
-        (base.replace("index = [2.0, 0.1]", "index = [2.0]"), "index"),
-        (with_hdf5(&base, "none.h5"), "structure.file"),
+        (
+            base.clone()
+                .raw("structure.primitive.0.shape.z_nm", "[300.0, 1500.0]"),
+            "z_nm",
+        ),
+        (
+            base.clone()
+                .raw("structure.primitive.0.material.index", "[2.0]"),
+            "index",
+        ),
+        (base.structure_file("none.h5"), "structure.file"),
     ] {
-        let err = match parse_scene(&p, &text) {
+        let err = match text.parse(&p) {
             Ok(_) => panic!("{key}: accepted"),
             Err(e) => e.to_string(),
         };
@@ -263,10 +259,8 @@ fn structure_input_errors_name_the_key() {
 #[test]
 fn geometry_command_draws_an_explicit_structure() {
     let dir = tempfile::tempdir().unwrap();
-    let text = slab_scene(dir.path(), 10.0);
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, &text).unwrap();
-    let rep = pipeline::run_geometry(&parse_scene(&path, &text).unwrap()).unwrap();
+    let scene = slab_scene(dir.path(), 10.0).scene(dir.path());
+    let rep = pipeline::run_geometry(&scene).unwrap();
     assert!(rep.geometry.is_none());
     assert!(
         rep.lines[0].starts_with("explicit structure: 1 bodies"),

@@ -10,44 +10,47 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// Two pigments × two sizes, 8 × 8 × 4 grid, two wavelengths.
-const SWEEP: &str = r#"
-[study]
-name = "t"
-seed = 5
-output_dir = "out"
-profile = "quick"
+mod common;
+use common::keys::floats;
+use common::scene::{PigmentToml, SceneToml};
+use common::study::StudyToml;
 
-[base.layer]
-thickness_nm = 400.0
-fragment_nm = [400.0, 400.0]
-pvc = 0.15
-[[base.pigment]]
-name = "p"
-material = { builtin = "red" }
-diameter_nm = 100.0
-[base.grid]
-cell_nm = 50.0
-z_cell_nm = 100.0
-[base.illumination]
-wavelengths_nm = [450.0, 600.0]
-polar_deg = [0.0]
+/// One red pigment of 100 nm at 15 % PVC in a 400 nm layer, 8 × 8 × 4
+/// grid, two wavelengths.
+fn base() -> SceneToml {
+    SceneToml::grains()
+        .thickness_nm(400.0)
+        .fragment_nm(400.0)
+        .layer_pvc(0.15)
+        .pigment(PigmentToml::builtin("red").named("p").diameter_nm(100.0))
+        .cell_nm(50.0)
+        .z_cell_nm(100.0)
+        .wavelengths_nm(&[450.0, 600.0])
+        .polar_deg(&[0.0])
+}
 
-[profiles.quick]
-"realisations" = 1
-[profiles.three]
-"illumination.wavelengths_nm" = [450.0, 550.0, 650.0]
+/// Two pigments × two sizes of `base`; profiles `quick` (the default) and
+/// `three` (three wavelengths).
+fn sweep_of(base: &SceneToml) -> StudyToml {
+    StudyToml::new("t", 5, "out", base)
+        .profile("quick")
+        .profile_key("quick", "realisations", 1)
+        .profile_key(
+            "three",
+            "illumination.wavelengths_nm",
+            floats(&[450.0, 550.0, 650.0]),
+        )
+        .axis(
+            "pigment",
+            "pigment.0.material.builtin",
+            r#"["red", "yellow"]"#,
+        )
+        .axis("d", "pigment.*.diameter_nm", "[100.0, 150.0]")
+}
 
-[[axis]]
-name = "pigment"
-key = "pigment.0.material.builtin"
-values = ["red", "yellow"]
-
-[[axis]]
-name = "d"
-key = "pigment.*.diameter_nm"
-values = [100.0, 150.0]
-"#;
+fn sweep() -> StudyToml {
+    sweep_of(&base())
+}
 
 fn inksim_in(dir: &Path, args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
@@ -70,19 +73,16 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-fn zipped(text: &str) -> String {
-    text.replace(
-        "profile = \"quick\"",
-        "profile = \"quick\"\nzip = [\"pigment\", \"d\"]",
-    )
+fn zipped(study: StudyToml) -> StudyToml {
+    study.zip(&["pigment", "d"])
 }
 
-fn parse(text: &str) -> Study {
-    Study::parse(Path::new("/virtual/sweep.toml"), text).unwrap()
+fn parse(study: &StudyToml) -> Study {
+    Study::parse(Path::new("/virtual/sweep.toml"), &study.toml()).unwrap()
 }
 
-fn names(text: &str, profile: Option<&str>) -> Vec<String> {
-    parse(text)
+fn names(study: &StudyToml, profile: Option<&str>) -> Vec<String> {
+    parse(study)
         .expand(profile)
         .unwrap()
         .variants
@@ -114,7 +114,7 @@ fn results(variants: &Path) -> BTreeMap<String, ResultSummary> {
 
 #[test]
 fn expansion_order_names_and_seeds() {
-    let s = parse(SWEEP);
+    let s = parse(&sweep());
     let e = s.expand(None).unwrap();
     let n: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(n, ["red_d100", "red_d150", "yellow_d100", "yellow_d150"]);
@@ -133,12 +133,9 @@ fn expansion_order_names_and_seeds() {
     assert_eq!(y150.label("d"), Some("d150"));
 
     // Seeds depend on the name only: other values, other order, same seed.
-    let other = SWEEP
-        .replace(
-            "values = [\"red\", \"yellow\"]",
-            "values = [\"yellow\", \"blue\", \"red\"]",
-        )
-        .replace("[100.0, 150.0]", "[150.0, 80.0, 100.0]");
+    let other = sweep()
+        .raw("axis.0.values", r#"["yellow", "blue", "red"]"#)
+        .raw("axis.1.values", "[150.0, 80.0, 100.0]");
     let e2 = parse(&other).expand(None).unwrap();
     assert_eq!(e2.variants.len(), 9);
     let find = |name: &str| e2.variants.iter().find(|v| v.name == name).unwrap();
@@ -156,21 +153,17 @@ fn expansion_order_names_and_seeds() {
 
 #[test]
 fn zip_exclude_explicit_and_compound_values() {
-    let text = format!(
-        "{}\n\
-         [[variant]]\nname = \"mix\"\nlabels = {{ d = \"d150\" }}\n\
-         set = {{ \"pigment\" = [ {{ name = \"y\", material = {{ builtin = \"yellow\" }} }}, \
-         {{ name = \"b\", material = {{ builtin = \"blue\" }}, share = 3.0 }} ] }}\n",
-        zipped(SWEEP)
-    );
     // Zipped: red with 100, yellow with 150. The explicit variant takes the
     // d axis value (label d150) and then its `set` replaces the pigments.
-    let text = text
-        .replace("share = 3.0 }", "share = 3.0, diameter_nm = 90.0 }")
-        .replace(
-            "{ name = \"y\", material = { builtin = \"yellow\" } }",
-            "{ name = \"y\", material = { builtin = \"yellow\" }, diameter_nm = 80.0 }",
-        );
+    let text = zipped(sweep()).variant(
+        "mix",
+        concat!(
+            r#"labels = { d = "d150" }, set = { "pigment" = ["#,
+            r#"{ name = "y", material = { builtin = "yellow" }, diameter_nm = 80.0 }, "#,
+            r#"{ name = "b", material = { builtin = "blue" }, share = 3.0, diameter_nm = 90.0 }"#,
+            "] }",
+        ),
+    );
     let e = parse(&text).expand(None).unwrap();
     let n: Vec<&str> = e.variants.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(n, ["red_d100", "yellow_d150", "mix"]);
@@ -186,13 +179,21 @@ fn zip_exclude_explicit_and_compound_values() {
     assert_eq!((sp[0].diameter_nm, sp[1].diameter_nm), (80.0, 90.0));
 
     // Compound axis with wildcard over two pigments, and an exclusion.
-    let compound = format!(
-        "{}\n[[axis]]\nname = \"grain\"\n\
-         [[axis.value]]\nlabel = \"mol\"\nset = {{ \"pigment.*.shape\" = {{ kind = \"molecular\" }} }}\n\
-         [[axis.value]]\nlabel = \"cyl\"\nset = {{ \"pigment.*.shape\" = {{ kind = \"cylinder\", aspect = 3.0, spheres = 5 }}, \"pigment.*.orientation\" = \"in-plane\" }}\n\
-         [[exclude]]\npigment = \"yellow\"\ngrain = \"cyl\"\n",
-        SWEEP
-    );
+    let compound = sweep()
+        .compound_axis(
+            "grain",
+            &[
+                ("mol", r#"{ "pigment.*.shape" = { kind = "molecular" } }"#),
+                (
+                    "cyl",
+                    concat!(
+                        r#"{ "pigment.*.shape" = { kind = "cylinder", aspect = 3.0, spheres = 5 }, "#,
+                        r#""pigment.*.orientation" = "in-plane" }"#,
+                    ),
+                ),
+            ],
+        )
+        .exclude(&[("pigment", "yellow"), ("grain", "cyl")]);
     let n = names(&compound, None);
     assert_eq!(n.len(), 8 - 2);
     assert!(n.contains(&"red_d150_cyl".to_string()));
@@ -203,9 +204,9 @@ fn zip_exclude_explicit_and_compound_values() {
 
 /// A bad sweep: the CLI fails with one `error:` line containing every
 /// needle, before any work (no output folder).
-fn expect_error(text: &str, needles: &[&str]) {
+fn expect_error(study: StudyToml, needles: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
-    let p = write(dir.path(), "sweep.toml", text);
+    let p = write(dir.path(), "sweep.toml", &study.toml());
     for cmd in ["run", "plan"] {
         let (ok, _, err) = inksim_in(dir.path(), &[cmd, p.to_str().unwrap()]);
         assert!(!ok, "{cmd} should fail: {needles:?}");
@@ -226,65 +227,53 @@ fn bad_sweep_files_are_rejected_before_any_work() {
     // An axis naming an unknown key: the scene schema rejects it, the
     // message names the axis and the key path.
     expect_error(
-        &SWEEP.replace(
-            "key = \"pigment.*.diameter_nm\"",
-            "key = \"pigment.*.diametre_nm\"",
-        ),
+        sweep().set("axis.1.key", "pigment.*.diametre_nm"),
         &["axis `d`", "diametre_nm", "unknown field"],
     );
     expect_error(
-        &SWEEP.replace(
-            "key = \"pigment.0.material.builtin\"",
-            "key = \"layer.pigment_colour\"",
-        ),
+        sweep().set("axis.0.key", "layer.pigment_colour"),
         &["axis `pigment`", "pigment_colour"],
     );
     // An out-of-range index.
     expect_error(
-        &SWEEP.replace("pigment.*.diameter_nm", "pigment.1.diameter_nm"),
+        sweep().set("axis.1.key", "pigment.1.diameter_nm"),
         &["axis `d`", "index 1 is out of range"],
     );
     // An empty axis.
     expect_error(
-        &SWEEP.replace("values = [100.0, 150.0]", "values = []"),
+        sweep().raw("axis.1.values", "[]"),
         &["axis `d`", "no values"],
     );
     // An exclusion that matches nothing (zipped, red never meets d150).
     expect_error(
-        &format!(
-            "{}\n[[exclude]]\npigment = \"red\"\nd = \"d150\"\n",
-            zipped(SWEEP)
-        ),
+        zipped(sweep()).exclude(&[("pigment", "red"), ("d", "d150")]),
         &["[[exclude]] 1", "matches no combination"],
     );
     // An exclusion naming a label that does not exist.
     expect_error(
-        &format!("{SWEEP}\n[[exclude]]\nd = \"d999\"\n"),
+        sweep().exclude(&[("d", "d999")]),
         &["axis `d` has no label `d999`", "d100, d150"],
     );
     // Two variants with the same name.
     expect_error(
-        &format!("{SWEEP}\n[[variant]]\nname = \"red_d100\"\n"),
+        sweep().variant("red_d100", ""),
         &["two variants are named `red_d100`"],
     );
     expect_error(
-        &SWEEP.replace(
-            "values = [100.0, 150.0]",
-            "values = [100.0, 150.0]\nlabels = [\"x+\", \"x*\"]",
-        ),
+        sweep().raw("axis.1.labels", r#"["x+", "x*"]"#),
         &["two variants are named `red_x-`"],
     );
     // An unknown profile, a reserved key, an invalid value.
     expect_error(
-        &SWEEP.replace("profile = \"quick\"", "profile = \"fast\""),
+        sweep().profile("fast"),
         &["unknown profile `fast`", "quick, three"],
     );
     expect_error(
-        &SWEEP.replace("key = \"pigment.*.diameter_nm\"", "key = \"seed\""),
+        sweep().set("axis.1.key", "seed"),
         &["axis `d`", "`seed`", "cannot be overridden"],
     );
     expect_error(
-        &SWEEP.replace("[100.0, 150.0]", "[100.0, 500.0]"),
+        sweep().raw("axis.1.values", "[100.0, 500.0]"),
         &["variant `red_d500`", "diameter_nm", "axis `d`"],
     );
 }
@@ -292,7 +281,7 @@ fn bad_sweep_files_are_rejected_before_any_work() {
 #[test]
 fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     let dir = tempfile::tempdir().unwrap();
-    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let p = write(dir.path(), "sweep.toml", &sweep().toml());
     let ps = p.to_str().unwrap();
     let (ok, plan, err) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
     assert!(ok, "{err}");
@@ -382,7 +371,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
 #[test]
 fn truncated_and_mismatched_results_are_redone() {
     let dir = tempfile::tempdir().unwrap();
-    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let p = write(dir.path(), "sweep.toml", &sweep().toml());
     let ps = p.to_str().unwrap();
     let (ok, _, err) = inksim_in(dir.path(), &["run", ps]);
     assert!(ok, "{err}");
@@ -412,7 +401,7 @@ fn truncated_and_mismatched_results_are_redone() {
 fn shards_together_give_the_unsharded_run() {
     let whole = tempfile::tempdir().unwrap();
     let parts = tempfile::tempdir().unwrap();
-    let text = SWEEP.replace("values = [100.0, 150.0]", "values = [100.0, 120.0, 150.0]");
+    let text = sweep().raw("axis.1.values", "[100.0, 120.0, 150.0]").toml();
     let pw = write(whole.path(), "sweep.toml", &text);
     let pp = write(parts.path(), "sweep.toml", &text);
     let (ok, _, err) = inksim_in(
@@ -465,14 +454,13 @@ fn shards_together_give_the_unsharded_run() {
 /// Slow enough variants (32 × 32 × 8, four wavelengths) that a kill lands
 /// mid-way.
 fn slow_sweep() -> String {
-    SWEEP
-        .replace("cell_nm = 50.0", "cell_nm = 12.5")
-        .replace("z_cell_nm = 100.0", "z_cell_nm = 50.0")
-        .replace(
-            "wavelengths_nm = [450.0, 600.0]",
-            "wavelengths_nm = [450.0, 500.0, 550.0, 600.0]",
-        )
-        .replace("values = [100.0, 150.0]", "values = [100.0, 120.0, 150.0]")
+    let base = base()
+        .cell_nm(12.5)
+        .z_cell_nm(50.0)
+        .wavelengths_nm(&[450.0, 500.0, 550.0, 600.0]);
+    sweep_of(&base)
+        .raw("axis.1.values", "[100.0, 120.0, 150.0]")
+        .toml()
 }
 
 #[test]
@@ -538,7 +526,7 @@ fn killed_run_resumes_to_the_uninterrupted_result() {
 #[test]
 fn slurm_script_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let p = write(dir.path(), "sweep.toml", SWEEP);
+    let p = write(dir.path(), "sweep.toml", &sweep().toml());
     let (ok, out, err) = inksim_in(
         dir.path(),
         &["slurm", p.to_str().unwrap(), "--shards", "3", "--cpus", "1"],

@@ -1,7 +1,11 @@
 //! Set-up shared by the tests: closed-form slab references, a packed layer
-//! of one pigment, and runs on a thread pool of a given size.
+//! of one pigment, runs on a thread pool of a given size, and builders of
+//! scene and study files (a test names only what it varies).
 #![allow(dead_code)]
 
 pub mod airy;
+pub mod keys;
 pub mod layers;
+pub mod scene;
+pub mod study;
 pub mod threads;

@@ -20,6 +20,27 @@ fn second_pigment() -> PigmentToml {
     PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(200.0)
 }
 
+/// The base scene as a user would write it, for the tests where the text
+/// itself is the point.
+const BY_HAND: &str = r#"
+[layer]
+thickness_nm = 1000.0
+fragment_nm = [2000.0, 2000.0]
+
+[[pigment]]
+name = "red"
+material = { builtin = "red" }
+pvc = 0.2
+diameter_nm = 200.0
+
+[grid]
+cell_nm = 25.0
+
+[illumination]
+wavelengths_nm = [450.0, 550.0, 650.0]
+polar_deg = [0.0, 30.0]
+"#;
+
 fn parse_text(text: &str) -> Result<Scene, ConfigError> {
     parse_scene(Path::new("cfg/test.toml"), text)
 }
@@ -90,26 +111,7 @@ fn demo_parses_with_expected_values() {
 /// replaced, a pigment added, a key dropped) land where they are meant to.
 #[test]
 fn scene_builder_writes_what_a_user_would() {
-    let by_hand: toml::Table = r#"
-[layer]
-thickness_nm = 1000.0
-fragment_nm = [2000.0, 2000.0]
-
-[[pigment]]
-name = "red"
-material = { builtin = "red" }
-pvc = 0.2
-diameter_nm = 200.0
-
-[grid]
-cell_nm = 25.0
-
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0, 30.0]
-"#
-    .parse()
-    .unwrap();
+    let by_hand: toml::Table = BY_HAND.parse().unwrap();
     assert_eq!(base().table(), &by_hand);
     let edited: toml::Table = base()
         .grid_n([8, 8, 4])
@@ -208,26 +210,12 @@ fn effective_medium_tolerance_defaults_and_is_limited() {
 #[test]
 fn unknown_key_is_named_on_one_line() {
     // The literal text is the point: the typo sits on line 4, column 1.
-    let text = r#"
-[layer]
-thickness_nm = 1000.0
-thicknes_nm = 5.0
-fragment_nm = [2000.0, 2000.0]
-
-[[pigment]]
-name = "red"
-material = { builtin = "red" }
-pvc = 0.2
-diameter_nm = 200.0
-
-[grid]
-cell_nm = 25.0
-
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0, 30.0]
-"#;
-    let err = parse_text(text).unwrap_err();
+    let text = BY_HAND.replacen(
+        "thickness_nm = 1000.0\n",
+        "thickness_nm = 1000.0\nthicknes_nm = 5.0\n",
+        1,
+    );
+    let err = parse_text(&text).unwrap_err();
     assert!(matches!(err, ConfigError::Parse { .. }), "{err:?}");
     let shown = err.to_string();
     assert!(

@@ -11,7 +11,7 @@ use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::layers::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{in_binder, layer_eps, packed_rsa};
 const CTL: Controls = Controls {
     tolerance: 1e-9,
     max_iterations: 20000,
@@ -91,11 +91,7 @@ fn check_airy(method: Method, ctl: &Controls) {
     for (eps, polar) in cases {
         let lat = Problem::lattice([4, 4, 250], [800.0, 800.0, h], 500.0, polar, 15.0);
         let grid = Array3::from_elem((250, 4, 4), eps);
-        let p = Problem {
-            lattice: lat,
-            eps: &grid,
-            eps_binder: EPS_B,
-        };
+        let p = in_binder(lat, &grid);
         let Some(sol) = solve_or_declared_failure(&p, method, ctl) else {
             continue;
         };
@@ -126,11 +122,7 @@ fn check_layer(method: Method, ctl: &Controls) {
     let geom = packed_rsa(size, 160.0, 0.25, 21);
     let (eps, _) = layer_eps(&geom, [32, 32, 50], C64::new(1.4, 0.6));
     let lat = Problem::lattice([32, 32, 50], size, 480.0, 25.0, 30.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     let reference = solver::solve(&p, Method::TimeMarching, &CTL).unwrap();
     let Some(sol) = solve_or_declared_failure(&p, method, ctl) else {
         return;

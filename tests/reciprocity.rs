@@ -13,14 +13,13 @@ use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::layers::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{in_binder, layer_eps, packed_rsa};
 
 #[test]
 fn reflected_orders_are_reciprocal() {
     let size = [900.0, 700.0, 500.0];
     let geom = packed_rsa(size, 150.0, 0.2, 8);
     let (eps, _) = layer_eps(&geom, [45, 27, 50], C64::new(1.4, 0.4));
-    let eps_b = EPS_B;
     let ctl = Controls {
         tolerance: 1e-10,
         max_iterations: 20000,
@@ -28,16 +27,7 @@ fn reflected_orders_are_reciprocal() {
     };
     let lambda = 520.0;
     let lat = Problem::lattice([45, 27, 50], size, lambda, 25.0, 30.0);
-    let sol = solver::solve(
-        &Problem {
-            lattice: lat,
-            eps: &eps,
-            eps_binder: eps_b,
-        },
-        Method::Auto,
-        &ctl,
-    )
-    .unwrap();
+    let sol = solver::solve(&in_binder(lat, &eps), Method::Auto, &ctl).unwrap();
     let ff = efficiencies(&sol);
     let mut checked = 0;
     for o in ff
@@ -53,16 +43,7 @@ fn reflected_orders_are_reciprocal() {
         let polar = (kx.hypot(ky) / lat.k0).asin().to_degrees();
         let azimuth = (-ky).atan2(-kx).to_degrees();
         let lat2 = Problem::lattice([45, 27, 50], size, lambda, polar, azimuth);
-        let sol2 = solver::solve(
-            &Problem {
-                lattice: lat2,
-                eps: &eps,
-                eps_binder: eps_b,
-            },
-            Method::Auto,
-            &ctl,
-        )
-        .unwrap();
+        let sol2 = solver::solve(&in_binder(lat2, &eps), Method::Auto, &ctl).unwrap();
         let ff2 = efficiencies(&sol2);
         let back = ff2
             .orders

@@ -7,7 +7,7 @@ use inksim::solver::{self, Controls, Problem, SolveError};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::layers::{layer_eps, packed_rsa as packed, EPS_B};
+use common::layers::{in_binder, layer_eps, packed_rsa as packed, EPS_B};
 use common::threads::on_threads;
 const CTL: Controls = Controls {
     tolerance: 1e-8,
@@ -23,16 +23,8 @@ fn energy_balance_on_random_absorbing_layer() {
     let (eps, _) = layer_eps(&geom, cells, C64::new(1.4, 0.5));
     for polar in [0.0, 45.0] {
         let lat = Problem::lattice([40, 40, 60], size, 520.0, polar, 0.0);
-        let sol = solver::solve(
-            &Problem {
-                lattice: lat,
-                eps: &eps,
-                eps_binder: EPS_B,
-            },
-            Method::TimeMarching,
-            &CTL,
-        )
-        .expect("time-marching converges");
+        let sol = solver::solve(&in_binder(lat, &eps), Method::TimeMarching, &CTL)
+            .expect("time-marching converges");
         let ff = efficiencies(&sol);
         eprintln!(
             "polar {polar}: R {} T {} A {} balance {:.2e} ({} it)",
@@ -111,11 +103,7 @@ fn born_reports_divergence_and_time_marching_converges() {
     let (eps, f) = layer_eps(&geom, cells, C64::new(1.4, 0.8));
     assert!((f - 0.4).abs() < 0.01, "fill {f}");
     let lat = Problem::lattice([32, 32, 64], size, 450.0, 20.0, 0.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     match solver::solve(&p, Method::Born, &CTL) {
         Err(SolveError::Diverged { .. }) => {}
         Err(e) => panic!("expected divergence, got {e}"),
@@ -150,16 +138,7 @@ fn shrinking_grains_approach_the_volume_averaged_slab() {
         let geom = packed(size, d, 0.2, 11);
         let (eps, f) = layer_eps(&geom, cells, n_p);
         let lat = Problem::lattice([48, 48, 50], size, lambda, 0.0, 0.0);
-        let sol = solver::solve(
-            &Problem {
-                lattice: lat,
-                eps: &eps,
-                eps_binder: EPS_B,
-            },
-            Method::Auto,
-            &CTL,
-        )
-        .expect("solve");
+        let sol = solver::solve(&in_binder(lat, &eps), Method::Auto, &CTL).expect("solve");
         let ff = efficiencies(&sol);
         let mean = (1.0 - f) * EPS_B + f * n_p * n_p;
         let (r0, t0) = common::airy::airy_power(lat.k0, mean, 0.0, size[2]);
@@ -188,16 +167,7 @@ fn same_result_for_one_and_two_threads() {
     let run = |threads| {
         on_threads(threads, || {
             let lat = Problem::lattice([24, 24, 30], size, 500.0, 30.0, 10.0);
-            let s = solver::solve(
-                &Problem {
-                    lattice: lat,
-                    eps: &eps,
-                    eps_binder: EPS_B,
-                },
-                Method::Auto,
-                &CTL,
-            )
-            .unwrap();
+            let s = solver::solve(&in_binder(lat, &eps), Method::Auto, &CTL).unwrap();
             (s.r, s.t, s.absorption, s.field)
         })
     };
@@ -252,16 +222,7 @@ fn exactly_grazing_orders_stay_finite() {
             Method::Gmres,
             Method::Auto,
         ] {
-            let sol = solver::solve(
-                &Problem {
-                    lattice: lat,
-                    eps: &eps,
-                    eps_binder: EPS_B,
-                },
-                method,
-                &CTL,
-            )
-            .expect("converges");
+            let sol = solver::solve(&in_binder(lat, &eps), method, &CTL).expect("converges");
             assert!(sol
                 .field
                 .iter()

@@ -5,8 +5,7 @@ use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 mod common;
-
-const EPS_B: f64 = 1.558 * 1.558;
+use common::layers::{in_binder, EPS_B};
 
 fn slab_solve(
     eps: C64,
@@ -18,11 +17,7 @@ fn slab_solve(
     let h = 1000.0;
     let lat = Problem::lattice([4, 4, nz], [800.0, 800.0, h], lambda, polar, 20.0);
     let grid = Array3::from_elem((nz, 4, 4), eps);
-    let p = Problem {
-        lattice: lat,
-        eps: &grid,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &grid);
     let sol = solver::solve(
         &p,
         method,

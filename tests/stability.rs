@@ -13,7 +13,7 @@ use inksim::solver::{self, Controls, Problem};
 use num_complex::Complex64 as C64;
 
 mod common;
-use common::layers::{layer_eps, EPS_B};
+use common::layers::{in_binder, layer_eps};
 const CTL: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20_000,
@@ -35,16 +35,8 @@ fn check_with(
 ) -> solver::Solution {
     let (eps, _) = layer_eps(geom, cells, n);
     let lat = Problem::lattice(cells, geom.size_nm, lambda, polar, 0.0);
-    let sol = solver::solve(
-        &Problem {
-            lattice: lat,
-            eps: &eps,
-            eps_binder: EPS_B,
-        },
-        Method::Auto,
-        ctl,
-    )
-    .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let sol = solver::solve(&in_binder(lat, &eps), Method::Auto, ctl)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(
         sol.field
             .iter()

@@ -8,7 +8,7 @@ use inksim::solver::{self, Controls, Problem};
 use ndarray::{s, Array3};
 
 mod common;
-use common::layers::{layer_eps, packed_rsa, EPS_B};
+use common::layers::{in_binder, layer_eps, packed_rsa};
 use num_complex::Complex64 as C64;
 
 #[test]
@@ -41,7 +41,6 @@ fn lossless_layer_on_white_paper_returns_all_light() {
     let size = [600.0, 600.0, 400.0];
     let geom = packed_rsa(size, 150.0, 0.2, 4);
     let (eps, _) = layer_eps(&geom, [24, 24, 40], C64::new(1.4, 0.0));
-    let eps_b = EPS_B;
     let flipped = eps.slice(s![..;-1, .., ..]).to_owned();
     let hemi = Hemisphere::new(6);
     let ctl = Controls {
@@ -51,16 +50,7 @@ fn lossless_layer_on_white_paper_returns_all_light() {
     };
     let solve = |e: &Array3<C64>, polar: f64| {
         let lat = Problem::lattice([24, 24, 40], size, 520.0, polar, 0.0);
-        let sol = solver::solve(
-            &Problem {
-                lattice: lat,
-                eps: e,
-                eps_binder: eps_b,
-            },
-            Method::Auto,
-            &ctl,
-        )
-        .unwrap();
+        let sol = solver::solve(&in_binder(lat, e), Method::Auto, &ctl).unwrap();
         efficiencies(&sol)
     };
     let (mut r_top, mut t_top, mut r_bottom) = (vec![], vec![], vec![]);

@@ -7,7 +7,8 @@ use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
-const EPS_B: f64 = 1.558 * 1.558;
+mod common;
+use common::layers::{in_binder, EPS_B};
 
 /// Lateral wavenumber of the lowest guided mode of the binder slab in vacuum
 /// (zero of Im(ρ e^{iγH}), |ρ e^{iγH}| = 1 for k0 < κ < k0 n_b), by bisection.
@@ -66,11 +67,7 @@ fn order_on_a_guided_resonance_stays_finite() {
     let eps = stripe_layer(nx, nz, C64::new(1.4, 0.3));
     let lat = Problem::lattice([nx, 1, nz], [period, period, h], lambda, 0.0, 0.0);
     assert!((lat.kappa(1, 0)[0] - kg).abs() < 1e-12 * kg);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     for method in [Method::Auto, Method::TimeMarching, Method::BiCgStab] {
         match solver::solve(
             &p,
@@ -120,11 +117,7 @@ fn strongly_evanescent_harmonics_in_a_thick_layer_stay_finite() {
     let h = 3000.0;
     let eps = stripe_layer(nx, nz, C64::new(1.4, 0.8));
     let lat = Problem::lattice([nx, 1, nz], [period, period, h], 450.0, 40.0, 0.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     let sol = solver::solve(
         &p,
         Method::Auto,

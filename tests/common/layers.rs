@@ -1,13 +1,23 @@
-//! A layer of one pigment in the binder, from packing to ε, and a
-//! brute-force check of particle gaps.
+//! A layer of one pigment in the binder, from packing to ε and to the
+//! problem the solver takes, and a brute-force check of particle gaps.
 
 use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
 use inksim::raster::{rasterize, Grid};
+use inksim::solver::{Lattice, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 /// Binder permittivity of the reference data (n = 1.558).
 pub const EPS_B: f64 = 1.558 * 1.558;
+
+/// The problem of a layer `eps` in the reference binder.
+pub fn in_binder(lattice: Lattice, eps: &Array3<C64>) -> Problem<'_> {
+    Problem {
+        lattice,
+        eps,
+        eps_binder: EPS_B,
+    }
+}
 
 /// Spheres of diameter `d` by random sequential addition.
 pub fn packed_rsa(size: [f64; 3], d: f64, pvc: f64, seed: u64) -> Geometry {

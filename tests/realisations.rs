@@ -2,57 +2,32 @@
 //! the colour is as certain as asked, or the most allowed are run; the run
 //! says how many it took and why, in its plan and its result file.
 
-use inksim::config::parse_scene;
 use inksim::output::h5::read_measured;
-use inksim::pipeline::{self, RunReport};
 use std::path::Path;
 
+mod common;
+use common::scene::{PigmentToml, SceneToml};
+
 /// A small layer of blue grains with realisations given by `realisations`
-/// (a TOML value) and `outputs`.
-fn scene(dir: &Path, realisations: &str, outputs: &str) -> String {
-    format!(
-        r#"
-seed = 11
-realisations = {realisations}
-[layer]
-thickness_nm = 300.0
-fragment_nm = [600.0, 600.0]
-[[pigment]]
-name = "blue"
-material = {{ builtin = "blue" }}
-pvc = 0.15
-diameter_nm = 120.0
-[grid]
-nx = 12
-ny = 12
-nz = 8
-[illumination]
-wavelengths_nm = [450.0, 550.0, 650.0]
-polar_deg = [0.0]
-[solver]
-tolerance = 1e-6
-[appearance]
-outputs = {outputs}
-measurements = ["45/0"]
-quadrature_points = 2
-[output]
-dir = "{}"
-name = "r"
-"#,
-        dir.display()
-    )
+/// (a TOML value), tile only.
+fn scene(dir: &Path, realisations: &str) -> SceneToml {
+    SceneToml::grains()
+        .seed(11)
+        .raw("realisations", realisations)
+        .thickness_nm(300.0)
+        .fragment_nm(600.0)
+        .pigment(PigmentToml::builtin("blue").pvc(0.15).diameter_nm(120.0))
+        .grid_n([12, 12, 8])
+        .polar_deg(&[0.0])
+        .tolerance(1e-6)
+        .outputs(&["tile"])
+        .measurements(&["45/0"])
+        .quadrature_points(2)
+        .output(dir, "r")
 }
 
-fn run(dir: &Path, text: &str) -> RunReport {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    pipeline::run(&parse_scene(&path, text).unwrap()).unwrap()
-}
-
-fn check_error(dir: &Path, text: &str) -> String {
-    let path = dir.join("scene.toml");
-    std::fs::write(&path, text).unwrap();
-    parse_scene(&path, text).unwrap_err().to_string()
+fn check_error(dir: &Path, scene: &SceneToml) -> String {
+    scene.parse(&scene.write(dir)).unwrap_err().to_string()
 }
 
 /// Seeds, the stored attributes of `/realisations` and the stored plan.
@@ -85,8 +60,7 @@ fn stored(path: &Path) -> (usize, f64, f64, String, String) {
 #[test]
 fn a_loose_target_stops_at_the_fewest_realisations() {
     let dir = tempfile::tempdir().unwrap();
-    let text = scene(dir.path(), "{ target_de00 = 50.0, max = 6 }", r#"["tile"]"#);
-    let rep = run(dir.path(), &text);
+    let rep = scene(dir.path(), "{ target_de00 = 50.0, max = 6 }").run(dir.path());
     let (seeds, target, achieved, why, plan) = stored(&rep.result_path);
     assert_eq!(seeds, 3, "the default minimum is 3");
     assert!(
@@ -111,12 +85,7 @@ fn a_loose_target_stops_at_the_fewest_realisations() {
 #[test]
 fn an_unreachable_target_runs_the_most_allowed_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
-    let text = scene(
-        dir.path(),
-        "{ target_de00 = 1e-9, min = 2, max = 4 }",
-        r#"["tile"]"#,
-    );
-    let rep = run(dir.path(), &text);
+    let rep = scene(dir.path(), "{ target_de00 = 1e-9, min = 2, max = 4 }").run(dir.path());
     let (seeds, _, achieved, why, plan) = stored(&rep.result_path);
     assert_eq!(seeds, 4);
     assert!(plan.contains("realisations: 4, the most allowed"), "{plan}");
@@ -136,15 +105,8 @@ fn a_count_and_a_target_agree_where_the_target_stops() {
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     std::fs::create_dir_all(&a).unwrap();
     std::fs::create_dir_all(&b).unwrap();
-    let ra = run(
-        &a,
-        &scene(
-            &a,
-            "{ target_de00 = 50.0, min = 2, max = 5 }",
-            r#"["tile"]"#,
-        ),
-    );
-    let rb = run(&b, &scene(&b, "2", r#"["tile"]"#));
+    let ra = scene(&a, "{ target_de00 = 50.0, min = 2, max = 5 }").run(&a);
+    let rb = scene(&b, "2").run(&b);
     let la = ra.appearance.unwrap().measured[0].lab;
     let lb = rb.appearance.unwrap().measured[0].lab;
     assert_eq!(la, lb);
@@ -157,33 +119,33 @@ fn bad_targets_are_refused_naming_the_key() {
     let cases = [
         (
             "{ target_de00 = 0.0, max = 4 }",
-            r#"["tile"]"#,
+            ["tile"],
             "realisations.target_de00",
         ),
         (
             "{ target_de00 = 0.5, min = 5, max = 4 }",
-            r#"["tile"]"#,
+            ["tile"],
             "realisations.max",
         ),
         (
             "{ target_de00 = 0.5, min = 1, max = 4 }",
-            r#"["tile"]"#,
+            ["tile"],
             "realisations.min",
         ),
         (
             "{ target_de00 = 0.5, max = 4, maximum = 3 }",
-            r#"["tile"]"#,
+            ["tile"],
             "maximum",
         ),
         (
             "{ target_de00 = 0.5, max = 4 }",
-            r#"["brdf"]"#,
+            ["brdf"],
             "realisations.target_de00",
         ),
-        ("0", r#"["tile"]"#, "realisations"),
+        ("0", ["tile"], "realisations"),
     ];
     for (value, outputs, key) in cases {
-        let msg = check_error(d, &scene(d, value, outputs));
+        let msg = check_error(d, &scene(d, value).outputs(&outputs));
         assert!(msg.contains(key), "{value}: {msg}");
         assert!(!msg.contains('\n'), "one line: {msg}");
     }

@@ -273,12 +273,10 @@ fn geometry_command_draws_an_explicit_structure() {
 }
 
 /// The slab scene with a conformal binder surface of film `film_nm`.
-fn conformal_slab_scene(dir: &Path, z_cell: f64, film_nm: f64) -> String {
-    slab_scene(dir, z_cell).replace(
-        "fragment_nm = [200.0, 200.0]\n",
-        &format!(
-            "fragment_nm = [200.0, 200.0]\nsurface = {{ kind = \"conformal\", film_nm = {film_nm} }}\n"
-        ),
+fn conformal_slab_scene(dir: &Path, z_cell: f64, film_nm: f64) -> SceneToml {
+    slab_scene(dir, z_cell).raw(
+        "layer.surface",
+        &format!("{{ kind = \"conformal\", film_nm = {film_nm:?} }}"),
     )
 }
 
@@ -294,7 +292,7 @@ fn conformal_film_over_a_slab_is_the_three_layer_airy_problem() {
     let mut worst = [0.0f64; 2];
     let mut apart = 0.0f64;
     for (k, z) in [10.0, 5.0].into_iter().enumerate() {
-        let rep = run(dir.path(), &conformal_slab_scene(dir.path(), z, 50.0));
+        let rep = conformal_slab_scene(dir.path(), z, 50.0).run(dir.path());
         for e in &rep.entries {
             let (r, t) = tmm(&stack, e.wavelength_nm, e.incidence.polar_deg);
             let eff = &e.efficiencies;

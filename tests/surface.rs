@@ -1,12 +1,14 @@
 //! The binder surface: the rough surface keeps the binder's volume, each
 //! realisation draws its own, and the surface keys are checked.
 
-use inksim::config::parse_scene;
 use inksim::raster::surface::{binder_share, rough};
 use inksim::raster::{Grid, Raster};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::path::Path;
+
+mod common;
+use common::scene::{PigmentToml, SceneToml};
 
 #[test]
 fn a_rough_surface_keeps_the_binder_volume_and_follows_its_heights() {
@@ -73,102 +75,84 @@ fn a_surface_map_at_the_plane_is_the_flat_surface() {
     assert_eq!(a[[top, 0, 0]], eps_b);
 }
 
-fn scene(dir: &Path, layer_extra: &str, pigment: &str) -> String {
-    format!(
-        r#"
-[layer]
-thickness_nm = 400.0
-fragment_nm = [400.0, 400.0]
-{layer_extra}
-[[pigment]]
-name = "red"
-material = {{ builtin = "red" }}
-pvc = 0.2
-{pigment}
-[grid]
-cell_nm = 25.0
-z_cell_nm = 20.0
-[illumination]
-wavelengths_nm = [550.0]
-polar_deg = [0.0]
-[output]
-dir = "{}"
-"#,
-        dir.display()
-    )
+/// Red grains of 100 nm at 20 % PVC in a 400 nm layer whose binder surface
+/// is `surface` (TOML text), one wavelength at normal incidence.
+fn scene(dir: &Path, surface: &str) -> SceneToml {
+    SceneToml::grains()
+        .thickness_nm(400.0)
+        .fragment_nm(400.0)
+        .raw("layer.surface", surface)
+        .diameter_nm(100.0)
+        .z_cell_nm(20.0)
+        .wavelengths_nm(&[550.0])
+        .polar_deg(&[0.0])
+        .set("output.dir", dir.display().to_string())
 }
 
 #[test]
 fn surface_keys_are_checked_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let sphere = "diameter_nm = 100.0";
     let cases = [
         (
-            r#"surface = { kind = "conformal", film_nm = 0.0 }"#,
-            sphere,
+            r#"{ kind = "conformal", film_nm = 0.0 }"#,
+            false,
             "layer.surface.film_nm",
         ),
         (
-            r#"surface = { kind = "conformal", film_nm = 250.0 }"#,
-            sphere,
+            r#"{ kind = "conformal", film_nm = 250.0 }"#,
+            false,
             "layer.surface.film_nm",
         ),
         (
-            r#"surface = { kind = "rough", rms_nm = 150.0, correlation_nm = 50.0 }"#,
-            sphere,
+            r#"{ kind = "rough", rms_nm = 150.0, correlation_nm = 50.0 }"#,
+            false,
             "layer.surface.rms_nm",
         ),
         (
-            r#"surface = { kind = "rough", rms_nm = 10.0, correlation_nm = 500.0 }"#,
-            sphere,
+            r#"{ kind = "rough", rms_nm = 10.0, correlation_nm = 500.0 }"#,
+            false,
             "layer.surface.correlation_nm",
         ),
-        (r#"surface = { kind = "wavy" }"#, sphere, "wavy"),
+        (r#"{ kind = "wavy" }"#, false, "wavy"),
         (
-            r#"surface = { kind = "conformal", film_nm = 10.0, rms_nm = 3.0 }"#,
-            sphere,
+            r#"{ kind = "conformal", film_nm = 10.0, rms_nm = 3.0 }"#,
+            false,
             "rms_nm",
         ),
         (
-            r#"surface = { kind = "conformal", film_nm = 10.0 }"#,
-            r#"shape = { kind = "molecular" }"#,
+            r#"{ kind = "conformal", film_nm = 10.0 }"#,
+            true,
             "layer.surface",
         ),
     ];
-    for (surface, pigment, key) in cases {
-        let text = scene(d, surface, pigment);
-        let path = d.join("scene.toml");
-        std::fs::write(&path, &text).unwrap();
-        let msg = parse_scene(&path, &text).unwrap_err().to_string();
+    for (surface, molecular, key) in cases {
+        let mut text = scene(d, surface);
+        if molecular {
+            text = text.pigment(PigmentToml::builtin("red").pvc(0.2).molecular());
+        }
+        let msg = text.parse(&text.write(d)).unwrap_err().to_string();
         assert!(msg.contains(key), "{surface}: {msg}");
     }
     // The three valid kinds parse.
     for surface in [
-        r#"surface = { kind = "flat" }"#,
-        r#"surface = { kind = "conformal", film_nm = 20.0 }"#,
-        r#"surface = { kind = "rough", rms_nm = 10.0, correlation_nm = 100.0 }"#,
+        r#"{ kind = "flat" }"#,
+        r#"{ kind = "conformal", film_nm = 20.0 }"#,
+        r#"{ kind = "rough", rms_nm = 10.0, correlation_nm = 100.0 }"#,
     ] {
-        let text = scene(d, surface, sphere);
-        let path = d.join("scene.toml");
-        std::fs::write(&path, &text).unwrap();
-        parse_scene(&path, &text).unwrap();
+        scene(d, surface).scene(d);
     }
 }
 
 #[test]
 fn each_realisation_draws_its_own_rough_surface_and_the_run_balances_energy() {
     let dir = tempfile::tempdir().unwrap();
-    let text = scene(
+    let rep = scene(
         dir.path(),
-        r#"surface = { kind = "rough", rms_nm = 15.0, correlation_nm = 100.0 }"#,
-        "diameter_nm = 100.0",
+        r#"{ kind = "rough", rms_nm = 15.0, correlation_nm = 100.0 }"#,
     )
-    .replace("[layer]", "realisations = 2\n[layer]");
-    let path = dir.path().join("scene.toml");
-    std::fs::write(&path, &text).unwrap();
-    let scene = parse_scene(&path, &text).unwrap();
-    let rep = inksim::pipeline::run(&scene).unwrap();
+    .realisations(2)
+    .run(dir.path());
     let r: Vec<f64> = rep
         .entries
         .iter()

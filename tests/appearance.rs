@@ -391,12 +391,10 @@ fn merl_export_stays_bounded_at_grazing_angles() {
     // by cos θo put spikes of 100/sr and more there).
     use inksim::output::merl;
     let dir = tempfile::tempdir().unwrap();
-    let text = grains_scene(
-        dir.path(),
-        2,
-        "[appearance]\nquadrature_points = 4\noutputs = [\"tile\", \"merl\"]",
-    );
-    run_text(dir.path(), &text);
+    grains_scene(dir.path(), 2)
+        .quadrature_points(4)
+        .outputs(&["tile", "merl"])
+        .run(dir.path());
     let bytes = std::fs::read(dir.path().join("grains.binary")).unwrap();
     let (mut moderate, mut grazing) = (0.0f64, 0.0f64);
     for ih in (0..90).step_by(3) {

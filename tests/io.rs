@@ -87,8 +87,8 @@ fn entries() -> Vec<SolveEntry> {
         },
         SolveEntry {
             wavelength_nm: 700.000_000_000_1,
-            side: Side::Above,
-            realisation: 0,
+            side: Side::Below,
+            realisation: 1,
             incidence: Incidence {
                 polar_deg: 60.0,
                 azimuth_deg: -90.0,
@@ -195,6 +195,8 @@ struct Row {
     energy_balance: f64,
     residual: f64,
     iterations: u64,
+    side: u8,
+    realisation: u64,
 }
 
 #[test]
@@ -376,9 +378,26 @@ fn file_contents_round_trip_through_hdf5() {
             energy_balance: x.efficiencies.energy_balance,
             residual: x.record.residual,
             iterations: x.record.iterations as u64,
+            side: match x.side {
+                inksim::optics::farfield::Side::Above => 0,
+                inksim::optics::farfield::Side::Below => 1,
+            },
+            realisation: x.realisation as u64,
         })
         .collect();
     assert_eq!(rows, want);
+    let summary = f.dataset("summary").unwrap();
+    let units = |n: &str| {
+        summary
+            .attr(&format!("{n}_units"))
+            .unwrap()
+            .read_scalar::<hdf5::types::VarLenUnicode>()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(units("wavelength_nm"), "nm");
+    assert_eq!(units("polar_deg"), "deg");
+    assert_eq!(units("side"), "1");
 
     assert_eq!(
         f.dataset("picture_png").unwrap().read_raw::<u8>().unwrap(),

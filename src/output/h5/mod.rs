@@ -56,13 +56,18 @@
 //! `realisation` (u64),
 //! `iterations`, `operator_applications` (u64), `residual`, `seconds` (f64),
 //! `note` (string); datasets over the K propagating orders: `orders_mn`
-//! (K × 2 i32: m, n), `orders_theta_deg`, `orders_phi_deg`,
+//! (K × 2 i32: m, n; its `description` attribute states the convention:
+//! κ = κ_inc + 2π (m/Lx, n/Ly), leaving at sin θ (cos φ, sin φ) = κ/k0),
+//! `orders_theta_deg`, `orders_phi_deg`,
 //! `orders_reflectance`, `orders_transmittance` (K f64).
 //!
 //! `/summary` — one compound row per solve, in solve order, with fields
 //! `wavelength_nm`, `polar_deg`, `azimuth_deg`, `reflectance`, `transmittance`,
-//! `absorption`, `energy_balance`, `residual` (f64) and `iterations` (u64);
-//! in Python: `h5py.File(p)["summary"]["reflectance"]`.
+//! `absorption`, `energy_balance`, `residual` (f64), `iterations` (u64),
+//! `side` (u8: 0 lit from above, the ink side; 1 from below, the layer
+//! flipped for the paper term) and `realisation` (u64); units and meaning of
+//! each field as attributes `<field>_units`, `<field>_description`. In
+//! Python: `s = h5py.File(p)["summary"][()]; s[s["side"] == 0]["reflectance"]`.
 //!
 //! `/picture_png` — the rendered PNG as a 1-D u8 dataset (present when given).
 //!

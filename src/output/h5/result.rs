@@ -14,7 +14,7 @@ use super::attrs::{vlu, write_scalar_attr, write_str_attr};
 use super::{IoError, FORMAT_VERSION};
 use crate::geometry::Statistics;
 use crate::optics::appearance::Appearance;
-use crate::optics::farfield::SolveEntry;
+use crate::optics::farfield::{Side, SolveEntry};
 use crate::output::atomic::write_atomic_with;
 
 /// Everything a result file holds; plain data filled by the pipeline.
@@ -106,7 +106,39 @@ struct SummaryRow {
     energy_balance: f64,
     residual: f64,
     iterations: u64,
+    /// 0: lit from above (the ink side); 1: from below (the layer flipped,
+    /// lit from the paper's side, for the paper term).
+    side: u8,
+    realisation: u64,
 }
+
+/// The sign convention of the order indices, stored with `orders_mn`.
+pub const ORDER_CONVENTION: &str =
+    "order (m, n): lateral wave vector κ = κ_inc + 2π (m/Lx, n/Ly), \
+     κ_inc = k0 sin θ (cos φ, sin φ) of the incident wave (light travelling towards +x for \
+     φ = 0); the order leaves at sin θ (cos φ, sin φ) = κ/k0, reflected orders back towards \
+     the light's side, transmitted ones onward; (0, 0) is the specular (mirror) order";
+
+/// Units and meaning of each `/summary` field, stored as attributes
+/// `<field>_units` and `<field>_description` on the dataset.
+const SUMMARY_FIELDS: [(&str, &str, &str); 11] = [
+    ("wavelength_nm", "nm", "vacuum wavelength"),
+    ("polar_deg", "deg", "polar angle of incidence"),
+    ("azimuth_deg", "deg", "azimuth of incidence"),
+    ("reflectance", "1", "total reflectance, all orders"),
+    ("transmittance", "1", "total transmittance, all orders"),
+    ("absorption", "1", "absorbed fraction"),
+    ("energy_balance", "1", "R + T + A − 1"),
+    ("residual", "1", "relative residual of the solve"),
+    ("iterations", "1", "solver iterations"),
+    (
+        "side",
+        "1",
+        "0: lit from above (the ink side, what a viewer sees); 1: from below (the layer \
+         flipped and lit from the paper's side, used for the paper term)",
+    ),
+    ("realisation", "1", "index of the random fragment (0-based)"),
+];
 
 /// Refuse inconsistent input before any file is touched.
 fn check_result_set(path: &Path, set: &ResultSet) -> Result<(), IoError> {
@@ -271,11 +303,26 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
             energy_balance: eff.energy_balance,
             residual: e.record.residual,
             iterations: e.record.iterations as u64,
+            side: match e.side {
+                Side::Above => 0,
+                Side::Below => 1,
+            },
+            realisation: e.realisation as u64,
         });
     }
-    file.new_dataset_builder()
+    let summary = file
+        .new_dataset_builder()
         .with_data(&rows[..])
         .create("summary")?;
+    write_str_attr(
+        &summary,
+        "description",
+        "one row per solve, in solve order; select side == 0 for what a viewer sees",
+    )?;
+    for (field, units, description) in SUMMARY_FIELDS {
+        write_str_attr(&summary, &format!("{field}_units"), units)?;
+        write_str_attr(&summary, &format!("{field}_description"), description)?;
+    }
 
     if let Some(png) = set.picture_png {
         file.new_dataset_builder()
@@ -362,7 +409,8 @@ fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
             eff.orders[i].n
         }
     });
-    g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
+    let orders_mn = g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
+    write_str_attr(&orders_mn, "description", ORDER_CONVENTION)?;
     let column = |f: fn(&crate::optics::farfield::Order) -> f64| {
         eff.orders.iter().map(f).collect::<Vec<_>>()
     };

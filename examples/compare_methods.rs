@@ -29,6 +29,7 @@ fn main() -> anyhow::Result<()> {
         tolerance,
         max_iterations: 20_000,
         precision: inksim::config::Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     println!(
         "{}: grid {}×{}×{}, tolerance {tolerance:.0e}",

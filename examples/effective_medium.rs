@@ -100,6 +100,7 @@ fn main() {
         tolerance: 1e-7,
         max_iterations: 20_000,
         precision: Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     // Per layer and grid: worst k0·d, error, diffuse power, error / coherent
     // term, diffuse / incoherent term, and the smallest estimate / error.

@@ -7,12 +7,12 @@
 //!
 //! `cargo run --release --example hard_case [side_nm] [seed]`
 
-use inksim::config::{Method, Precision};
+use inksim::config::{Background, Method, Precision};
 use inksim::geometry::{pack_dynamics, DynParams, DynSpecies, Orientation, Shape};
 use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::methods::{bicgstab, gmres, marching};
-use inksim::solver::{self, Controls, Field, Problem, Solver, System, SHIFT_MARGIN};
+use inksim::solver::{self, Controls, Field, Problem, ShiftParams, Solver, System, SHIFT_MARGIN};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -66,6 +66,7 @@ fn main() {
         tolerance: 1e-6,
         max_iterations: 50_000,
         precision: Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     println!("| method | CBS shift margin | iterations | operator applications | seconds | R | A | balance |");
     println!("|---|---|---|---|---|---|---|---|");
@@ -81,7 +82,7 @@ fn main() {
     let tm = marching::TimeMarching::DEFAULT;
     let g20 = gmres::Gmres::DEFAULT;
     let g80 = gmres::Gmres { restart: 80 };
-    let bi = bicgstab::BiCgStab {};
+    let bi = bicgstab::BiCgStab::DEFAULT;
     let runs: [(&str, f64, &dyn Solver); 10] = [
         ("time-marching (plain CBS)", 1.01, &tm),
         ("time-marching (default)", SHIFT_MARGIN, &tm),
@@ -96,7 +97,14 @@ fn main() {
     ];
     let mut counts = Vec::new();
     for (label, margin, method) in runs {
-        let mut sys = System::with_margin(&p, margin).expect("system");
+        let mut sys = System::with_params(
+            &p,
+            ShiftParams {
+                margin,
+                ..ShiftParams::of(Background::Binder)
+            },
+        )
+        .expect("system");
         let mut scr = sys.scratch();
         let mut u = Field::F64(Array3::<C64>::zeros(eps.dim()));
         sys.set_background_field(&mut u);

@@ -114,6 +114,7 @@ fn run(a: &Args) -> Result<(), String> {
         tolerance: a.tolerance,
         max_iterations: 20_000,
         precision: inksim::config::Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     for &cell in &a.cells {
         let nx = cells_in(PERIOD, cell, "lateral")?;

@@ -75,6 +75,7 @@ fn main() {
         tolerance: 1e-6,
         max_iterations: iterations,
         precision,
+        background: inksim::config::Background::DEFAULT,
     };
     let t = Instant::now();
     let outcome = match solver::solve(&p, method, &ctl) {

@@ -2,8 +2,9 @@
 //! helper (the macro at the bottom instantiates it per method). A method
 //! either reproduces the reference or — only where it declares itself not
 //! valid (Born on strong scattering) — fails loudly; it never returns a wrong
-//! answer. Each case runs with f64 and with f32 field storage.
-use inksim::config::{Method, Precision};
+//! answer. Each case runs with f64 and with f32 field storage, and on both
+//! backgrounds of the shifted form (binder with the CBS shift, layer mean).
+use inksim::config::{Background, Method, Precision};
 use inksim::optics::farfield::efficiencies;
 use inksim::solver::methods::born::Born;
 use inksim::solver::{self, Controls, Problem, SolveError, Solver, System, Validity};
@@ -16,12 +17,24 @@ const CTL: Controls = Controls {
     tolerance: 1e-9,
     max_iterations: 20000,
     precision: Precision::F64,
+    background: Background::Binder,
 };
 /// f32 field storage: the tolerance it can reach (config enforces ≥ 1e-6).
 const CTL32: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20000,
     precision: Precision::F32,
+    background: Background::Binder,
+};
+
+/// The same on the mean background.
+const CTL_MEAN: Controls = Controls {
+    background: Background::Mean,
+    ..CTL
+};
+const CTL32_MEAN: Controls = Controls {
+    background: Background::Mean,
+    ..CTL32
 };
 
 /// What a solve at `ctl` must reproduce: (energy balance, agreement with
@@ -57,7 +70,7 @@ fn solve_or_declared_failure(
                 ),
                 "{e}"
             );
-            let mut sys = System::new(p).unwrap();
+            let mut sys = System::new(p, ctl.background).unwrap();
             let mut scr = sys.scratch();
             assert!(
                 matches!(
@@ -149,25 +162,30 @@ fn check_layer(method: Method, ctl: &Controls) {
     );
 }
 
+/// One test per (name, check, controls) for one method.
+macro_rules! every_case {
+    ($method:expr; $($test:ident => $check:ident($ctl:expr)),* $(,)?) => {$(
+        #[test]
+        fn $test() {
+            $check($method, &$ctl);
+        }
+    )*};
+}
+
 macro_rules! every_method {
     ($($name:ident => $method:expr),* $(,)?) => {$(
         mod $name {
             use super::*;
-            #[test]
-            fn airy_slabs() {
-                check_airy($method, &CTL);
-            }
-            #[test]
-            fn grain_layer() {
-                check_layer($method, &CTL);
-            }
-            #[test]
-            fn airy_slabs_f32() {
-                check_airy($method, &CTL32);
-            }
-            #[test]
-            fn grain_layer_f32() {
-                check_layer($method, &CTL32);
+            every_case! {
+                $method;
+                airy_slabs => check_airy(CTL),
+                grain_layer => check_layer(CTL),
+                airy_slabs_f32 => check_airy(CTL32),
+                grain_layer_f32 => check_layer(CTL32),
+                airy_slabs_mean => check_airy(CTL_MEAN),
+                grain_layer_mean => check_layer(CTL_MEAN),
+                airy_slabs_f32_mean => check_airy(CTL32_MEAN),
+                grain_layer_f32_mean => check_layer(CTL32_MEAN),
             }
         }
     )*};

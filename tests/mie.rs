@@ -160,6 +160,7 @@ fn worst_error(eps_s: C64, polar_deg: f64, l: f64, cells: usize) -> f64 {
             tolerance: 1e-10,
             max_iterations: 2000,
             precision: inksim::config::Precision::F64,
+            background: inksim::config::Background::DEFAULT,
         },
     )
     .unwrap();

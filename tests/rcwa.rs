@@ -17,6 +17,7 @@ const CTL: Controls = Controls {
     tolerance: 1e-10,
     max_iterations: 20000,
     precision: inksim::config::Precision::F64,
+    background: inksim::config::Background::DEFAULT,
 };
 
 /// Minimal JSON value: enough to read the fixture without a JSON crate.

@@ -24,6 +24,7 @@ fn reflected_orders_are_reciprocal() {
         tolerance: 1e-10,
         max_iterations: 20000,
         precision: inksim::config::Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     let lambda = 520.0;
     let lat = Problem::lattice([45, 27, 50], size, lambda, 25.0, 30.0);

@@ -234,6 +234,7 @@ fn measured(material: &Material, d: f64, pvc: f64, wl: f64, polar: f64) -> (f64,
         tolerance: 1e-8,
         max_iterations: 10_000,
         precision: Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     let e = efficiencies(&solver::solve(&p, Method::Auto, &ctl).unwrap());
     let s = airy::slab(eps_p * pvc + eps_b * (1.0 - pvc), 400.0, wl, polar);

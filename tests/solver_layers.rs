@@ -13,6 +13,7 @@ const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
     precision: inksim::config::Precision::F64,
+    background: inksim::config::Background::DEFAULT,
 };
 
 #[test]

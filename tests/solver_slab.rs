@@ -25,6 +25,7 @@ fn slab_solve(
             tolerance: 1e-11,
             max_iterations: 20000,
             precision: inksim::config::Precision::F64,
+            background: inksim::config::Background::DEFAULT,
         },
     )
     .expect("solve");

@@ -18,6 +18,7 @@ const CTL: Controls = Controls {
     tolerance: 1e-6,
     max_iterations: 20_000,
     precision: Precision::F64,
+    background: inksim::config::Background::DEFAULT,
 };
 
 fn check(name: &str, geom: &Geometry, cells: [usize; 3], n: C64, lambda: f64, polar: f64) {

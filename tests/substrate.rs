@@ -47,6 +47,7 @@ fn lossless_layer_on_white_paper_returns_all_light() {
         tolerance: 1e-9,
         max_iterations: 20000,
         precision: inksim::config::Precision::F64,
+        background: inksim::config::Background::DEFAULT,
     };
     let solve = |e: &Array3<C64>, polar: f64| {
         let lat = Problem::lattice([24, 24, 40], size, 520.0, polar, 0.0);

@@ -76,6 +76,7 @@ fn order_on_a_guided_resonance_stays_finite() {
                 tolerance: 1e-8,
                 max_iterations: 20000,
                 precision: inksim::config::Precision::F64,
+                background: inksim::config::Background::DEFAULT,
             },
         ) {
             Ok(sol) => {
@@ -125,6 +126,7 @@ fn strongly_evanescent_harmonics_in_a_thick_layer_stay_finite() {
             tolerance: 1e-8,
             max_iterations: 20000,
             precision: inksim::config::Precision::F64,
+            background: inksim::config::Background::DEFAULT,
         },
     )
     .expect("converges");

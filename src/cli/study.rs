@@ -112,7 +112,7 @@ pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) 
 fn peak_bytes(exp: &Expansion) -> f64 {
     let cal = plan::Calibration {
         grids: Default::default(),
-        applications: plan::DEFAULT_APPLICATIONS,
+        applications: plan::MEAN_APPLICATIONS,
         applications_source: String::new(),
     };
     exp.variants

@@ -227,6 +227,44 @@ impl std::fmt::Display for Precision {
     }
 }
 
+/// The background medium of the iterative solvers' Green's operator
+/// (METHOD §4). Both give the same discrete solution; they differ in how
+/// many operator applications reach it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Background {
+    /// The binder slab shifted to `ε_r + iε_s` with the convergent-Born-series
+    /// preconditioner (Osnabrugge et al. 2016).
+    Binder,
+    /// The layer's mean permittivity ⟨ε⟩ (over every voxel), unpreconditioned;
+    /// time-marching, which needs the CBS shift to converge, keeps `Binder`.
+    Mean,
+}
+
+impl Background {
+    /// What a scene without `solver.background` gets.
+    pub const DEFAULT: Background = Background::Mean;
+
+    /// The name scenes use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Background::Binder => "binder",
+            Background::Mean => "mean",
+        }
+    }
+}
+
+impl Default for Background {
+    fn default() -> Self {
+        Background::DEFAULT
+    }
+}
+
+impl std::fmt::Display for Background {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// Solver settings.
 #[derive(Debug, Clone, Copy)]
 pub struct SolverSpec {
@@ -236,6 +274,8 @@ pub struct SolverSpec {
     pub max_iterations: usize,
     /// Field storage.
     pub precision: Precision,
+    /// Background medium of the Krylov methods' Green's operator.
+    pub background: Background,
     /// Largest absolute error in R, T or A accepted from replacing a grain
     /// layer by the homogeneous slab of the volume-averaged ε (closed form,
     /// no solve) when the measured estimate allows it; 0 never does.

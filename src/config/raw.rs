@@ -253,7 +253,15 @@ pub struct RawSolver {
     pub tolerance: Option<f64>,
     pub max_iterations: Option<i64>,
     pub precision: Option<RawPrecision>,
+    pub background: Option<RawBackground>,
     pub effective_medium_tolerance: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawBackground {
+    Binder,
+    Mean,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

@@ -138,6 +138,7 @@ fn controls(scene: &Scene) -> Controls {
         tolerance: scene.solver.tolerance,
         max_iterations: scene.solver.max_iterations,
         precision: scene.solver.precision,
+        background: scene.solver.background,
     }
 }
 

@@ -4,7 +4,9 @@
 //! `ε = ε_b + Δε`. The scattered field solves `u = u_bg + G_bg [k0² Δε u]`
 //! with the exact slab Green's operator ([`operator`], [`green`]): outgoing
 //! plane waves above and below are built in, so no absorbing layers and no
-//! padding are needed.
+//! padding are needed. The iterative methods solve the same equation in a
+//! shifted form, on the convergent-Born-series shift or on the layer's mean
+//! permittivity ([`Controls::background`], [`system`]).
 //!
 //! Takes a [`Problem`] (lattice, permittivity grid, binder), a [`Method`] and
 //! [`Controls`]; gives a [`Solution`] (field, order amplitudes, absorption and
@@ -60,14 +62,14 @@ pub mod simd;
 pub mod storage;
 pub mod system;
 
-use crate::config::{Method, Precision};
+use crate::config::{Background, Method, Precision};
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
 pub use lattice::Lattice;
 pub use methods::{Outcome, Solver, Validity};
 pub use storage::{dot, Field, Storage};
-pub use system::{Scratch, System, SHIFT_MARGIN};
+pub use system::{Scratch, ShiftParams, System, MEAN_LOSS_FLOOR, SHIFT_MARGIN};
 
 /// What every solve records, stored beside its result.
 #[derive(Debug, Clone)]
@@ -141,6 +143,8 @@ pub struct Controls {
     pub max_iterations: usize,
     /// Field storage of the iterative methods ([`storage`]).
     pub precision: Precision,
+    /// Background of the Krylov methods' Green's operator ([`system`]).
+    pub background: Background,
 }
 
 /// A solved problem: the field and what the far field needs.

@@ -3,8 +3,12 @@
 //!
 //! [`System`] is the equation `u = u_bg + G_b V u` of one [`Problem`]: the
 //! operator, the potential `V = k0²(ε − ε_b)`, the source `u_bg`, and the same
-//! equation in its shifted (convergent-Born-series) form
-//! `u = u_s + G_s V' u` (see [`marching`](super::methods::marching)). It is
+//! equation in its shifted form `u = u_s + G_s V' u` on one of two
+//! backgrounds ([`Background`]): the convergent-Born-series shift
+//! `ε_r + iε_s` with its preconditioner (see
+//! [`marching`](super::methods::marching)), or the layer's mean permittivity
+//! `⟨ε⟩` with a loss floor ([`MEAN_LOSS_FLOOR`]) and no preconditioner
+//! (METHOD §4, "The mean background"). It is
 //! built once per solve and read by the methods through its operations
 //! (residuals, the shifted operator, the preconditioner, the far field).
 //! [`Scratch`] is the working memory of those operations, owned by the caller
@@ -16,11 +20,41 @@ use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
 use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
 use super::{Problem, Solution, SolveError, SolveRecord};
+use crate::config::Background;
 use ndarray::{Array2, Array3, Zip};
 use num_complex::Complex64 as C64;
 
 /// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
 pub const SHIFT_MARGIN: f64 = 1.05;
+
+/// The mean background's loss floor: `Im ε_bg ≥ MEAN_LOSS_FLOOR · max|ε − ⟨ε⟩|²`.
+/// A lossless mean slab has sharp guided resonances that Krylov methods
+/// resolve slowly; a loss growing with the square of the contrast (as the
+/// scattering loss of the coherent wave does) damps them where scattering is
+/// strong and leaves weak layers alone. 0.1 was the best of 0–0.25 on the
+/// layers of docs/PERFORMANCE.md ("The mean background").
+pub const MEAN_LOSS_FLOOR: f64 = 0.1;
+
+/// How the shifted form's background is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShiftParams {
+    pub background: Background,
+    /// CBS: `ε_s = margin · max|ε − ε_r|`, in [1, 100].
+    pub margin: f64,
+    /// Mean: the loss floor factor, in [0, 100].
+    pub mean_loss_floor: f64,
+}
+
+impl ShiftParams {
+    /// The defaults for `background`.
+    pub const fn of(background: Background) -> ShiftParams {
+        ShiftParams {
+            background,
+            margin: SHIFT_MARGIN,
+            mean_loss_floor: MEAN_LOSS_FLOOR,
+        }
+    }
+}
 
 /// The discrete equation `u = u_bg + G_b V u` of one problem, in its plain
 /// and its shifted form.
@@ -38,24 +72,29 @@ pub struct System<'a> {
     r_bg: C64,
     t_bg: C64,
     ubg_norm: f64,
-    /// CBS shift: real centre ε_r, ε_s, c = k0²(ε_r + iε_s − ε_b), and the
-    /// exact per-harmonic shifted operators.
+    /// The background of the shifted form, its exact operator and source.
     shift: Shift,
-    /// u_s = (I − c G_b)⁻¹ u_bg per z cell (harmonic 00 only).
-    us: Vec<C64>,
-    us_norm: f64,
+    /// Kept to rebuild the shift for another background.
+    params: ShiftParams,
     /// Top/bottom functionals of G_b for harmonic 00 (never resonant: it propagates).
     top00: Vec<C64>,
     bottom00: Vec<C64>,
 }
 
-/// The CBS shift of a problem (Osnabrugge et al. 2016): background
-/// `ε_r + iε_s` with `ε_s = margin · max|ε − ε_r|`.
+/// The background of the shifted form `u = u_s + G_s V' u`: permittivity
+/// `ε_s` inside the slab (vacuum stays outside), `c = k0²(ε_s − ε_b)`, the
+/// exact per-harmonic operators, `u_s = (I − c G_b)⁻¹ u_bg` (harmonic 00
+/// only, per z cell) and, for the CBS shift, its preconditioner.
 struct Shift {
-    er: f64,
-    es: f64,
+    kind: Background,
+    eps: C64,
+    /// CBS: real centre ε_r and ε_s of `γ = 1 + i(ε − ε_r)/ε_s`; `None` for
+    /// the unpreconditioned mean background.
+    cbs: Option<(f64, f64)>,
     c: C64,
     table: ShiftTable,
+    us: Vec<C64>,
+    us_norm: f64,
 }
 
 /// Working memory of a [`System`]'s operations, sized for its lattice.
@@ -83,16 +122,25 @@ pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
 }
 
 impl<'a> System<'a> {
-    pub fn new(p: &Problem<'a>) -> Result<Self, SolveError> {
-        Self::with_margin(p, SHIFT_MARGIN)
+    /// The system of `p` with the Krylov methods' background `bg`.
+    pub fn new(p: &Problem<'a>, bg: Background) -> Result<Self, SolveError> {
+        Self::with_params(p, ShiftParams::of(bg))
     }
 
-    /// As [`System::new`] with the CBS shift `ε_s = margin · max|ε − ε_r|`
-    /// (margin ≥ 1; Osnabrugge et al. take 1, [`SHIFT_MARGIN`] is the default).
-    pub fn with_margin(p: &Problem<'a>, margin: f64) -> Result<Self, SolveError> {
+    /// As [`System::new`] with other shift parameters: the CBS shift
+    /// `ε_s = margin · max|ε − ε_r|` (margin ≥ 1; Osnabrugge et al. take 1,
+    /// [`SHIFT_MARGIN`] is the default) or the mean background's loss floor.
+    pub fn with_params(p: &Problem<'a>, params: ShiftParams) -> Result<Self, SolveError> {
+        let margin = params.margin;
         if !(1.0..=100.0).contains(&margin) {
             return Err(SolveError::Invalid(format!(
                 "CBS shift margin must be in [1, 100], got {margin}"
+            )));
+        }
+        let floor = params.mean_loss_floor;
+        if !(0.0..=100.0).contains(&floor) {
+            return Err(SolveError::Invalid(format!(
+                "mean background loss floor must be in [0, 100], got {floor}"
             )));
         }
         let lat = p.lattice;
@@ -117,25 +165,14 @@ impl<'a> System<'a> {
         let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
         let ubg_norm =
             (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
-        let (er, rad) = shift_of(p.eps, p.eps_binder);
-        let es = (margin * rad).max(1e-9);
-        let c = k2 * (C64::new(er, es) - p.eps_binder);
-        let table = ShiftTable::new(&lat, p.eps_binder, c);
-        let mut scr = BandScratch::new(lat.nz);
-        scr.column().copy_from_slice(&ubg);
-        table.solve_column(0, &mut scr);
-        let us = scr.column().to_vec();
-        let us_norm =
-            (us.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let shift = Shift::new(&lat, p.eps, p.eps_binder, &ubg, params);
         let c00 = green::coef_from(&lat.slab(), g2, lat.beta(0, 0));
         let top00 = (0..lat.nz).map(|k| c00.top_weight(lat.nz, k)).collect();
         let bottom00 = (0..lat.nz).map(|k| c00.bottom_weight(lat.nz, k)).collect();
-        let shift = Shift { er, es, c, table };
         Ok(System {
             shift,
+            params,
             k2,
-            us,
-            us_norm,
             top00,
             bottom00,
             op,
@@ -147,6 +184,21 @@ impl<'a> System<'a> {
             t_bg,
             ubg_norm,
         })
+    }
+
+    /// Rebuild the shifted form on background `bg` (time-marching needs the
+    /// CBS shift); nothing happens if it is already the one in use.
+    pub fn use_background(&mut self, bg: Background) {
+        if self.shift.kind != bg {
+            self.params.background = bg;
+            self.shift = Shift::new(
+                &self.op.lat,
+                self.eps,
+                self.eps_binder,
+                &self.ubg,
+                self.params,
+            );
+        }
     }
 
     /// Fresh working memory for this system's operations.
@@ -166,9 +218,26 @@ impl<'a> System<'a> {
         self.eps
     }
 
-    /// The CBS shift's real centre ε_r and imaginary part ε_s.
-    pub fn shift(&self) -> (f64, f64) {
-        (self.shift.er, self.shift.es)
+    /// The background of the shifted form in use.
+    pub fn background(&self) -> Background {
+        self.shift.kind
+    }
+
+    /// The shifted form's background permittivity `ε_s` inside the slab.
+    pub fn background_eps(&self) -> C64 {
+        self.shift.eps
+    }
+
+    /// The background for a solve record's note: `ε_r = …, ε_s = …` (CBS)
+    /// or `mean background ⟨ε⟩ = …`.
+    pub fn describe_background(&self) -> String {
+        match self.shift.cbs {
+            Some((er, es)) => format!("ε_r = {er:.4}, ε_s = {es:.4}"),
+            None => {
+                let e = self.shift.eps;
+                format!("mean background ⟨ε⟩ = {:.4}{:+.4}i", e.re, e.im)
+            }
+        }
     }
 
     /// Fill `u` with the background field.
@@ -181,6 +250,21 @@ impl<'a> System<'a> {
     /// [`Self::set_background`] in either storage.
     pub fn set_background_field(&self, u: &mut Field) {
         on_field!(u, u => self.set_background(u))
+    }
+
+    /// Fill `u` with the iterations' start: on the mean background its own
+    /// slab's field `u_s` (the coherent field of the homogenised layer, and
+    /// the exact answer where the layer is homogeneous), else `u_bg`.
+    pub fn set_start_field(&self, u: &mut Field) {
+        let start = match self.shift.kind {
+            Background::Mean => &self.shift.us,
+            Background::Binder => &self.ubg,
+        };
+        on_field!(u, u => {
+            for (j, mut slice) in u.outer_iter_mut().enumerate() {
+                slice.fill(Storage::store(start[j]));
+            }
+        })
     }
 
     /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)`.
@@ -249,8 +333,8 @@ impl<'a> System<'a> {
         self.load_scaled(scr, u, self.shift.c);
         self.op
             .apply_shifted_green(&self.shift.table, &mut scr.field, &mut scr.op);
-        self.finish_residual(scr, &self.us, u, out);
-        self.norm(out) * self.ubg_norm / self.us_norm
+        self.finish_residual(scr, &self.shift.us, u, out);
+        self.norm(out) * self.ubg_norm / self.shift.us_norm
     }
 
     /// `out ← x − G_s V' x` (the shifted operator, without u_s).
@@ -270,9 +354,11 @@ impl<'a> System<'a> {
     }
 
     /// `x ← γ x`, γ = 1 + i(ε − ε_r)/ε_s: the CBS preconditioner of the
-    /// shifted form.
+    /// shifted form; the identity on the mean background.
     pub fn precondition<S: Storage>(&self, x: &mut Array3<S>) {
-        let (er, es) = (self.shift.er, self.shift.es);
+        let Some((er, es)) = self.shift.cbs else {
+            return;
+        };
         Zip::from(x)
             .and(self.eps)
             .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)));
@@ -330,8 +416,9 @@ impl<'a> System<'a> {
             &mut t,
         );
         let c = self.shift.c;
-        let us_top: C64 = self.top00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
-        let us_bottom: C64 = self.bottom00.iter().zip(&self.us).map(|(w, u)| w * u).sum();
+        let us = &self.shift.us;
+        let us_top: C64 = self.top00.iter().zip(us).map(|(w, u)| w * u).sum();
+        let us_bottom: C64 = self.bottom00.iter().zip(us).map(|(w, u)| w * u).sum();
         r[[0, 0]] += self.r_bg + c * us_top;
         t[[0, 0]] += self.t_bg + c * us_bottom;
         let dz = lat.size_nm[2] / lat.nz as f64;
@@ -339,5 +426,53 @@ impl<'a> System<'a> {
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
+    }
+}
+
+/// Mean of the permittivity over every voxel, the mean background.
+pub fn mean_eps(eps: &Array3<C64>) -> C64 {
+    eps.iter().sum::<C64>() / eps.len() as f64
+}
+
+impl Shift {
+    fn new(
+        lat: &Lattice,
+        eps: &Array3<C64>,
+        eps_binder: f64,
+        ubg: &[C64],
+        params: ShiftParams,
+    ) -> Shift {
+        let kind = params.background;
+        let (bg, cbs) = match kind {
+            Background::Binder => {
+                let (er, rad) = shift_of(eps, eps_binder);
+                let es = (params.margin * rad).max(1e-9);
+                (C64::new(er, es), Some((er, es)))
+            }
+            Background::Mean => {
+                let m = mean_eps(eps);
+                let rad = eps.iter().map(|e| (e - m).norm()).fold(0.0, f64::max);
+                let floor = params.mean_loss_floor * rad * rad;
+                (C64::new(m.re, m.im.max(floor).max(1e-9)), None)
+            }
+        };
+        let k2 = lat.k0 * lat.k0;
+        let c = k2 * (bg - eps_binder);
+        let table = ShiftTable::new(lat, eps_binder, c);
+        let mut scr = BandScratch::new(lat.nz);
+        scr.column().copy_from_slice(ubg);
+        table.solve_column(0, &mut scr);
+        let us = scr.column().to_vec();
+        let us_norm =
+            (us.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        Shift {
+            kind,
+            eps: bg,
+            cbs,
+            c,
+            table,
+            us,
+            us_norm,
+        }
     }
 }

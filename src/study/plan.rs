@@ -20,12 +20,13 @@
 //! `N log₂(nx ny)` (the FFTs). `applications` is the mean number of operator
 //! applications per solve of this study's finished results when there are
 //! any (iterations + 1 times the method's applications per iteration, from
-//! the solver's registry), else [`DEFAULT_APPLICATIONS`]. Geometry packing and output are not modelled
+//! the solver's registry), else the measured rate of the variants'
+//! `solver.background` ([`default_applications`]). Geometry packing and output are not modelled
 //! (seconds per variant). The estimate is a guide (±2×), not a promise.
 
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Method, Precision, Scene};
+use crate::config::{Background, Method, Precision, Scene};
 use crate::pipeline;
 use crate::solver::{Problem, System};
 use ndarray::Array3;
@@ -39,9 +40,24 @@ pub const BASELINE_BYTES: f64 = 25e6;
 /// Largest grid timed directly at plan time.
 pub const CALIBRATION_VOXELS: usize = 1 << 19;
 /// Operator applications per solve assumed when no result of the study
-/// exists yet: BiCGStab on the demo layer needed 84–348 (median 232) to
-/// 1e-6 (docs/PERFORMANCE.md); 200 is the round middle.
-pub const DEFAULT_APPLICATIONS: f64 = 200.0;
+/// exists yet, on the binder background: BiCGStab on the demo layer needed
+/// 84–348 (median 232) to 1e-6 (docs/PERFORMANCE.md); 200 is the round middle.
+pub const BINDER_APPLICATIONS: f64 = 200.0;
+/// The same on the mean background: `auto` (BiCGStab) on the standard
+/// profile's layer (2 × 2 µm, 20 nm cells, red 30 % 200 nm) needed
+/// 370 over 10 solves (16–84 each, against 2534 on the binder background)
+/// at tolerance 1e-5 (`examples/study_cost`,
+/// docs/PERFORMANCE.md).
+pub const MEAN_APPLICATIONS: f64 = 37.0;
+
+/// Operator applications per solve assumed on `background` when no result
+/// of the study exists yet.
+pub fn default_applications(background: Background) -> f64 {
+    match background {
+        Background::Binder => BINDER_APPLICATIONS,
+        Background::Mean => MEAN_APPLICATIONS,
+    }
+}
 /// Work per operator application beyond the timed operator (BiCGStab's
 /// vector updates and inner products), as a factor.
 pub const KRYLOV_OVERHEAD: f64 = 1.25;
@@ -142,7 +158,7 @@ fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
     let mut out = Array3::zeros((nz, ny, nx));
     for _ in 0..3 {
         let t = Instant::now();
-        let Ok(sys) = System::new(&p) else {
+        let Ok(sys) = System::new(&p, Background::DEFAULT) else {
             return (f64::NAN, f64::NAN);
         };
         let mut scr = sys.scratch();
@@ -190,9 +206,13 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
             format!("mean of the {files} finished result(s) of this study"),
         ),
         None => (
-            DEFAULT_APPLICATIONS,
-            "assumed (no finished result yet; BiCGStab on the demo layer needed 84–348, \
-             docs/PERFORMANCE.md)"
+            variants
+                .iter()
+                .map(|v| default_applications(v.scene.solver.background))
+                .sum::<f64>()
+                / variants.len().max(1) as f64,
+            "assumed (no finished result yet): the measured rate of the variants' solver \
+             background (docs/PERFORMANCE.md, \"The mean background\")"
                 .to_string(),
         ),
     };

@@ -1,9 +1,9 @@
-//! `[solver]`: the method, tolerance, iteration limit, field precision and
-//! the effective-medium tolerance.
+//! `[solver]`: the method, tolerance, iteration limit, field precision, the
+//! Krylov methods' background and the effective-medium tolerance.
 
 use super::Checker;
-use crate::config::raw::{RawMethod, RawPrecision, RawSolver};
-use crate::config::{ConfigError, Method, Precision, SolverSpec};
+use crate::config::raw::{RawBackground, RawMethod, RawPrecision, RawSolver};
+use crate::config::{Background, ConfigError, Method, Precision, SolverSpec};
 
 const DEFAULT_TOLERANCE: f64 = 1e-6;
 const DEFAULT_MAX_ITERATIONS: usize = 5000;
@@ -52,6 +52,11 @@ impl Checker<'_> {
                 ),
             ));
         }
+        let background = match raw.and_then(|s| s.background) {
+            Some(RawBackground::Binder) => Background::Binder,
+            Some(RawBackground::Mean) => Background::Mean,
+            None => Background::default(),
+        };
         let e = raw
             .and_then(|s| s.effective_medium_tolerance)
             .unwrap_or(DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE);
@@ -66,6 +71,7 @@ impl Checker<'_> {
             tolerance,
             max_iterations,
             precision,
+            background,
             effective_medium_tolerance,
         })
     }

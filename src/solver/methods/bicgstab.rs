@@ -15,8 +15,26 @@ use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
 
 /// BiCGStab settings.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct BiCgStab {}
+#[derive(Debug, Clone, Copy)]
+pub struct BiCgStab {
+    pub shadow: Shadow,
+}
+
+/// The shadow vector r̂ of the bi-orthogonality conditions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shadow {
+    /// The first (preconditioned) residual of each restart.
+    Residual,
+    /// A fixed pseudo-random vector (seeded, so every run gives the same
+    /// bits), drawn once per solve.
+    Random,
+}
+
+impl BiCgStab {
+    pub const DEFAULT: BiCgStab = BiCgStab {
+        shadow: Shadow::Random,
+    };
+}
 
 impl Solver for BiCgStab {
     fn method(&self) -> Method {
@@ -65,8 +83,7 @@ impl BiCgStab {
             applications += 1;
             let (r0, target) = match restart(sys, scr, u, &mut r, &mut monitor, iterations, ctl)? {
                 Restart::Converged(residual) => {
-                    let (er, es) = sys.shift();
-                    let note = format!("BiCGStab, ε_r = {er:.4}, ε_s = {es:.4}");
+                    let note = format!("BiCGStab, {}", sys.describe_background());
                     return Ok(Outcome {
                         method: Method::BiCgStab,
                         iterations,
@@ -77,7 +94,11 @@ impl BiCgStab {
                 }
                 Restart::Go { norm, target } => (norm, target),
             };
-            rh.assign(&r);
+            match self.shadow {
+                Shadow::Residual => rh.assign(&r),
+                Shadow::Random if iterations == 0 => fill_random(&mut rh, r0),
+                Shadow::Random => {}
+            }
             p.fill(S::default());
             v.fill(S::default());
             let (mut rho, mut alpha, mut omega) = (one, one, one);
@@ -124,4 +145,16 @@ impl BiCgStab {
             }
         }
     }
+}
+
+/// Complex entries uniform in a square, from a fixed seed, scaled to norm
+/// `norm` (so the breakdown tests see the scale of a residual).
+fn fill_random<S: Storage>(x: &mut Array3<S>, norm: f64) {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(0x5eed);
+    for v in x.iter_mut() {
+        *v = S::store(C64::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)));
+    }
+    let scale = norm / norm_sqr(x).sqrt();
+    x.mapv_inplace(|v| S::store(v.load() * scale));
 }

@@ -104,6 +104,7 @@ mod tests {
             tolerance: 1e-6,
             max_iterations: 10,
             precision: Precision::F32,
+            background: crate::config::Background::DEFAULT,
         };
         let eps = C64::new(2.2, 0.3);
         let lat = Problem::lattice([3, 2, 5], [400.0, 300.0, 700.0], 450.0, 40.0, 0.0);

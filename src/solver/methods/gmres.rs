@@ -67,8 +67,7 @@ impl Gmres {
             applications += 1;
             let (beta, target) = match restart(sys, scr, u, &mut r, &mut monitor, inner, ctl)? {
                 Restart::Converged(residual) => {
-                    let (er, es) = sys.shift();
-                    let note = format!("GMRES({m}), ε_r = {er:.4}, ε_s = {es:.4}");
+                    let note = format!("GMRES({m}), {}", sys.describe_background());
                     return Ok(Outcome {
                         method: Method::Gmres,
                         iterations: inner,

@@ -10,6 +10,8 @@
 //! *of the same discrete* `G_b`, `V' = V − c` and `u_s = (I − c G_b)⁻¹ u_bg`.
 //! [`shift`](crate::solver::shift) applies `G_s` exactly in O(N) per harmonic without
 //! ever forming `G_b`, so guided-mode poles of the binder slab never enter.
+//! The march always runs on this shift, also where the Krylov methods use
+//! the layer's mean permittivity as background (`solver.background`).
 //! We march `du/dτ = γ r'`, `r' = u_s + G_s V' u − u`,
 //! `γ = 1 + i(ε − ε_r)/ε_s`, by explicit Euler; with `dτ = 1` this is the CBS
 //! iteration, which converges for any contrast (the Galerkin `G_b` is the
@@ -19,9 +21,9 @@
 //! above its best. Cost per step: one application of `G_s` between a forward
 //! and an inverse 2-D FFT.
 
-use super::{run_in_field_storage, Monitor, Outcome, Solver};
-use crate::config::{Method, Precision};
-use crate::solver::storage::Storage;
+use super::{Monitor, Outcome, Solver};
+use crate::config::{Background, Method, Precision};
+use crate::solver::storage::{on_field, Field, Storage};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
@@ -46,7 +48,18 @@ impl Solver for TimeMarching {
         1.0
     }
 
-    run_in_field_storage!();
+    /// Marches on the CBS shift whatever background the system was built
+    /// with: without its preconditioner the march need not converge.
+    fn run(
+        &self,
+        sys: &mut System,
+        scr: &mut Scratch,
+        u: &mut Field,
+        ctl: &Controls,
+    ) -> Result<Outcome, SolveError> {
+        sys.use_background(Background::Binder);
+        on_field!(u, u => self.iterate(sys, scr, u, ctl))
+    }
 }
 
 impl TimeMarching {
@@ -60,14 +73,13 @@ impl TimeMarching {
         u: &mut Array3<S>,
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
-        let (er, es) = sys.shift();
         let mut r = Array3::<S>::default(u.dim());
         let step = self.step;
         let mut monitor = Monitor::new(Method::TimeMarching);
         for it in 0..=ctl.max_iterations {
             let res = sys.residual_shifted(scr, u, &mut r);
             if monitor.check(res, it, ctl)? {
-                let note = format!("ε_r = {er:.4}, ε_s = {es:.4}, dτ = {step}");
+                let note = format!("{}, dτ = {step}", sys.describe_background());
                 return Ok(Outcome {
                     method: Method::TimeMarching,
                     iterations: it,

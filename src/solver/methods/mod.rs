@@ -52,7 +52,7 @@ impl Method {
             Method::Born => &born::Born,
             Method::TimeMarching => &marching::TimeMarching::DEFAULT,
             Method::Gmres => &gmres::Gmres::DEFAULT,
-            Method::BiCgStab => &bicgstab::BiCgStab {},
+            Method::BiCgStab => &bicgstab::BiCgStab::DEFAULT,
             Method::Auto => &auto::Auto,
             Method::Airy => &closed_form::Airy,
         }
@@ -119,10 +119,10 @@ pub trait Solver: Sync {
     /// field stored at `ctl.precision` and [`Solver::run`].
     fn solve(&self, p: &Problem, ctl: &Controls) -> Result<Solution, SolveError> {
         let start = Instant::now();
-        let mut sys = System::new(p)?;
+        let mut sys = System::new(p, ctl.background)?;
         let mut scr = sys.scratch();
         let mut u = Field::zeros(ctl.precision, p.eps.dim());
-        sys.set_background_field(&mut u);
+        sys.set_start_field(&mut u);
         let out = self.run(&mut sys, &mut scr, &mut u, ctl)?;
         let mut note = out.note;
         if ctl.precision == Precision::F32 {

@@ -47,6 +47,7 @@ use crate::raster::structure;
 use crate::solver;
 
 pub use appearance::{appearance_spec, PROXY_STEP_NM};
+pub use eps::fraction_eps;
 pub use grains::{build_geometry, build_geometry_seeded, grid_of, Packer, RSA_MAX_PVC};
 pub use plan::{plan_text, planned_solves, realisation_seed, RunPlan};
 pub use run::{run, run_geometry, run_with, GeometryReport, RunReport};

@@ -115,14 +115,19 @@ pub trait Solver: Sync {
         )))
     }
 
-    /// Solve one problem: build its [`System`], start from the background
-    /// field stored at `ctl.precision` and [`Solver::run`].
+    /// Solve one problem: build its [`System`], start from its start field (u_bg for Born)
+    /// stored at `ctl.precision` and [`Solver::run`].
     fn solve(&self, p: &Problem, ctl: &Controls) -> Result<Solution, SolveError> {
         let start = Instant::now();
         let mut sys = System::new(p, ctl.background)?;
         let mut scr = sys.scratch();
         let mut u = Field::zeros(ctl.precision, p.eps.dim());
-        sys.set_start_field(&mut u);
+        if self.method() == Method::Born {
+            // Born iterates the plain equation, from u_bg on any background.
+            sys.set_background_field(&mut u);
+        } else {
+            sys.set_start_field(&mut u);
+        }
         let out = self.run(&mut sys, &mut scr, &mut u, ctl)?;
         let mut note = out.note;
         if ctl.precision == Precision::F32 {

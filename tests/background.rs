@@ -11,7 +11,7 @@ use num_complex::Complex64 as C64;
 use rand::{Rng, SeedableRng};
 
 mod common;
-use common::EPS_B;
+use common::layers::{in_binder, EPS_B};
 
 fn ctl(background: Background) -> Controls {
     Controls {
@@ -55,11 +55,7 @@ fn mean_background_gives_the_binder_solution_on_random_layers() {
     for (max_im, seed) in [(0.8, 1), (0.0, 2)] {
         let eps = random_layer((40, 12, 16), max_im, seed);
         let lat = Problem::lattice([16, 12, 40], size, 500.0, 30.0, 20.0);
-        let p = Problem {
-            lattice: lat,
-            eps: &eps,
-            eps_binder: EPS_B,
-        };
+        let p = in_binder(lat, &eps);
         let binder = solver::solve(&p, Method::BiCgStab, &ctl(Background::Binder)).unwrap();
         let fb = efficiencies(&binder);
         for method in [Method::BiCgStab, Method::Gmres, Method::Auto] {
@@ -97,11 +93,7 @@ fn the_mean_background_is_the_layer_mean_with_a_loss_floor() {
     let eps = random_layer((20, 8, 8), 0.5, 3);
     let mean = eps.iter().sum::<C64>() / eps.len() as f64;
     let lat = Problem::lattice([8, 8, 20], [400.0, 400.0, 200.0], 500.0, 0.0, 0.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     let sys = System::new(&p, Background::Mean).unwrap();
     assert_eq!(sys.background(), Background::Mean);
     // Im ⟨ε⟩ ≈ 0.25 is above the floor 0.1 · max|ε − ⟨ε⟩|² (≈ 0.13 at most).
@@ -123,11 +115,7 @@ fn a_homogeneous_layer_is_solved_by_its_own_background() {
     let eps_layer = C64::new(2.3, 0.05);
     let eps = Array3::from_elem((100, 4, 4), eps_layer);
     let lat = Problem::lattice([4, 4, 100], [800.0, 800.0, 1000.0], 500.0, 50.0, 0.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     let binder = solver::solve(&p, Method::BiCgStab, &ctl(Background::Binder)).unwrap();
     let mean = solver::solve(&p, Method::BiCgStab, &ctl(Background::Mean)).unwrap();
     // V' = 0: the first residual is zero, the answer is u_s itself.
@@ -142,11 +130,7 @@ fn a_homogeneous_layer_is_solved_by_its_own_background() {
 fn time_marching_keeps_the_cbs_shift_on_the_mean_background() {
     let eps = random_layer((20, 8, 8), 0.5, 4);
     let lat = Problem::lattice([8, 8, 20], [400.0, 400.0, 200.0], 500.0, 0.0, 0.0);
-    let p = Problem {
-        lattice: lat,
-        eps: &eps,
-        eps_binder: EPS_B,
-    };
+    let p = in_binder(lat, &eps);
     let c = Controls {
         tolerance: 1e-8,
         ..ctl(Background::Mean)

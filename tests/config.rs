@@ -192,13 +192,16 @@ fn solver_precision_parses_and_limits_the_tolerance() {
 
 #[test]
 fn solver_background_parses_and_names_the_allowed_values() {
-    assert_eq!(parse(BASE).unwrap().solver.background, Background::DEFAULT);
+    assert_eq!(
+        parse(&base()).unwrap().solver.background,
+        Background::DEFAULT
+    );
     for (word, want) in [("binder", Background::Binder), ("mean", Background::Mean)] {
-        let s = parse(&format!("{BASE}\n[solver]\nbackground = \"{word}\"\n")).unwrap();
+        let s = parse(&base().set("solver.background", word)).unwrap();
         assert_eq!(s.solver.background, want);
         assert_eq!(want.name(), word);
     }
-    let err = parse(&format!("{BASE}\n[solver]\nbackground = \"vacuum\"\n")).unwrap_err();
+    let err = parse(&base().set("solver.background", "vacuum")).unwrap_err();
     assert!(matches!(err, ConfigError::Parse { .. }), "{err}");
     let shown = err.to_string();
     assert!(

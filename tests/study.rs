@@ -366,6 +366,32 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         let mean = above.iter().map(|e| e.total_reflectance).sum::<f64>() / above.len() as f64;
         assert!((mean - r).abs() < 1e-15);
     }
+    // Typed axis values: the diameters the axis set, as numbers, in the
+    // table's order; the pigment axis sets strings, so only its labels.
+    let vg = f.group("values/d").unwrap();
+    let keys = vg.member_names().unwrap();
+    assert_eq!(keys.len(), 1, "{keys:?}");
+    let d: Vec<f64> = vg.dataset(&keys[0]).unwrap().read_raw().unwrap();
+    for (n, d) in names.iter().zip(&d) {
+        let v = three
+            .variants
+            .iter()
+            .find(|v| v.name == n.as_str())
+            .unwrap();
+        assert_eq!(*d, v.scene.species[0].diameter_nm, "{}", n.as_str());
+    }
+    assert!(!f.link_exists("values/pigment"));
+    // Every variant's measured colours, as its own file has them.
+    let lab: Vec<f64> = f.dataset("colour/45_0/lab").unwrap().read_raw().unwrap();
+    let lch: Vec<f64> = f.dataset("colour/45_0/lch").unwrap().read_raw().unwrap();
+    for (i, n) in names.iter().enumerate() {
+        let path = sd.join(format!("variants/{}.h5", n.as_str()));
+        let (records, _, _) = inksim::output::h5::read_measured(&path).unwrap().unwrap();
+        let own = records.iter().find(|m| m.geometry == "45/0").unwrap();
+        assert_eq!(&lab[3 * i..3 * i + 3], &own.lab[..]);
+        let c = own.lab[1].hypot(own.lab[2]);
+        assert!((lch[3 * i + 1] - c).abs() < 1e-12);
+    }
 }
 
 #[test]

@@ -274,6 +274,8 @@ pub struct MeasuredRecord {
     /// The geometry's name (`45/0`, `d/8 SCI`, `d/8 SCE`).
     pub geometry: String,
     pub lab: [f64; 3],
+    /// CIE XYZ (Y of the perfect diffuser = 100).
+    pub xyz: [f64; 3],
     /// Standard errors of L*, a*, b* and of ΔE00 (two or more realisations).
     pub lab_se: Option<[f64; 3]>,
     pub de00_se: Option<f64>,
@@ -320,6 +322,7 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
         out.push(MeasuredRecord {
             geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
             lab: three(&d, "lab")?.unwrap_or([f64::NAN; 3]),
+            xyz: three(&d, "xyz")?.unwrap_or([f64::NAN; 3]),
             lab_se: three(&d, "lab_se")?,
             de00_se,
         });

@@ -14,8 +14,12 @@
 //!   `mean_absorption` (f64, means over the solves), `natural_srgb8` (n × 3
 //!   u8, sRGB under natural light at the first viewing angle; `has_colour`
 //!   (u8) says whether the result had an `/appearance` group) and
-//!   `labels/<axis>` (UTF-8, empty where a variant has no label on that axis).
-//!   Root attributes `study`, `profile`, `sweep_file`.
+//!   `labels/<axis>` (UTF-8, empty where a variant has no label on that axis);
+//!   `values/<axis>/<key>` (f64, NaN off the axis) for every key an axis sets
+//!   to a number; `colour/<geometry>/{xyz, lab, lch, lab_se}` (n × 3) and
+//!   `de00_se` (n) per measurement geometry (`45_0`, `d8_sci`, `d8_sce`; NaN
+//!   where a variant has none), attributes `illuminant`, `observer_deg` on
+//!   `colour`. Root attributes `study`, `profile`, `sweep_file`.
 //! - `grids/<grid>[__<axis>-<label>…].png`: for each declared grid (or the
 //!   default: first axis as rows, second as columns), one picture per
 //!   combination of the labels of the remaining axes not fixed by `where`;
@@ -30,12 +34,14 @@
 //! missing and why.
 //!
 //! - `grid`: the comparison-grid pictures.
-//! - `summary_h5`: the summary HDF5 file.
+//! - `summary_h5`: the summary HDF5 file; `summary_values` its typed axis
+//!   values and measured colours.
 //! - `page`: the Markdown and HTML pages.
 
 mod grid;
 mod page;
 mod summary_h5;
+mod summary_values;
 
 pub use grid::{shrink, CELL_PX};
 

@@ -107,6 +107,8 @@ pub(super) fn write_summary_h5(
                 .create(a.name.as_str())
                 .map_err(h)?;
         }
+        super::summary_values::write_axis_values(&f, study, rows).map_err(h)?;
+        super::summary_values::write_colours(&f, rows)?;
         f.close().map_err(h)?;
         Ok(())
     })

@@ -36,8 +36,14 @@ use std::process::ExitCode;
 )]
 struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
+    /// More than 4 × the cores are capped there.
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Memory a run may use, e.g. 512M, 24G (default: the machine's
+    /// available memory). A scene or variant whose estimate exceeds it stops
+    /// before allocating, naming the grid, the estimate and what to change.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = inksim::pipeline::memory::parse_bytes)]
+    max_memory: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -154,14 +160,15 @@ fn main() -> ExitCode {
 
 fn real_main() -> Result<ExitCode> {
     let args = Cli::parse();
-    if let Some(n) = args.threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+    let threads = args.threads.map(cli::capped_threads).transpose()?;
+    if let Some(n) = threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
             .build_global()
             .context("setting up threads")?;
     }
-    let nthreads = cli::threads(args.threads);
+    let nthreads = cli::threads(threads);
+    let memory = inksim::pipeline::memory::MemoryLimit::resolve(args.max_memory);
     match args.command {
         Command::Run {
             config,
@@ -170,6 +177,7 @@ fn real_main() -> Result<ExitCode> {
             shard,
             jobs,
         } => {
+            cli::readable(&config)?;
             if cli::is_study(&config) {
                 return cli::study::run(
                     &config,
@@ -178,6 +186,7 @@ fn real_main() -> Result<ExitCode> {
                     shard.as_deref(),
                     jobs,
                     nthreads,
+                    memory,
                 );
             }
             if profile.is_some() || shard.is_some() || jobs.is_some() {
@@ -186,13 +195,19 @@ fn real_main() -> Result<ExitCode> {
                     config.display()
                 );
             }
-            cli::scene::run(&config, output_dir)?;
+            cli::scene::run(&config, output_dir, memory)?;
         }
         Command::Plan {
             config,
             profile,
             shard,
-        } => cli::plan::plan(&config, profile.as_deref(), shard.as_deref(), nthreads)?,
+        } => cli::plan::plan(
+            &config,
+            profile.as_deref(),
+            shard.as_deref(),
+            nthreads,
+            memory,
+        )?,
         Command::Slurm {
             config,
             profile,
@@ -209,9 +224,9 @@ fn real_main() -> Result<ExitCode> {
         Command::Geometry { config, output_dir } => cli::scene::geometry(&config, output_dir)?,
         Command::Check { config } => {
             if cli::is_study(&config) {
-                cli::study::check(&config)?;
+                cli::study::check(&config, memory)?;
             } else {
-                cli::scene::check(&config)?;
+                cli::scene::check(&config, memory)?;
             }
         }
     }

@@ -256,3 +256,90 @@ fn geometry_command_writes_particles_and_picture() {
     );
     assert!(!out.join("tiny.h5").exists(), "no solves were run");
 }
+
+/// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (197 + 8) B + 25 MB = 68.8 GB by the memory model.
+fn huge_scene() -> String {
+    TINY.replace(
+        "fragment_nm = [500.0, 500.0]",
+        "fragment_nm = [4096.0, 4096.0]",
+    )
+    .replace("cell_nm = 25.0", "cell_nm = 1.0")
+}
+
+/// One line, no panic, naming the grid, the estimate, the limit and what
+/// to change.
+fn assert_memory_line(err: &str) {
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    for needle in [
+        "scene.toml: grid 4096 × 4096 × 20",
+        "estimated peak memory 68.8 GB",
+        "exceeds 1.0 GB (--max-memory)",
+        "cell_nm",
+        "raise --max-memory",
+    ] {
+        assert!(err.contains(needle), "`{needle}` missing: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), &huge_scene());
+    let cfg = cfg.to_str().unwrap();
+    let (ok, _, err) = inksim(&["check", cfg, "--max-memory", "1G"]);
+    assert!(!ok);
+    assert_memory_line(&err);
+    let out = dir.path().join("out");
+    let t = std::time::Instant::now();
+    let (ok, _, err) = inksim(&[
+        "run",
+        cfg,
+        "--max-memory",
+        "1G",
+        "--output-dir",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert_memory_line(&err);
+    assert!(t.elapsed().as_secs_f64() < 10.0, "no work before the check");
+    assert!(!out.join("tiny.h5").exists());
+    let small = write_config(dir.path(), TINY);
+    let (ok, out, _) = inksim(&["check", small.to_str().unwrap(), "--max-memory", "1G"]);
+    assert!(ok, "20 × 20 × 20 fits in 1 GB: {out}");
+    assert!(
+        out.contains("estimated peak memory 27 MB (limit 1.0 GB (--max-memory))"),
+        "{out}"
+    );
+    let (ok, _, err) = inksim(&["check", cfg, "--max-memory", "12X"]);
+    assert!(
+        !ok && err.contains("--max-memory") && err.contains("unknown unit"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_missing_file_is_not_found_whatever_the_flags() {
+    let (ok, _, err) = inksim(&["run", "/nonexistent/nope.toml", "--jobs", "2"]);
+    assert!(!ok && err.contains("nope.toml: cannot read"), "{err}");
+    assert!(!err.contains("apply to studies"), "{err}");
+}
+
+#[test]
+fn plan_on_a_scene_says_it_is_not_a_study() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let (ok, _, err) = inksim(&["plan", cfg.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("scene.toml: not a study (no [study] table)"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_huge_thread_count_is_capped_with_a_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write_config(dir.path(), TINY);
+    let (ok, _, err) = inksim(&["--threads", "100000", "check", cfg.to_str().unwrap()]);
+    assert!(ok && err.contains("--threads 100000 capped at"), "{err}");
+}

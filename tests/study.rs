@@ -565,3 +565,37 @@ fn slurm_script_is_written() {
     assert!(s.contains("--profile 'quick' --jobs 1"), "{s}");
     assert!(dir.path().join("out/quick/slurm").is_dir());
 }
+
+#[test]
+fn a_variant_beyond_the_memory_limit_fails_alone_and_the_others_finish() {
+    // The sweep × a cell axis: the four 1 nm variants (400 × 400 × 4 cells,
+    // ≈ 156 MB) exceed 100 MB, the four 50 nm ones fit.
+    let text = format!(
+        "{SWEEP}\n[[axis]]\nname = \"cell\"\nkey = \"grid.cell_nm\"\nvalues = [50.0, 1.0]\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "s.toml", &text);
+    let (ok, _, err) = inksim_in(d, &["check", "s.toml", "--max-memory", "100M"]);
+    assert!(
+        !ok && err.contains("s.toml: profile quick, variant "),
+        "{err}"
+    );
+    assert!(err.contains(": grid 400 × 400 × 4, "), "{err}");
+    let (_, out, _) = inksim_in(d, &["plan", "s.toml", "--max-memory", "100M"]);
+    let over: Vec<&str> = out.lines().filter(|l| l.contains("OVER MEMORY")).collect();
+    assert!(
+        over.len() == 4 && over.iter().all(|l| l.contains("cell1")),
+        "{out}"
+    );
+    assert!(out.contains("WARNING: 4 variant(s) exceed the memory limit 100 MB"));
+    let (ok, out, _) = inksim_in(d, &["run", "s.toml", "--max-memory", "100M"]);
+    assert!(!ok, "a failed variant makes the exit non-zero");
+    assert!(
+        out.contains("4 ran, 0 skipped (already finished), 4 failed"),
+        "{out}"
+    );
+    let results = results(&d.join("out/quick/variants"));
+    assert_eq!(results.len(), 4);
+    assert!(results.keys().all(|k| k.ends_with("cell50")), "{results:?}");
+}

@@ -65,14 +65,46 @@ pub fn is_study(path: &Path) -> bool {
         .unwrap_or(false)
 }
 
+/// The config file exists and can be read; else one line naming it.
+pub fn readable(path: &Path) -> Result<()> {
+    std::fs::File::open(path)
+        .map(|_| ())
+        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))
+}
+
 /// Read and check a study; `output_dir` (from `--output-dir`) replaces its
 /// `study.output_dir`.
 pub fn load_study(path: &Path, output_dir: Option<PathBuf>) -> Result<Study> {
+    readable(path)?;
+    anyhow::ensure!(
+        is_study(path),
+        "{}: not a study (no [study] table); `inksim run` and `inksim check` take a scene",
+        path.display()
+    );
     let mut study = Study::load(path)?;
     if let Some(d) = output_dir {
         study.output_dir = d;
     }
     Ok(study)
+}
+
+/// Most worker threads per core `--threads` is allowed (more only queue).
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// `--threads N` checked: at least 1, at most [`MAX_THREADS_PER_CORE`] × the
+/// cores (capped there with a message, as results do not depend on it).
+pub fn capped_threads(n: usize) -> Result<usize> {
+    anyhow::ensure!(n >= 1, "--threads must be at least 1");
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    let most = MAX_THREADS_PER_CORE * cores;
+    if n > most {
+        eprintln!(
+            "[inksim] --threads {n} capped at {most} ({MAX_THREADS_PER_CORE} × the {cores} \
+             core(s)); results do not depend on it"
+        );
+        return Ok(most);
+    }
+    Ok(n)
 }
 
 /// The worker threads: `--threads`, else all cores.

@@ -3,7 +3,8 @@
 
 use anyhow::Result;
 use inksim::config::{Method, Precision};
-use inksim::study::plan::{self, human_bytes, human_time};
+use inksim::pipeline::memory::{self, human_bytes, MemoryLimit};
+use inksim::study::plan::{self, human_time};
 use inksim::study::run::{self as srun, Shard, State};
 use inksim::study::sweep::Expansion;
 use std::path::Path;
@@ -15,6 +16,7 @@ pub fn plan(
     profile: Option<&str>,
     shard: Option<&str>,
     nthreads: usize,
+    limit: Option<MemoryLimit>,
 ) -> Result<()> {
     let study = super::load_study(config, None)?;
     let shard = match shard {
@@ -69,15 +71,15 @@ pub fn plan(
             format!(
                 "{} {:.0}/{:.0}",
                 m.name(),
-                plan::bytes_per_voxel(m, Precision::F64),
-                plan::bytes_per_voxel(m, Precision::F32)
+                memory::bytes_per_voxel(m, Precision::F64),
+                memory::bytes_per_voxel(m, Precision::F32)
             )
         })
         .collect();
     println!(
         "memory model: {} + voxels × (bytes per voxel of the method, f64/f32 storage: {}; \
          docs/PERFORMANCE.md) + 8 B per voxel and species",
-        human_bytes(plan::BASELINE_BYTES),
+        human_bytes(memory::BASELINE_BYTES),
         rates.join(", ")
     );
     println!(
@@ -85,6 +87,7 @@ pub fn plan(
         "#", "variant", "solves", "grid", "voxels", "real.", "est. time", "memory"
     );
     let (mut t_sum, mut s_sum, mut peak, mut n) = (0.0, 0usize, 0.0f64, 0usize);
+    let mut over = 0usize;
     for v in chosen.variants.iter().filter(|v| shard.contains(v.index)) {
         let e = plan::estimate(&v.scene, &cal);
         let st = srun::state(v);
@@ -98,7 +101,10 @@ pub fn plan(
             e.realisations,
             human_time(e.seconds),
             human_bytes(e.bytes),
-            if st == State::Done {
+            if memory::fits(&v.scene, limit).is_err() {
+                over += 1;
+                "OVER MEMORY LIMIT".to_string()
+            } else if st == State::Done {
                 "done".to_string()
             } else {
                 st.reason()
@@ -109,7 +115,7 @@ pub fn plan(
         peak = peak.max(e.bytes);
         n += 1;
     }
-    let jobs = srun::default_jobs(nthreads, peak, n);
+    let jobs = srun::default_jobs(nthreads, peak, n, limit);
     println!(
         "total ({} variants{}): {s_sum} solves, est. {} of compute on this machine; peak memory \
          {} per variant; default --jobs {jobs} ({} peak at once)",
@@ -123,6 +129,13 @@ pub fn plan(
         human_bytes(peak),
         human_bytes(peak * jobs as f64)
     );
+    if over > 0 {
+        println!(
+            "WARNING: {over} variant(s) exceed the memory limit {} and would stop before \
+             solving (`inksim check` names the grid and what to change)",
+            limit.map(|m| m.describe()).unwrap_or_default()
+        );
+    }
     if let Some(v) = chosen
         .variants
         .iter()

@@ -1,16 +1,18 @@
 //! The commands on one scene: `run`, `geometry` and `check`.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
+use inksim::pipeline::memory::{human_bytes, MemoryLimit};
 use std::path::{Path, PathBuf};
 
 /// `inksim run SCENE`: the whole pipeline; prints where the results went and
 /// the worst energy balance.
-pub fn run(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
+pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimit>) -> Result<()> {
     let mut scene = inksim::config::load_scene(config)?;
     if let Some(d) = output_dir {
         scene.output.dir = d;
     }
-    let report = inksim::pipeline::run(&scene)?;
+    let report = inksim::pipeline::run_with(&scene, false, memory)
+        .with_context(|| config.display().to_string())?;
     let worst = report
         .entries
         .iter()
@@ -41,8 +43,9 @@ pub fn geometry(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
 }
 
 /// `inksim check SCENE`: validate and print what a run would compute.
-pub fn check(config: &Path) -> Result<()> {
+pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
     let scene = inksim::config::load_scene(config)?;
+    inksim::pipeline::memory::fits(&scene, memory).with_context(|| config.display().to_string())?;
     let g = scene.grid;
     println!("{}: valid", config.display());
     println!(
@@ -74,6 +77,13 @@ pub fn check(config: &Path) -> Result<()> {
     for line in inksim::pipeline::accuracy::expected_error(&scene) {
         println!("  {line}");
     }
+    println!(
+        "estimated peak memory {}{}",
+        human_bytes(inksim::pipeline::memory::estimate_bytes(&scene)),
+        memory
+            .map(|m| format!(" (limit {})", m.describe()))
+            .unwrap_or_default()
+    );
     let (h5, png) = inksim::pipeline::result_paths(&scene);
     println!("would write {} and {}", h5.display(), png.display());
     Ok(())

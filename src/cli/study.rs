@@ -1,7 +1,7 @@
 //! The commands on a study: `run`, `check` and `merge`.
 
-use anyhow::{bail, Result};
-use inksim::study::plan;
+use anyhow::{bail, Context, Result};
+use inksim::pipeline::memory::{human_bytes, MemoryLimit};
 use inksim::study::run::{self as srun, RunOptions, State};
 use inksim::study::sweep::Expansion;
 use std::path::{Path, PathBuf};
@@ -16,6 +16,7 @@ pub fn run(
     shard: Option<&str>,
     jobs: Option<usize>,
     nthreads: usize,
+    memory: Option<MemoryLimit>,
 ) -> Result<ExitCode> {
     let study = super::load_study(config, output_dir)?;
     let shard = super::shard_of(shard)?;
@@ -25,10 +26,22 @@ pub fn run(
         .iter()
         .filter(|v| shard.contains(v.index))
         .count();
+    let peak = peak_bytes(&exp);
     let jobs = match jobs {
         Some(0) => bail!("--jobs must be at least 1"),
-        Some(j) => j,
-        None => srun::default_jobs(nthreads, peak_bytes(&exp), to_run),
+        Some(j) => {
+            let held = srun::jobs_memory_holds(peak, memory).max(1);
+            if j > held {
+                eprintln!(
+                    "[inksim] --jobs {j} capped at {held}: {held} variant(s) of up to {} each \
+                     fit in {}",
+                    human_bytes(peak),
+                    memory.map(|m| m.describe()).unwrap_or_default()
+                );
+            }
+            j.min(held)
+        }
+        None => srun::default_jobs(nthreads, peak, to_run, memory),
     };
     eprintln!(
         "[inksim] study {} profile {}: {} variants ({} in shard {}/{}), results in {}",
@@ -46,6 +59,7 @@ pub fn run(
             jobs,
             shard,
             quiet: false,
+            memory,
         },
     );
     print!("{}", report.text());
@@ -69,8 +83,9 @@ pub fn run(
 }
 
 /// `inksim check STUDY`: expand every profile (which validates every
-/// variant's scene) and say how many variants each has.
-pub fn check(config: &Path) -> Result<()> {
+/// variant's scene), hold every variant to the memory limit and say how
+/// many variants each has.
+pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
     let study = super::load_study(config, None)?;
     let profiles: Vec<Option<String>> = if study.profiles.is_empty() {
         vec![None]
@@ -80,6 +95,16 @@ pub fn check(config: &Path) -> Result<()> {
     println!("{}: valid study `{}`", config.display(), study.name);
     for p in profiles {
         let exp = study.expand(p.as_deref())?;
+        for v in &exp.variants {
+            inksim::pipeline::memory::fits(&v.scene, memory).with_context(|| {
+                format!(
+                    "{}: profile {}, variant {}",
+                    config.display(),
+                    p.as_deref().unwrap_or("(none)"),
+                    v.name
+                )
+            })?;
+        }
         println!(
             "profile {}: {} variants, all valid scenes; results in {}",
             p.as_deref().unwrap_or("(none)"),
@@ -110,13 +135,8 @@ pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) 
 
 /// Largest memory estimate over the variants (bytes).
 fn peak_bytes(exp: &Expansion) -> f64 {
-    let cal = plan::Calibration {
-        grids: Default::default(),
-        applications: plan::MEAN_APPLICATIONS,
-        applications_source: String::new(),
-    };
     exp.variants
         .iter()
-        .map(|v| plan::estimate(&v.scene, &cal).bytes)
+        .map(|v| inksim::pipeline::memory::estimate_bytes(&v.scene))
         .fold(0.0, f64::max)
 }

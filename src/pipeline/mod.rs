@@ -22,6 +22,8 @@
 //! - `result`: the result file assembled from a run's parts;
 //! - `run`: a run end to end ([`run`]), and the geometry-only run
 //!   ([`run_geometry`]);
+//! - [`memory`]: the memory model of a run and the preflight against the
+//!   memory limit;
 //! - [`accuracy`]: the expected error of a scene's fidelity settings.
 
 pub mod accuracy;
@@ -29,6 +31,7 @@ mod appearance;
 mod eps;
 mod grains;
 mod layer;
+pub mod memory;
 mod plan;
 mod result;
 mod run;
@@ -86,6 +89,8 @@ pub enum PipelineError {
     Structure(#[from] structure::StructureError),
     #[error("{0}")]
     NoGrains(String),
+    #[error(transparent)]
+    Memory(Box<memory::OverMemory>),
 }
 
 /// Paths of the result files of a scene.

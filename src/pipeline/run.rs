@@ -19,6 +19,7 @@ use crate::raster::{self, structure, Raster};
 use super::appearance::appearance_spec;
 use super::grains::{build_geometry, grid_of, Packer};
 use super::layer;
+use super::memory::{self, MemoryLimit};
 use super::plan::{plan_text, RunPlan};
 use super::result::ResultParts;
 use super::{check_output_dir, result_paths, PipelineError, SUPERSAMPLE};
@@ -37,20 +38,27 @@ pub struct RunReport {
 }
 
 /// Run a scene end to end and write its result files, with a progress bar
-/// (terminal) or log lines.
+/// (terminal) or log lines, held to the machine's available memory.
 pub fn run(scene: &Scene) -> Result<RunReport, PipelineError> {
-    run_with(scene, false)
+    run_with(scene, false, MemoryLimit::resolve(None))
 }
 
 /// [`run`], optionally without any progress output (variants of a study
-/// running side by side report through the study's own bar).
-pub fn run_with(scene: &Scene, quiet: bool) -> Result<RunReport, PipelineError> {
+/// running side by side report through the study's own bar), held to
+/// `limit`: a scene whose memory estimate exceeds it stops before any large
+/// allocation ([`memory::preflight`]).
+pub fn run_with(
+    scene: &Scene,
+    quiet: bool,
+    limit: Option<MemoryLimit>,
+) -> Result<RunReport, PipelineError> {
     let (result_path, picture_path) = result_paths(scene);
     let orders_path = scene
         .output
         .dir
         .join(format!("{}-orders.png", scene.output.name));
     check_output_dir(&scene.output.dir)?;
+    memory::preflight(scene, limit)?;
     let mut plan = RunPlan::of(scene);
     let total = plan.solves(scene) as u64;
     let progress = if quiet {

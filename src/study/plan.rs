@@ -3,12 +3,8 @@
 //!
 //! Work: [`pipeline::planned_solves`] solves on an `nx × ny × nz` grid.
 //!
-//! Memory model (peak resident bytes of one variant):
-//! `BASELINE_BYTES + voxels × (B_method + 8 × species)`, with `B_method` the
-//! method's bytes per voxel from the solver registry ([`bytes_per_voxel`]:
-//! the solver's fields at the storage precision plus 32 B of raster and
-//! tables; measured in docs/PERFORMANCE.md) and 8 B per species for the
-//! raster's volume fractions.
+//! Memory: the run's own model, [`pipeline::memory`] (the one `check` and
+//! `run` hold a run to).
 //!
 //! Time model (one variant, all threads): per solve
 //! `t_setup + applications × t_apply × KRYLOV_OVERHEAD`, where `t_setup`
@@ -26,7 +22,7 @@
 
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Background, Method, Precision, Scene};
+use crate::config::{Background, Scene};
 use crate::pipeline;
 use crate::solver::{Problem, System};
 use ndarray::Array3;
@@ -34,9 +30,6 @@ use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-/// Resident memory of the program before any field is allocated (binary,
-/// geometry, tables): the 23 MB baseline of docs/PERFORMANCE.md, rounded up.
-pub const BASELINE_BYTES: f64 = 25e6;
 /// Largest grid timed directly at plan time.
 pub const CALIBRATION_VOXELS: usize = 1 << 19;
 /// Operator applications per solve assumed when no result of the study
@@ -61,14 +54,6 @@ pub fn default_applications(background: Background) -> f64 {
 /// Work per operator application beyond the timed operator (BiCGStab's
 /// vector updates and inner products), as a factor.
 pub const KRYLOV_OVERHEAD: f64 = 1.25;
-
-/// Bytes per voxel of a solve: the method's own peak from the solver's
-/// registry (measured by `examples/solver_memory`, docs/PERFORMANCE.md,
-/// "Memory") plus the pipeline's ε grid and its flipped copy for the solves
-/// from below (16 B each).
-pub fn bytes_per_voxel(m: Method, p: Precision) -> f64 {
-    m.solver().bytes_per_voxel(p) + 32.0
-}
 
 /// Timings of one grid.
 #[derive(Debug, Clone, Copy)]
@@ -231,10 +216,7 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
     let seconds = cal.grids.get(&grid).map_or(f64::NAN, |t| {
         solves as f64 * (t.setup_s + cal.applications * t.apply_s * KRYLOV_OVERHEAD)
     });
-    let bytes = BASELINE_BYTES
-        + voxels as f64
-            * (bytes_per_voxel(scene.solver.method, scene.solver.precision)
-                + 8.0 * scene.species.len() as f64);
+    let bytes = pipeline::memory::estimate_bytes(scene);
     Estimate {
         solves,
         grid,
@@ -258,29 +240,15 @@ pub fn human_time(s: f64) -> String {
     }
 }
 
-/// `12 MB`, `3.4 GB`.
-pub fn human_bytes(b: f64) -> String {
-    if b < 1e9 {
-        format!("{:.0} MB", b / 1e6)
-    } else {
-        format!("{:.1} GB", b / 1e9)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn memory_model_matches_the_documented_rates() {
-        assert_eq!(bytes_per_voxel(Method::TimeMarching, Precision::F64), 118.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64), 197.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32), 141.0);
-        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64), 453.0);
+    fn times_print_in_their_unit() {
         assert_eq!(human_time(30.0), "30.0 s");
         assert_eq!(human_time(600.0), "10 min");
         assert_eq!(human_time(7200.0), "2.0 h");
-        assert_eq!(human_bytes(2.5e9), "2.5 GB");
     }
 
     #[test]

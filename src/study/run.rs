@@ -23,6 +23,7 @@ use super::sweep::Variant;
 use crate::output::h5;
 use crate::output::progress::Progress;
 use crate::pipeline;
+use crate::pipeline::memory::{LimitSource, MemoryLimit};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -163,6 +164,8 @@ pub struct RunOptions {
     pub shard: Shard,
     /// No progress output (tests).
     pub quiet: bool,
+    /// The memory each variant is held to ([`pipeline::memory::preflight`]).
+    pub memory: Option<MemoryLimit>,
 }
 
 /// What happened to one variant.
@@ -273,7 +276,7 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
                     todo.len(),
                     states[i].reason()
                 ));
-                let r = run_one(v);
+                let r = run_one(v, opts.memory);
                 let msg = match &r {
                     Ok(t) => format!("{} done in {t:.1} s", v.name),
                     Err(e) => format!("{} FAILED: {e}", v.name),
@@ -308,7 +311,7 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
 }
 
 /// Run one variant; a panic inside is caught so the others go on.
-fn run_one(v: &Variant) -> Result<f64, String> {
+fn run_one(v: &Variant, memory: Option<MemoryLimit>) -> Result<f64, String> {
     let t = Instant::now();
     let (h5, png) = paths(v);
     for p in [&h5, &png] {
@@ -317,7 +320,7 @@ fn run_one(v: &Variant) -> Result<f64, String> {
         let _ = std::fs::remove_file(PathBuf::from(tmp));
     }
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pipeline::run_with(&v.scene, true)
+        pipeline::run_with(&v.scene, true, memory)
     }));
     match r {
         Ok(Ok(_)) => Ok(t.elapsed().as_secs_f64()),
@@ -333,21 +336,32 @@ fn run_one(v: &Variant) -> Result<f64, String> {
 }
 
 /// Default number of parallel variants: the smallest of the cores, what the
-/// available memory holds at 80 % (`MemAvailable` of /proc/meminfo over the
-/// largest per-variant estimate), and the variants to run; at least 1.
-pub fn default_jobs(threads: usize, peak_bytes: f64, to_run: usize) -> usize {
-    let by_mem = available_memory()
-        .map(|m| ((0.8 * m as f64) / peak_bytes.max(1.0)).floor() as usize)
-        .unwrap_or(usize::MAX);
-    threads.min(by_mem).min(to_run).max(1)
+/// memory limit holds (all of `--max-memory`, 80 % of the machine's
+/// available memory, over the largest per-variant estimate), and the
+/// variants to run; at least 1.
+pub fn default_jobs(
+    threads: usize,
+    peak_bytes: f64,
+    to_run: usize,
+    memory: Option<MemoryLimit>,
+) -> usize {
+    threads
+        .min(jobs_memory_holds(peak_bytes, memory))
+        .min(to_run)
+        .max(1)
 }
 
-/// Available memory in bytes (Linux `MemAvailable`), if known.
-pub fn available_memory() -> Option<u64> {
-    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
+/// How many variants of `peak_bytes` each the memory limit holds at once.
+pub fn jobs_memory_holds(peak_bytes: f64, memory: Option<MemoryLimit>) -> usize {
+    memory
+        .map(|m| {
+            let usable = match m.source {
+                LimitSource::Flag => m.bytes,
+                LimitSource::Available => 0.8 * m.bytes,
+            };
+            (usable / peak_bytes.max(1.0)).floor() as usize
+        })
+        .unwrap_or(usize::MAX)
 }
 
 #[cfg(test)]

@@ -1,0 +1,260 @@
+//! The memory model of a run and the preflight that holds a run to it.
+//!
+//! Peak resident bytes of one scene (or study variant):
+//! `BASELINE_BYTES + voxels × (B_method + 32 + 8 × species)`, with
+//! `B_method` the solver's own peak per voxel from its registry
+//! (`Solver::bytes_per_voxel`, measured by `examples/solver_memory`,
+//! docs/PERFORMANCE.md "Memory"), 32 B for the pipeline's ε grid and its
+//! flipped copy for the solves from below, and 8 B per species for the
+//! raster's volume fractions. The grid is the one the run solves on
+//! (including the cells a relief adds on top).
+//!
+//! The limit is the smaller of `--max-memory` and the machine's available
+//! memory (`MemAvailable` of /proc/meminfo, where present). [`preflight`]
+//! compares the estimate with it before anything large is allocated and,
+//! when the estimate is within it, reserves the estimate once with a
+//! fallible allocation (`Vec::try_reserve_exact`), so that a request the
+//! system refuses is an error of this scene rather than an abort of the
+//! process.
+
+use crate::config::{Method, Precision, Scene};
+
+use super::grains::grid_of;
+use super::PipelineError;
+
+/// Resident memory of the program before any field is allocated (binary,
+/// geometry, tables): the 23 MB baseline of docs/PERFORMANCE.md, rounded up.
+pub const BASELINE_BYTES: f64 = 25e6;
+
+/// Bytes per voxel of a solve: the method's own peak from the solver's
+/// registry plus the pipeline's ε grid and its flipped copy (16 B each).
+pub fn bytes_per_voxel(m: Method, p: Precision) -> f64 {
+    m.solver().bytes_per_voxel(p) + 32.0
+}
+
+/// The grid a scene solves on, `[nx, ny, nz]`.
+pub fn solve_grid(scene: &Scene) -> [usize; 3] {
+    let g = grid_of(scene);
+    [g.nx, g.ny, g.nz]
+}
+
+/// Estimated peak resident bytes of a run of `scene`.
+pub fn estimate_bytes(scene: &Scene) -> f64 {
+    let voxels: f64 = solve_grid(scene).iter().map(|&n| n as f64).product();
+    BASELINE_BYTES
+        + voxels
+            * (bytes_per_voxel(scene.solver.method, scene.solver.precision)
+                + 8.0 * scene.species.len() as f64)
+}
+
+/// A run whose memory estimate exceeds the limit: what to say about it.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "grid {grid}, method {method} ({precision} fields): estimated peak memory {estimate} \
+     exceeds {limit}; use fewer cells (a larger [grid] cell_nm or a smaller fragment), \
+     solver precision = \"f32\" or method = \"time-marching\", or {remedy}"
+)]
+pub struct OverMemory {
+    pub grid: String,
+    pub method: String,
+    pub precision: String,
+    pub estimate: String,
+    pub limit: String,
+    pub remedy: &'static str,
+}
+
+/// Where a memory limit came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitSource {
+    /// `--max-memory`.
+    Flag,
+    /// The machine's available memory (`MemAvailable`).
+    Available,
+}
+
+/// The memory a run may use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MemoryLimit {
+    pub bytes: f64,
+    pub source: LimitSource,
+}
+
+impl MemoryLimit {
+    /// The smaller of `flag` (bytes) and the machine's available memory;
+    /// `None` when neither is known.
+    pub fn resolve(flag: Option<u64>) -> Option<MemoryLimit> {
+        let flag = flag.map(|b| MemoryLimit {
+            bytes: b as f64,
+            source: LimitSource::Flag,
+        });
+        let machine = available_memory().map(|b| MemoryLimit {
+            bytes: b as f64,
+            source: LimitSource::Available,
+        });
+        match (flag, machine) {
+            (Some(f), Some(m)) if m.bytes < f.bytes => Some(m),
+            (Some(f), _) => Some(f),
+            (None, m) => m,
+        }
+    }
+
+    /// What to change when a run does not fit.
+    pub fn remedy(&self) -> &'static str {
+        match self.source {
+            LimitSource::Flag => "raise --max-memory",
+            LimitSource::Available => "run where more memory is free",
+        }
+    }
+
+    /// `24.0 GB (--max-memory)` or `24.0 GB (available on this machine)`.
+    pub fn describe(&self) -> String {
+        let from = match self.source {
+            LimitSource::Flag => "--max-memory",
+            LimitSource::Available => "available on this machine",
+        };
+        format!("{} ({from})", human_bytes(self.bytes))
+    }
+}
+
+/// Available memory in bytes (Linux `MemAvailable`), if known.
+pub fn available_memory() -> Option<u64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    meminfo_available(&s)
+}
+
+/// `MemAvailable` of /proc/meminfo text, in bytes.
+fn meminfo_available(s: &str) -> Option<u64> {
+    let line = s.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Check the scene's estimate against `limit`; one error line naming the
+/// grid, the estimate, the limit and what to change (`check`, `plan`).
+pub fn fits(scene: &Scene, limit: Option<MemoryLimit>) -> Result<(), PipelineError> {
+    admit(scene, limit, false)
+}
+
+/// [`fits`], then reserve the estimate once with a fallible allocation so a
+/// request the system refuses is this scene's error, not an abort (`run`).
+pub fn preflight(scene: &Scene, limit: Option<MemoryLimit>) -> Result<(), PipelineError> {
+    admit(scene, limit, true)
+}
+
+fn admit(scene: &Scene, limit: Option<MemoryLimit>, reserve: bool) -> Result<(), PipelineError> {
+    if scene.is_molecular() {
+        return Ok(());
+    }
+    let bytes = estimate_bytes(scene);
+    let [nx, ny, nz] = solve_grid(scene);
+    let what = |limit: String, remedy| {
+        PipelineError::Memory(Box::new(OverMemory {
+            grid: format!("{nx} × {ny} × {nz}"),
+            method: scene.solver.method.name().to_string(),
+            precision: match scene.solver.precision {
+                Precision::F64 => "f64",
+                Precision::F32 => "f32",
+            }
+            .to_string(),
+            estimate: human_bytes(bytes),
+            limit,
+            remedy,
+        }))
+    };
+    if let Some(l) = limit {
+        if bytes > l.bytes {
+            return Err(what(l.describe(), l.remedy()));
+        }
+    }
+    if reserve {
+        let mut probe: Vec<u8> = Vec::new();
+        probe.try_reserve_exact(bytes as usize).map_err(|_| {
+            what(
+                "what the system would allocate".into(),
+                "run where more memory is free",
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// `12 MB`, `3.4 GB`, `1.2 TB`.
+pub fn human_bytes(b: f64) -> String {
+    if b < 1e9 {
+        format!("{:.0} MB", b / 1e6)
+    } else if b < 1e12 {
+        format!("{:.1} GB", b / 1e9)
+    } else {
+        format!("{:.1} TB", b / 1e12)
+    }
+}
+
+/// Parse a memory size: bytes, or a number with K, M, G or T (powers of
+/// 1000, an optional trailing `B`; `Ki`, `Mi`, `Gi`, `Ti` for powers of 1024).
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let unit = unit.trim().to_ascii_uppercase();
+    let unit = unit.strip_suffix('B').unwrap_or(&unit);
+    let scale = match unit {
+        "" => 1.0,
+        "K" => 1e3,
+        "M" => 1e6,
+        "G" => 1e9,
+        "T" => 1e12,
+        "KI" => 1024.0,
+        "MI" => 1024f64.powi(2),
+        "GI" => 1024f64.powi(3),
+        "TI" => 1024f64.powi(4),
+        _ => {
+            return Err(format!(
+                "`{s}`: unknown unit (allowed: K, M, G, T, Ki, Mi, Gi, Ti)"
+            ))
+        }
+    };
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("`{s}`: not a size (e.g. 512M, 24G)"))?;
+    let b = v * scale;
+    if !(1.0..1e18).contains(&b) {
+        return Err(format!("`{s}`: must be between 1 byte and 1000 PB"));
+    }
+    Ok(b as u64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_with_units() {
+        assert_eq!(parse_bytes("512"), Ok(512));
+        assert_eq!(parse_bytes("24G"), Ok(24_000_000_000));
+        assert_eq!(parse_bytes("2.5 GB"), Ok(2_500_000_000));
+        assert_eq!(parse_bytes("1Mi"), Ok(1 << 20));
+        assert_eq!(parse_bytes("3kb"), Ok(3000));
+        assert!(parse_bytes("12X").is_err());
+        assert!(parse_bytes("G").is_err());
+        assert!(parse_bytes("0").is_err());
+    }
+
+    #[test]
+    fn meminfo_is_read_in_kibibytes() {
+        let text = "MemTotal:       16318412 kB\nMemFree:  1 kB\nMemAvailable:    2000 kB\n";
+        assert_eq!(meminfo_available(text), Some(2_048_000));
+        assert_eq!(meminfo_available("MemTotal: 5 kB\n"), None);
+    }
+
+    #[test]
+    fn the_model_adds_the_pipeline_grids_to_the_solver_rates() {
+        assert_eq!(bytes_per_voxel(Method::TimeMarching, Precision::F64), 118.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64), 197.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32), 141.0);
+        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64), 453.0);
+        assert_eq!(human_bytes(2.5e9), "2.5 GB");
+        assert_eq!(human_bytes(2.2e14), "220.0 TB");
+    }
+}

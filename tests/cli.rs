@@ -343,3 +343,23 @@ fn a_huge_thread_count_is_capped_with_a_message() {
     let (ok, _, err) = inksim(&["--threads", "100000", "check", cfg.to_str().unwrap()]);
     assert!(ok && err.contains("--threads 100000 capped at"), "{err}");
 }
+
+#[test]
+fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("tiny.h5")).unwrap();
+    let text = format!("{TINY}dir = \"{}\"\n", out.display());
+    let cfg = write_config(dir.path(), &text);
+    for cmd in ["check", "run"] {
+        let (ok, _, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok, "{cmd}");
+        assert!(
+            err.contains("tiny.h5: is a folder where a result file goes"),
+            "{cmd}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+    let written: Vec<_> = std::fs::read_dir(&out).unwrap().flatten().collect();
+    assert_eq!(written.len(), 1, "nothing but the folder: {written:?}");
+}

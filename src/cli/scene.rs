@@ -45,7 +45,9 @@ pub fn geometry(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
 /// `inksim check SCENE`: validate and print what a run would compute.
 pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
     let scene = inksim::config::load_scene(config)?;
-    inksim::pipeline::memory::fits(&scene, memory).with_context(|| config.display().to_string())?;
+    inksim::pipeline::memory::fits(&scene, memory)
+        .and_then(|()| inksim::pipeline::check_output_files(&scene))
+        .with_context(|| config.display().to_string())?;
     let g = scene.grid;
     println!("{}: valid", config.display());
     println!(

@@ -96,14 +96,16 @@ pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
     for p in profiles {
         let exp = study.expand(p.as_deref())?;
         for v in &exp.variants {
-            inksim::pipeline::memory::fits(&v.scene, memory).with_context(|| {
-                format!(
-                    "{}: profile {}, variant {}",
-                    config.display(),
-                    p.as_deref().unwrap_or("(none)"),
-                    v.name
-                )
-            })?;
+            inksim::pipeline::memory::fits(&v.scene, memory)
+                .and_then(|()| inksim::pipeline::check_output_files(&v.scene))
+                .with_context(|| {
+                    format!(
+                        "{}: profile {}, variant {}",
+                        config.display(),
+                        p.as_deref().unwrap_or("(none)"),
+                        v.name
+                    )
+                })?;
         }
         println!(
             "profile {}: {} variants, all valid scenes; results in {}",

@@ -102,6 +102,41 @@ pub fn result_paths(scene: &Scene) -> (PathBuf, PathBuf) {
     )
 }
 
+/// Every file a run of `scene` writes: the result, the picture, the orders
+/// picture and, when asked for, the MERL file.
+pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
+    let (h5, png) = result_paths(scene);
+    let d = &scene.output.dir;
+    let mut files = vec![h5, png, d.join(format!("{}-orders.png", scene.output.name))];
+    if scene.appearance.products.merl {
+        files.push(d.join(format!("{}.binary", scene.output.name)));
+    }
+    files
+}
+
+/// No output path is taken by something a file cannot replace: the output
+/// folder is a folder (or not there yet) and no result file's name is a
+/// folder. Checked by `check` and before a run's first solve.
+pub fn check_output_files(scene: &Scene) -> Result<(), PipelineError> {
+    let err = |path: &Path, m: &str| PipelineError::Output {
+        path: path.to_path_buf(),
+        message: m.to_string(),
+    };
+    let dir = &scene.output.dir;
+    if dir.exists() && !dir.is_dir() {
+        return Err(err(dir, "is a file, not a folder"));
+    }
+    for f in output_files(scene) {
+        if f.is_dir() {
+            return Err(err(
+                &f,
+                "is a folder where a result file goes; remove it or choose another [output] name",
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Make sure the output folder exists and accepts files.
 pub fn check_output_dir(dir: &Path) -> Result<(), PipelineError> {
     let err = |m: String| PipelineError::Output {

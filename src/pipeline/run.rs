@@ -22,7 +22,7 @@ use super::layer;
 use super::memory::{self, MemoryLimit};
 use super::plan::{plan_text, RunPlan};
 use super::result::ResultParts;
-use super::{check_output_dir, result_paths, PipelineError, SUPERSAMPLE};
+use super::{check_output_dir, check_output_files, result_paths, PipelineError, SUPERSAMPLE};
 
 /// What a finished run produced.
 pub struct RunReport {
@@ -57,6 +57,7 @@ pub fn run_with(
         .output
         .dir
         .join(format!("{}-orders.png", scene.output.name));
+    check_output_files(scene)?;
     check_output_dir(&scene.output.dir)?;
     memory::preflight(scene, limit)?;
     let mut plan = RunPlan::of(scene);

@@ -257,13 +257,10 @@ fn geometry_command_writes_particles_and_picture() {
     assert!(!out.join("tiny.h5").exists(), "no solves were run");
 }
 
-/// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (197 + 8) B + 25 MB = 68.8 GB by the memory model.
-fn huge_scene() -> String {
-    TINY.replace(
-        "fragment_nm = [500.0, 500.0]",
-        "fragment_nm = [4096.0, 4096.0]",
-    )
-    .replace("cell_nm = 25.0", "cell_nm = 1.0")
+/// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (197 + 8) B
+/// + 25 MB = 68.8 GB by the memory model.
+fn huge_scene() -> SceneToml {
+    tiny().fragment_nm(4096.0).cell_nm(1.0).z_cell_nm(20.0)
 }
 
 /// One line, no panic, naming the grid, the estimate, the limit and what
@@ -285,7 +282,7 @@ fn assert_memory_line(err: &str) {
 #[test]
 fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), &huge_scene());
+    let cfg = huge_scene().write(dir.path());
     let cfg = cfg.to_str().unwrap();
     let (ok, _, err) = inksim(&["check", cfg, "--max-memory", "1G"]);
     assert!(!ok);
@@ -304,7 +301,7 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert_memory_line(&err);
     assert!(t.elapsed().as_secs_f64() < 10.0, "no work before the check");
     assert!(!out.join("tiny.h5").exists());
-    let small = write_config(dir.path(), TINY);
+    let small = tiny().write(dir.path());
     let (ok, out, _) = inksim(&["check", small.to_str().unwrap(), "--max-memory", "1G"]);
     assert!(ok, "20 × 20 × 20 fits in 1 GB: {out}");
     assert!(
@@ -328,7 +325,7 @@ fn a_missing_file_is_not_found_whatever_the_flags() {
 #[test]
 fn plan_on_a_scene_says_it_is_not_a_study() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let (ok, _, err) = inksim(&["plan", cfg.to_str().unwrap()]);
     assert!(
         !ok && err.contains("scene.toml: not a study (no [study] table)"),
@@ -339,7 +336,7 @@ fn plan_on_a_scene_says_it_is_not_a_study() {
 #[test]
 fn a_huge_thread_count_is_capped_with_a_message() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write_config(dir.path(), TINY);
+    let cfg = tiny().write(dir.path());
     let (ok, _, err) = inksim(&["--threads", "100000", "check", cfg.to_str().unwrap()]);
     assert!(ok && err.contains("--threads 100000 capped at"), "{err}");
 }
@@ -349,8 +346,7 @@ fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir_all(out.join("tiny.h5")).unwrap();
-    let text = format!("{TINY}dir = \"{}\"\n", out.display());
-    let cfg = write_config(dir.path(), &text);
+    let cfg = tiny().output(&out, "tiny").write(dir.path());
     for cmd in ["check", "run"] {
         let (ok, _, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
         assert!(!ok, "{cmd}");

@@ -570,9 +570,7 @@ fn slurm_script_is_written() {
 fn a_variant_beyond_the_memory_limit_fails_alone_and_the_others_finish() {
     // The sweep × a cell axis: the four 1 nm variants (400 × 400 × 4 cells,
     // ≈ 156 MB) exceed 100 MB, the four 50 nm ones fit.
-    let text = format!(
-        "{SWEEP}\n[[axis]]\nname = \"cell\"\nkey = \"grid.cell_nm\"\nvalues = [50.0, 1.0]\n"
-    );
+    let text = sweep().axis("cell", "grid.cell_nm", "[50.0, 1.0]").toml();
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     write(d, "s.toml", &text);

@@ -23,4 +23,4 @@ pub mod solver;
 pub mod study;
 
 /// Version string embedded in every result file.
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("INKSIM_COMMIT"));

@@ -29,7 +29,7 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(
     name = "inksim",
-    version,
+    version = inksim::VERSION,
     about,
     long_about,
     after_help = "Examples:\n  inksim run configs/demo.toml                 run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml               validate and show the work a run would do\n  inksim --threads 1 run scene.toml            same numbers for any thread count\n  inksim plan configs/study.toml               variants, work, estimated time and memory per profile\n  inksim run configs/study.toml --profile quick    run (or resume) the whole study\n  inksim run configs/study.toml --shard 0/4    run a quarter of it\n  inksim slurm configs/study.toml --shards 16  write an sbatch job-array script\n  inksim merge configs/study.toml              summary.h5, comparison grids, summary.md/html"

@@ -359,3 +359,34 @@ fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
     let written: Vec<_> = std::fs::read_dir(&out).unwrap().flatten().collect();
     assert_eq!(written.len(), 1, "nothing but the folder: {written:?}");
 }
+
+#[test]
+fn version_names_the_commit_and_log_lines_carry_their_time() {
+    let (ok, out, _) = inksim(&["--version"]);
+    assert!(ok);
+    let v = out.trim().strip_prefix("inksim ").unwrap();
+    assert_eq!(v, inksim::VERSION);
+    let (pkg, commit) = v.split_once('+').unwrap();
+    assert_eq!(pkg, env!("CARGO_PKG_VERSION"));
+    assert!(
+        commit == "unknown"
+            || (commit.len() == 12 && commit.chars().all(|c| c.is_ascii_hexdigit())),
+        "{commit}"
+    );
+    // Off a terminal every progress line of a run starts with its UTC time.
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, err, _, out) = run_scene(dir.path(), &tiny());
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert!(lines.len() > 3, "{err}");
+    for l in lines {
+        let b = l.as_bytes();
+        assert!(
+            b.len() > 21 && b[4] == b'-' && b[10] == b'T' && b[19] == b'Z' && b[20] == b' ',
+            "{l}"
+        );
+    }
+    // The result file names the same version.
+    let s = inksim::output::h5::read_summary(&out.join("tiny.h5")).unwrap();
+    assert_eq!(s.version, inksim::VERSION);
+}

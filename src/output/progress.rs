@@ -3,7 +3,8 @@
 //! On a terminal (`stderr` is a TTY) [`Progress`] draws an indicatif bar with
 //! elapsed time and ETA. Otherwise (logs, CI, batch jobs) it writes plain lines
 //! to stderr,
-//! `[inksim] label: 3/9 (33%), elapsed 12.3 s, eta 24.6 s — message`,
+//! `2026-11-23T21:37:05Z [inksim] label: 3/9 (33%), elapsed 12.3 s, eta 24.6 s — message`
+//! (every plain line starts with its UTC time, [`utc_stamp`]),
 //! at most one every [`PLAIN_INTERVAL`] plus the line that reaches the total,
 //! so log files stay short. All methods take `&self` and the type is `Sync`,
 //! so rayon workers can report directly. Output errors are ignored: progress
@@ -11,7 +12,7 @@
 
 use std::io::{IsTerminal, Write};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -113,7 +114,7 @@ impl Progress {
                         self.start.elapsed(),
                         message,
                     );
-                    let _ = writeln!(p.out, "{line}");
+                    let _ = writeln!(p.out, "{} {line}", utc_stamp(SystemTime::now()));
                     let _ = p.out.flush();
                 }
             }
@@ -127,7 +128,7 @@ impl Progress {
             Mode::Bar(bar) => bar.println(line),
             Mode::Plain(m) => {
                 let mut p = lock(m);
-                let _ = writeln!(p.out, "{line}");
+                let _ = writeln!(p.out, "{} {line}", utc_stamp(SystemTime::now()));
                 let _ = p.out.flush();
             }
             Mode::Hidden => {}
@@ -148,7 +149,7 @@ impl Progress {
                     self.start.elapsed().as_secs_f64(),
                     suffix(message)
                 );
-                let _ = writeln!(p.out, "{line}");
+                let _ = writeln!(p.out, "{} {line}", utc_stamp(SystemTime::now()));
                 let _ = p.out.flush();
             }
             Mode::Hidden => {}
@@ -179,6 +180,29 @@ fn suffix(message: &str) -> String {
 }
 
 /// One plain progress line (see the module docs).
+/// `t` as an ISO 8601 UTC time to the second, `2026-11-23T21:37:05Z`
+/// (civil date from days since 1970-01-01, proleptic Gregorian).
+pub fn utc_stamp(t: SystemTime) -> String {
+    let secs = t.duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs()) as i64;
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Howard Hinnant's days-to-civil.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
 pub fn plain_line(label: &str, pos: u64, total: u64, elapsed: Duration, message: &str) -> String {
     let secs = elapsed.as_secs_f64();
     let percent = if total == 0 {
@@ -229,6 +253,31 @@ mod tests {
         }
     }
 
+    /// The lines without their UTC stamps, each checked to be one.
+    fn unstamped(lines: Vec<String>) -> Vec<String> {
+        lines
+            .into_iter()
+            .map(|l| {
+                let (stamp, rest) = l.split_at(20);
+                let b = stamp.as_bytes();
+                assert!(
+                    b[4] == b'-' && b[10] == b'T' && b[19] == b'Z' && rest.starts_with(' '),
+                    "{l}"
+                );
+                rest[1..].to_string()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn utc_stamps_are_the_civil_time() {
+        let at = |s: u64| utc_stamp(UNIX_EPOCH + Duration::from_secs(s));
+        assert_eq!(at(0), "1970-01-01T00:00:00Z");
+        assert_eq!(at(951_782_400), "2000-02-29T00:00:00Z");
+        assert_eq!(at(1_795_469_825), "2026-11-23T21:37:05Z");
+        assert_eq!(at(4_107_542_399), "2100-02-28T23:59:59Z");
+    }
+
     #[test]
     fn plain_line_format() {
         let d = Duration::from_secs_f64(12.3);
@@ -255,7 +304,7 @@ mod tests {
         }
         p.log("a note");
         p.finish("all good");
-        let lines = buf.lines();
+        let lines = unstamped(buf.lines());
         assert_eq!(lines.len(), 4, "{lines:?}");
         assert!(
             lines[0].starts_with("[inksim] run: 1/5 (20%), elapsed "),
@@ -283,7 +332,7 @@ mod tests {
         let p = Progress::plain_to(200, "par", Box::new(buf.clone()), Duration::ZERO);
         (0..200u64).into_par_iter().for_each(|_| p.inc(1, ""));
         assert_eq!(p.position(), 200);
-        let lines = buf.lines();
+        let lines = unstamped(buf.lines());
         assert_eq!(lines.len(), 200);
         assert!(lines
             .last()

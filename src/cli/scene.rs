@@ -20,6 +20,10 @@ pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimi
         .fold(0.0, f64::max);
     println!("results: {}", report.result_path.display());
     println!("picture: {}", report.picture_path.display());
+    println!("orders: {}", report.orders_picture_path.display());
+    for p in &report.plot_paths {
+        println!("plot: {}", p.display());
+    }
     println!(
         "{} solves, worst energy balance |ΣR+ΣT+A−1| = {worst:.1e}",
         report.entries.len()

@@ -31,6 +31,11 @@ pub struct RunReport {
     pub picture_path: PathBuf,
     /// Every reflected order of every solve, drawn per wavelength and angle.
     pub orders_picture_path: PathBuf,
+    /// The plots, when the run assembled its appearance:
+    /// `<name>-spectra.png` (R, T, A against wavelength),
+    /// `<name>-brdf-plane.png` (the BRDF in the plane of incidence) and
+    /// `<name>-brdf-polar.png` (the BRDF as a polar map).
+    pub plot_paths: Vec<PathBuf>,
     /// Geometry of realisation 0 (None for a molecular mixture).
     pub geometry: Option<Geometry>,
     pub entries: Vec<SolveEntry>,
@@ -82,6 +87,15 @@ pub fn run_with(
 
     let pictures = assemble_products(scene, &plan, &layer.entries)?;
     atomic::write_atomic(&orders_path, &pictures.orders_png)?;
+    let mut plot_paths = vec![];
+    for (suffix, png) in &pictures.plots {
+        let p = scene
+            .output
+            .dir
+            .join(format!("{}-{suffix}.png", scene.output.name));
+        atomic::write_atomic(&p, png)?;
+        plot_paths.push(p);
+    }
     atomic::write_atomic(
         &picture_path,
         pictures.tile_png.as_deref().unwrap_or(&pictures.orders_png),
@@ -103,6 +117,7 @@ pub fn run_with(
         result_path,
         picture_path,
         orders_picture_path: orders_path,
+        plot_paths,
         geometry: layer.geometry,
         entries: layer.entries,
         appearance: pictures.appearance,
@@ -132,6 +147,8 @@ struct RunProducts {
     orders_png: Vec<u8>,
     /// The colour tile, when the scene asked for it.
     tile_png: Option<Vec<u8>>,
+    /// The plots of the appearance: (file-name suffix, PNG).
+    plots: Vec<(&'static str, Vec<u8>)>,
     appearance: Option<Appearance>,
 }
 
@@ -179,6 +196,17 @@ fn assemble_products(
         )?),
         _ => None,
     };
+    let plots = match appearance.as_ref() {
+        Some(a) => {
+            let name = &scene.output.name;
+            vec![
+                ("spectra", render::spectra_png(a, name)?),
+                ("brdf-plane", render::brdf_plane_png(a, name)?),
+                ("brdf-polar", render::brdf_polar_png(a, name)?),
+            ]
+        }
+        None => vec![],
+    };
     if let (Some(a), true) = (appearance.as_ref(), products.merl) {
         let merl = merl::encode(a)?;
         atomic::write_atomic(
@@ -192,6 +220,7 @@ fn assemble_products(
     Ok(RunProducts {
         orders_png,
         tile_png,
+        plots,
         appearance,
     })
 }

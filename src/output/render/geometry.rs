@@ -1,13 +1,16 @@
 //! The geometry picture: the layer on its raster, top view and cross-section.
 
 use super::canvas::{self, text_width, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
+use super::plot::colour_map::{colour_bar, BAR_LABELS_W, BAR_W};
+use super::plot::Scale;
 use super::{fmt_num, RenderError, MAX_PIXELS};
 
 /// A picture of a layer so a person can see it: the top view (pigment
 /// fraction averaged over the thickness) and the x–z cross-section through
 /// the middle of the fragment (pigment fraction; z down), both on the raster,
 /// with axes in nm or µm, a scale bar, the section's line marked on the top
-/// view and `lines` of statistics underneath. Bright = pigment, dark = binder.
+/// view, a grey-scale bar of the pigment volume fraction (0 binder, 1
+/// pigment) and `lines` of statistics underneath.
 pub fn geometry_png(
     raster: &crate::raster::Raster,
     title: &str,
@@ -51,7 +54,8 @@ pub fn geometry_png(
     );
     let x0 = margin + y_axis_w;
     let x1 = x0 + top_w.max(text_width(&heading_top)) + margin + y_axis_w;
-    let w = (x1 + cross_w.max(text_width(&heading_cross)) + margin)
+    let bar_x = x1 + cross_w.max(text_width(&heading_cross)) + margin;
+    let w = (bar_x + BAR_W + BAR_LABELS_W + margin)
         .max(margin * 2 + lines.iter().map(|l| text_width(l)).max().unwrap_or(0))
         .max(margin * 2 + canvas::text_width_px(&heading, TITLE_HEIGHT as f64).ceil() as usize);
     let y_head = margin + TITLE_HEIGHT + 8;
@@ -152,6 +156,20 @@ pub fn geometry_png(
         x1 + bar_px + 8,
         by + 2 - GLYPH_HEIGHT / 2,
         &format!("{} {unit}", fmt_num(bar_nm / div)),
+        fg,
+    );
+    // The grey ramp of both views.
+    let bar_top = y_body + GLYPH_HEIGHT + 10;
+    colour_bar(
+        &mut img,
+        (
+            bar_x,
+            bar_top,
+            (body_h + axis_h).saturating_sub(GLYPH_HEIGHT + 10).max(60),
+        ),
+        &Scale::linear(0.0, 1.0),
+        grey,
+        "pigment fraction",
         fg,
     );
     for (k, l) in lines.iter().enumerate() {

@@ -36,22 +36,32 @@
 //!
 //! [`geometry_png`] draws a layer's raster (top view and an x–z section, with
 //! axes in nm or µm, a scale bar and the section's position); [`tile::tile_png`]
-//! the colour tile. Text is set by [`canvas`] in an embedded TrueType font.
+//! the colour tile; [`spectra_png`], [`brdf_plane_png`] and [`brdf_polar_png`]
+//! the plots of a run (R, T, A against wavelength; the BRDF in the plane of
+//! incidence; the BRDF as a polar map), drawn with [`plot`]. Text is set by
+//! [`canvas`] in an embedded TrueType font.
 
 use std::cmp::Ordering;
 
 use crate::config::Incidence;
 use crate::optics::farfield::{Order, SolveEntry};
 
+mod brdf_plane;
+mod brdf_polar;
 pub mod canvas;
 mod colour_bar;
 mod geometry;
+pub mod plot;
+mod spectra;
 pub mod tile;
 
+pub use brdf_plane::{brdf_plane_png, pick_evenly};
+pub use brdf_polar::{brdf_polar_png, map_scale};
 pub use canvas::{text_width, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
 use colour_bar::colour_bar;
 pub use colour_bar::superscript;
 pub use geometry::geometry_png;
+pub use spectra::spectra_png;
 
 /// Radius of a panel's disk of directions, in pixels.
 pub const DISK_RADIUS_PX: f64 = 60.0;

@@ -39,9 +39,11 @@ use std::f64::consts::PI;
 
 pub mod conditions;
 pub mod gamut;
+mod uncertainty;
 
 pub use conditions::{bradford, illuminant_a, Illuminant, StandardObserver, SRGB_WHITE};
 use conditions::{interpolate, mat_vec, D50_CSV, D65_CSV};
+pub use uncertainty::{delta_e2000_se, lch_se};
 
 /// Wavelength range (nm) a spectrum's samples must lie in.
 pub const WAVELENGTH_RANGE_NM: (f64, f64) = (360.0, 830.0);

@@ -5,7 +5,7 @@
 //! [`CELL_PX`] pixels where the result has no measured colour).
 
 use crate::config::{Illuminant, StandardObserver};
-use crate::optics::colour::{gamut, lab_to_lch, Observer};
+use crate::optics::colour::{gamut, lab_to_lch, lch_se, Observer};
 use crate::output::h5;
 use crate::output::render::canvas::{text_width, Canvas, GLYPH_HEIGHT};
 use crate::study::run;
@@ -177,13 +177,10 @@ fn colour_card(v: &Variant) -> Result<Option<Canvas>, StudyError> {
 fn card_lines(m: &h5::MeasuredRecord, ill: Illuminant, so: StandardObserver) -> Vec<String> {
     let [l, c, h] = lab_to_lch(m.lab);
     let pm = |se: Option<f64>| se.map_or(String::new(), |s| format!(" ± {s:.2}"));
-    let c_se = m.lab_se.map(|se| {
-        let (a, b) = (m.lab[1], m.lab[2]);
-        ((a * se[1]).powi(2) + (b * se[2]).powi(2)).sqrt() / c.max(1e-12)
-    });
+    let lch_se = m.lab_se.map(|se| lch_se(m.lab, se));
     let mut lines = vec![
-        format!("L* {l:.1}{}", pm(m.lab_se.map(|s| s[0]))),
-        format!("C*ab {c:.1}{}", pm(c_se)),
+        format!("L* {l:.1}{}", pm(lch_se.map(|s| s[0]))),
+        format!("C*ab {c:.1}{}", pm(lch_se.map(|s| s[1]))),
         format!("h° {h:.0}"),
     ];
     lines.push(match m.de00_se {

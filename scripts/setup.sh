@@ -5,9 +5,19 @@
 # Installs what is missing for the HDF5 bindings: the HDF5 C library and
 # headers come from the distribution's packages (Debian/Ubuntu `libhdf5-dev`),
 # found by the build through `pkg-config`; no HDF5 is built from source and
-# no cmake is needed. Safe to run repeatedly: it installs nothing that is
-# already there.
+# no cmake is needed. With --with-browser it also installs Chromium (Debian
+# package `chromium`), which the test of the study's summary page renders it
+# in (without it that test skips). Safe to run repeatedly: it installs
+# nothing that is already there.
 set -euo pipefail
+
+with_browser=0
+for arg in "$@"; do
+    case "$arg" in
+        --with-browser) with_browser=1 ;;
+        *) printf '[setup] error: unknown argument %s (known: --with-browser)\n' "$arg" >&2; exit 2 ;;
+    esac
+done
 
 say() { printf '[setup] %s\n' "$*"; }
 
@@ -29,8 +39,20 @@ if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists hdf5; then
     say "HDF5 development files (pkg-config module hdf5) are missing"
 fi
 
+if command -v pkg-config >/dev/null 2>&1 && pkg-config --exists hdf5; then
+    say "HDF5 $(pkg-config --modversion hdf5) found via pkg-config"
+fi
+if ((with_browser)); then
+    if command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1; then
+        say "Chromium found"
+    else
+        packages+=(chromium)
+        say "Chromium is missing"
+    fi
+fi
+
 if ((${#packages[@]} == 0)); then
-    say "HDF5 $(pkg-config --modversion hdf5) found via pkg-config; nothing to install"
+    say "nothing to install"
     exit 0
 fi
 
@@ -56,6 +78,10 @@ say "running: ${apt[*]} update"
 say "running: ${apt[*]} install -y --no-install-recommends ${packages[*]}"
 "${apt[@]}" install -y --no-install-recommends "${packages[@]}"
 
+if ((with_browser)) && ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1; then
+    say "error: chromium installed but not on PATH" >&2
+    exit 1
+fi
 if pkg-config --exists hdf5; then
     say "HDF5 $(pkg-config --modversion hdf5) installed"
 else

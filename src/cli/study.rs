@@ -66,14 +66,10 @@ pub fn run(
     let all_done = exp.variants.iter().all(|v| srun::state(v) == State::Done);
     if all_done {
         println!(
-            "all {} variants finished; next: inksim merge {}{}",
-            exp.variants.len(),
-            config.display(),
-            exp.profile
-                .as_deref()
-                .map(|p| format!(" --profile {p}"))
-                .unwrap_or_default()
+            "all {} variants finished; merging (as `inksim merge` does)",
+            exp.variants.len()
         );
+        print_merge(&inksim::study::merge::merge(&study, &exp)?);
     }
     Ok(if report.failed().next().is_some() {
         ExitCode::FAILURE
@@ -122,7 +118,12 @@ pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
 pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) -> Result<()> {
     let study = super::load_study(config, output_dir)?;
     let exp = study.expand(profile)?;
-    let r = inksim::study::merge::merge(&study, &exp)?;
+    print_merge(&inksim::study::merge::merge(&study, &exp)?);
+    Ok(())
+}
+
+/// Say where merge wrote its files.
+fn print_merge(r: &inksim::study::merge::MergeReport) {
     println!("summary: {}", r.summary_h5.display());
     println!(
         "page: {} and {}",
@@ -132,7 +133,9 @@ pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) 
     for g in &r.grids {
         println!("grid: {}", g.display());
     }
-    Ok(())
+    for p in &r.plots {
+        println!("plot: {}", p.display());
+    }
 }
 
 /// Largest memory estimate over the variants (bytes).

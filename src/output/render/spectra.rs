@@ -62,7 +62,8 @@ pub fn spectra_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
             .collect()
     };
     let x = Scale::covering_linear(s.wavelengths_nm.iter().map(|&w| (w, 0.0)), false)
-        .ok_or(RenderError::Empty)?;
+        .ok_or(RenderError::Empty)?
+        .padded(0.04);
     let mut panels = vec![];
     for (e, what) in [
         (&a.reflectance, "reflectance R"),

@@ -23,23 +23,30 @@
 //! - `grids/<grid>[__<axis>-<label>…].png`: for each declared grid (or the
 //!   default: first axis as rows, second as columns), one picture per
 //!   combination of the labels of the remaining axes not fixed by `where`;
-//!   each cell is the variant's tile, shrunk by an integer factor to at
-//!   most [`CELL_PX`] pixels, with row and column labels; an empty cell is
-//!   grey with a dash.
-//! - `summary.md` and `summary.html`: the grids and a table of the variants
-//!   (labels, mean R, T, A, colour as hex and L*a*b*; the HTML page shows
-//!   swatches).
+//!   each cell is the variant's 45°/0° colour card (its tile, shrunk to at
+//!   most [`CELL_PX`] pixels, where the result has no measured colour), with
+//!   row and column labels; an empty cell is grey with a dash.
+//! - `plots/<axis>[__<axis>-<label>…].png`: L* and C*ab against each axis
+//!   ([`plots`]).
+//! - `summary.md` and `summary.html`: facts of the run, the effects table
+//!   ([`effects`]), the plots and grids, the variants with links to their
+//!   files ([`page`]).
 //!
 //! Merge refuses to run until every variant is finished, and lists what is
 //! missing and why.
 //!
 //! - `grid`: the comparison-grid pictures.
+//! - `plots`: the study plots.
+//! - `effects`: the effects table's numbers.
 //! - `summary_h5`: the summary HDF5 file; `summary_values` its typed axis
 //!   values and measured colours.
-//! - `page`: the Markdown and HTML pages.
+//! - `page`, `markdown`: the HTML and Markdown pages.
 
+mod effects;
 mod grid;
+mod markdown;
 mod page;
+mod plots;
 mod summary_h5;
 mod summary_values;
 
@@ -59,6 +66,8 @@ pub struct MergeReport {
     pub summary_md: PathBuf,
     pub summary_html: PathBuf,
     pub grids: Vec<PathBuf>,
+    /// L* and C*ab against each axis (`plots/`).
+    pub plots: Vec<PathBuf>,
 }
 
 /// One row of the summary table.
@@ -68,6 +77,35 @@ struct Row<'a> {
     r: f64,
     t: f64,
     a: f64,
+    /// The variant's colour in [`COLOUR_GEOMETRY`] (else its first
+    /// measurement geometry), when the result has measured colours.
+    measured: Option<Measured>,
+}
+
+/// The measurement geometry the plots, the effects table and the grid cards
+/// show.
+const COLOUR_GEOMETRY: &str = "45/0";
+
+/// A variant's measured colour and the conditions it was computed for.
+struct Measured {
+    record: h5::MeasuredRecord,
+    /// "D50, 2°".
+    conditions: String,
+}
+
+/// The measured colour of a result file (see [`Row::measured`]).
+fn measured(path: &std::path::Path) -> Result<Option<Measured>, StudyError> {
+    let Some((records, illuminant, observer_deg)) = h5::read_measured(path)? else {
+        return Ok(None);
+    };
+    let pick = records
+        .iter()
+        .position(|m| m.geometry == COLOUR_GEOMETRY)
+        .or((!records.is_empty()).then_some(0));
+    Ok(pick.map(|k| Measured {
+        record: records[k].clone(),
+        conditions: format!("{illuminant}, {observer_deg}°"),
+    }))
 }
 
 /// Merge a finished study (see the module docs).
@@ -112,7 +150,15 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             mean(|e| e.total_transmittance),
             mean(|e| e.absorption),
         );
-        rows.push(Row { v, s, r, t, a });
+        let measured = measured(&run::paths(v).0)?;
+        rows.push(Row {
+            v,
+            s,
+            r,
+            t,
+            a,
+            measured,
+        });
     }
     let dir = &exp.study_dir;
     let grids_dir = dir.join("grids");
@@ -124,9 +170,29 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             grids.push(p);
         }
     }
+    let plots_dir = dir.join("plots");
+    let mut plots = vec![];
+    let profile = exp.profile.as_deref().unwrap_or("");
+    for (file, title, canvas) in plots::draw_plots(study, profile, &rows)? {
+        let p = plots_dir.join(file);
+        atomic::write_atomic(&p, &canvas.encode_png(&title)?)?;
+        plots.push(p);
+    }
     let summary_h5 = dir.join("summary.h5");
     summary_h5::write_summary_h5(study, exp, &rows, &summary_h5)?;
-    let (md, html) = page::pages(study, exp, &rows, &grids);
+    let effects = effects::effects(study, &rows);
+    let unix_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (md, html) = page::pages(&page::PageInput {
+        study,
+        exp,
+        rows: &rows,
+        effects: &effects,
+        grids: &grids,
+        plots: &plots,
+        unix_s,
+    });
     let summary_md = dir.join("summary.md");
     let summary_html = dir.join("summary.html");
     atomic::write_atomic(&summary_md, md.as_bytes())?;
@@ -136,5 +202,6 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
         summary_md,
         summary_html,
         grids,
+        plots,
     })
 }

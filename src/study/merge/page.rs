@@ -1,125 +1,336 @@
-//! `summary.md` and `summary.html`: the grids and the table of the variants
-//! (labels, mean R, T, A, colour as hex and L*a*b*; swatches in HTML).
+//! `summary.html`: what was run (inksim version, date, sweep file, profile
+//! and its settings, colour conditions), the effects table, the study plots
+//! and the comparison grids scaled to the page, the table of the variants
+//! (labels, R, T, A, L*, C*ab, h° ± s.e., a swatch) and links to every
+//! result file. Every link is relative to the study folder and names a file
+//! that exists when the page is written. `summary.md` (see [`markdown`])
+//! holds the same in Markdown.
 
-use super::Row;
-use crate::study::sweep::{Expansion, Study};
+use super::effects::{Effect, MeanSe};
+use super::{markdown, Row};
+use crate::optics::colour::{lab_to_lch, lch_se};
+use crate::study::run;
+use crate::study::sweep::{Expansion, Study, Variant};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Colour of a row: (hex, L*a*b* text), when the result has `/appearance`.
-fn colour(r: &Row) -> Option<(String, String)> {
-    let a = r.s.appearance.as_ref()?;
-    let c = a.natural_srgb8.first()?;
-    let lab = a
-        .natural_lab
-        .first()
-        .map(|l| format!("L* {:.1} a* {:.1} b* {:.1}", l[0], l[1], l[2]))
-        .unwrap_or_default();
-    Some((format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]), lab))
+/// Everything the pages show.
+pub(super) struct PageInput<'a> {
+    pub study: &'a Study,
+    pub exp: &'a Expansion,
+    pub rows: &'a [Row<'a>],
+    pub effects: &'a [Effect],
+    pub grids: &'a [PathBuf],
+    pub plots: &'a [PathBuf],
+    /// Seconds since 1970-01-01 UTC of the merge.
+    pub unix_s: u64,
 }
 
-fn html_escape(s: &str) -> String {
+impl PageInput<'_> {
+    /// `p` relative to the study folder, with `/` separators.
+    pub fn rel(&self, p: &Path) -> String {
+        let r = p.strip_prefix(&self.exp.study_dir).unwrap_or(p);
+        r.components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join("/")
+    }
+
+    pub fn profile(&self) -> &str {
+        self.exp.profile.as_deref().unwrap_or("(none)")
+    }
+
+    /// The facts at the top of the page: (what, value).
+    pub fn facts(&self) -> Vec<(String, String)> {
+        let settings = match self.exp.profile.as_ref() {
+            Some(p) => self.study.profiles.get(p).map_or(String::new(), |o| {
+                o.iter()
+                    .map(|o| format!("{} = {}", o.key, o.value))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            }),
+            None => "no profiles".into(),
+        };
+        let mut realisations: Vec<usize> =
+            self.rows.iter().map(|r| r.v.scene.realisations).collect();
+        realisations.sort_unstable();
+        realisations.dedup();
+        let colour = self.rows.iter().find_map(|r| r.measured.as_ref()).map_or(
+            "no measured colours".into(),
+            |m| {
+                format!(
+                    "{} geometry; {} (illuminant, observer)",
+                    m.record.geometry, m.conditions
+                )
+            },
+        );
+        vec![
+            ("study".into(), self.study.name.clone()),
+            ("sweep file".into(), self.study.path.display().to_string()),
+            ("profile".into(), self.profile().to_string()),
+            ("profile settings".into(), settings),
+            ("variants".into(), self.rows.len().to_string()),
+            (
+                "realisations per variant".into(),
+                realisations
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ),
+            ("colour".into(), colour),
+            (
+                "inksim version".into(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
+            ("merged".into(), utc_date(self.unix_s)),
+        ]
+    }
+
+    /// Links to a variant's files that exist: (text, relative path).
+    pub fn variant_files(&self, v: &Variant) -> Vec<(String, String)> {
+        let (h5, tile) = run::paths(v);
+        let dir = h5.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut files = vec![("h5".to_string(), h5), ("tile".to_string(), tile)];
+        for what in ["orders", "spectra", "brdf-plane", "brdf-polar"] {
+            files.push((what.into(), dir.join(format!("{}-{what}.png", v.name))));
+        }
+        files
+            .into_iter()
+            .filter(|(_, p)| p.is_file())
+            .map(|(t, p)| (t, self.rel(&p)))
+            .collect()
+    }
+}
+
+/// `YYYY-MM-DD HH:MM UTC` of a Unix time (proleptic Gregorian calendar).
+pub fn utc_date(unix_s: u64) -> String {
+    let days = (unix_s / 86_400) as i64;
+    let secs = unix_s % 86_400;
+    // Howard Hinnant's days → civil date.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02} {:02}:{:02} UTC",
+        secs / 3600,
+        secs % 3600 / 60
+    )
+}
+
+/// `+1.23 ± 0.04` (signed) or `1.23 ± 0.04`; no "±" without an s.e.
+pub fn fmt_mean_se(m: &MeanSe, signed: bool) -> String {
+    let v = if signed {
+        format!("{:+.2}", m.mean)
+    } else {
+        format!("{:.2}", m.mean)
+    };
+    match m.se {
+        Some(s) => format!("{v} ± {s:.2}"),
+        None => v,
+    }
+}
+
+/// A variant's colour cells: L*, C*ab, h° (each ± s.e.) and the sRGB hex
+/// of the result's natural-light colour; `None` without measured colour.
+pub fn colour_cells(r: &Row) -> Option<([String; 3], Option<String>)> {
+    let m = r.measured.as_ref()?;
+    let lch = lab_to_lch(m.record.lab);
+    let se = m.record.lab_se.map(|s| lch_se(m.record.lab, s));
+    let cell = |k: usize, digits: usize| match se {
+        Some(s) => format!("{:.*} ± {:.*}", digits, lch[k], digits, s[k]),
+        None => format!("{:.*}", digits, lch[k]),
+    };
+    let hex =
+        r.s.appearance
+            .as_ref()
+            .and_then(|a| a.natural_srgb8.first())
+            .map(|c| format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]));
+    Some(([cell(0, 1), cell(1, 1), cell(2, 0)], hex))
+}
+
+/// The header cells of the effects table and each effect's cells.
+pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>) {
+    let head = vec![
+        "axis",
+        "step",
+        "pairs",
+        "direction",
+        "ΔL*",
+        "ΔC*ab",
+        "Δh°",
+        "ΔE00",
+        "ΔE00 range",
+    ];
+    let rows = effects
+        .iter()
+        .map(|e| {
+            vec![
+                e.axis.clone(),
+                format!("{} → {}", e.from, e.to),
+                e.pairs.to_string(),
+                e.direction(),
+                fmt_mean_se(&e.delta_lch[0], true),
+                fmt_mean_se(&e.delta_lch[1], true),
+                fmt_mean_se(&e.delta_lch[2], true),
+                fmt_mean_se(&e.delta_e00, false),
+                format!("{:.2} – {:.2}", e.delta_e00_range.0, e.delta_e00_range.1),
+            ]
+        })
+        .collect();
+    (head, rows)
+}
+
+pub(super) fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }
 
-/// The Markdown and HTML summary pages.
-pub(super) fn pages(
-    study: &Study,
-    exp: &Expansion,
-    rows: &[Row],
-    grids: &[PathBuf],
-) -> (String, String) {
-    let rel = |p: &Path| {
-        p.strip_prefix(&exp.study_dir)
-            .unwrap_or(p)
-            .display()
-            .to_string()
-    };
-    let profile = exp.profile.as_deref().unwrap_or("(none)");
-    let axes: Vec<&str> = study.axes.iter().map(|a| a.name.as_str()).collect();
-    let mut md = String::new();
-    let _ = writeln!(md, "# Study `{}` — profile `{profile}`\n", study.name);
-    let _ = writeln!(
-        md,
-        "{} variants from `{}`; results in `variants/`, all linked from `summary.h5`. \
-         R, T, A: mean total reflectance, transmittance and absorption over the solves from above; \
-         colour: sRGB and CIELAB under natural light at the first viewing angle (\"—\" \
-         where the result has no appearance data).\n",
-        rows.len(),
-        study.path.display()
-    );
-    let _ = writeln!(md, "## Comparison grids\n");
-    for g in grids {
-        let _ = writeln!(md, "![{0}]({0})\n", rel(g));
+fn tr(cells: &[String], tag: &str) -> String {
+    let mut s = String::from("<tr>");
+    for c in cells {
+        let _ = write!(s, "<{tag}>{c}</{tag}>");
     }
-    let _ = writeln!(md, "## Variants\n");
-    let mut head = vec!["#", "name"];
-    head.extend(&axes);
-    head.extend(["R", "T", "A", "colour", "L*a*b*"]);
-    let _ = writeln!(md, "| {} |", head.join(" | "));
-    let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-    let mut trs = String::new();
-    for (i, r) in rows.iter().enumerate() {
-        let labels: Vec<&str> = axes.iter().map(|a| r.v.label(a).unwrap_or("—")).collect();
-        let (hex, lab) = colour(r).unwrap_or_else(|| ("—".into(), "—".into()));
-        let _ = writeln!(
-            md,
-            "| {} | [{}](variants/{}.png) | {} | {:.4} | {:.4} | {:.4} | {hex} | {lab} |",
-            i + 1,
-            r.v.name,
-            r.v.name,
-            labels.join(" | "),
-            r.r,
-            r.t,
-            r.a
-        );
-        let swatch = match colour(r) {
-            Some((hex, _)) => format!(
-                "<span style=\"display:inline-block;width:2em;height:1em;background:{hex};\
-                 border:1px solid #888\"></span> {hex}"
-            ),
-            None => "—".into(),
-        };
-        let _ = writeln!(
-            trs,
-            "<tr><td>{}</td><td><a href=\"variants/{n}.png\">{n}</a></td>{}<td>{:.4}</td>\
-             <td>{:.4}</td><td>{:.4}</td><td>{swatch}</td><td>{}</td></tr>",
-            i + 1,
-            labels
+    s + "</tr>\n"
+}
+
+/// The Markdown and HTML pages.
+pub(super) fn pages(p: &PageInput) -> (String, String) {
+    (markdown::page(p), html_page(p))
+}
+
+fn html_page(p: &PageInput) -> String {
+    let e = html_escape;
+    let title = format!("Study {} — profile {}", p.study.name, p.profile());
+    let mut body = format!("<h1>{}</h1>\n<table class=\"facts\">\n", e(&title));
+    for (k, v) in p.facts() {
+        body += &tr(&[e(&k), e(&v)], "td");
+    }
+    body += "</table>\n<p>Files: <a href=\"summary.h5\">summary.h5</a> (every variant \
+             linked), <a href=\"summary.md\">summary.md</a>.</p>\n";
+    body += "<h2>Effects</h2>\n<p>Each step between neighbouring labels of an axis: the \
+             mean change of the measured colour over the pairs of variants that differ in that \
+             axis only, ± the standard error of the mean from the variants' own standard \
+             errors; the ΔE00 range over the pairs shows how much the effect depends on the \
+             other axes.</p>\n";
+    let (head, rows) = effect_table(p.effects);
+    if rows.is_empty() {
+        body += "<p>No pairs of variants with measured colours.</p>\n";
+    } else {
+        body += "<table>\n";
+        body += &tr(&head.iter().map(|h| e(h)).collect::<Vec<_>>(), "th");
+        for r in rows {
+            body += &tr(&r.iter().map(|c| e(c)).collect::<Vec<_>>(), "td");
+        }
+        body += "</table>\n";
+    }
+    for (h, files, class) in [
+        ("Plots", p.plots, "pics"),
+        ("Comparison grids", p.grids, "pics wide"),
+    ] {
+        let _ = writeln!(body, "<h2>{h}</h2>\n<div class=\"{class}\">");
+        for f in files {
+            let r = e(&p.rel(f));
+            let _ = writeln!(
+                body,
+                "<figure><a href=\"{r}\"><img src=\"{r}\" alt=\"{r}\"></a>\
+                 <figcaption>{r}</figcaption></figure>"
+            );
+        }
+        body += "</div>\n";
+    }
+    body += &variants_html(p);
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <meta name=\"viewport\" content=\"width=device-width\"><title>{t}</title>\n<style>\
+         body{{font-family:'DejaVu Sans',sans-serif;margin:1.5em;color:#222}}\
+         table{{border-collapse:collapse;margin:0.5em 0}}\
+         td,th{{border:1px solid #ccc;padding:2px 6px;text-align:left}}\
+         .pics{{display:flex;flex-wrap:wrap;gap:12px}}\
+         figure{{margin:0;flex:0 1 calc(50% - 8px);max-width:100%}}\
+         .wide figure{{flex:0 1 auto}}\
+         figure img{{max-width:100%;height:auto;border:1px solid #ddd}}\
+         figcaption{{font-size:small;color:#555}}\
+         .swatch{{display:inline-block;width:2em;height:1em;border:1px solid #888}}\
+         </style></head><body>\n{body}</body></html>\n",
+        t = e(&title)
+    )
+}
+
+fn variants_html(p: &PageInput) -> String {
+    let e = html_escape;
+    let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
+    let mut head: Vec<String> = vec!["#".into(), "name".into()];
+    head.extend(axes.iter().map(|a| e(a)));
+    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
+        head.push(h.into());
+    }
+    let mut s = String::from(
+        "<h2>Variants</h2>\n<p>R, T, A: mean total reflectance, transmittance and absorption \
+         over the solves from above. L*, C*ab, h°: the measured colour ± s.e.; swatch: sRGB \
+         under natural light at the first viewing angle.</p>\n<table>\n",
+    );
+    s += &tr(&head, "th");
+    for (i, r) in p.rows.iter().enumerate() {
+        let mut cells = vec![(i + 1).to_string(), e(&r.v.name)];
+        cells.extend(axes.iter().map(|a| e(r.v.label(a).unwrap_or("—"))));
+        cells.extend([r.r, r.t, r.a].map(|x| format!("{x:.4}")));
+        match colour_cells(r) {
+            Some((lch, hex)) => {
+                cells.extend(lch);
+                cells.push(hex.map_or("—".into(), |h| {
+                    format!("<span class=\"swatch\" style=\"background:{h}\"></span> {h}")
+                }));
+            }
+            None => cells.extend(["—", "—", "—", "—"].map(String::from)),
+        }
+        cells.push(
+            p.variant_files(r.v)
                 .iter()
-                .map(|l| format!("<td>{}</td>", html_escape(l)))
-                .collect::<String>(),
-            r.r,
-            r.t,
-            r.a,
-            html_escape(&lab),
-            n = html_escape(&r.v.name)
+                .map(|(t, f)| format!("<a href=\"{}\">{}</a>", e(f), e(t)))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
+        s += &tr(&cells, "td");
+    }
+    s + "</table>\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dates_are_utc_civil_dates() {
+        assert_eq!(utc_date(0), "1970-01-01 00:00 UTC");
+        assert_eq!(utc_date(951_782_400), "2000-02-29 00:00 UTC");
+        assert_eq!(utc_date(1_700_000_000), "2023-11-14 22:13 UTC");
+    }
+
+    #[test]
+    fn means_with_and_without_errors() {
+        let m = MeanSe {
+            mean: 1.234,
+            se: Some(0.056),
+        };
+        assert_eq!(fmt_mean_se(&m, true), "+1.23 ± 0.06");
+        assert_eq!(
+            fmt_mean_se(
+                &MeanSe {
+                    mean: 2.0,
+                    se: None
+                },
+                false
+            ),
+            "2.00"
         );
     }
-    let imgs: String = grids
-        .iter()
-        .map(|g| {
-            format!(
-                "<p><img src=\"{0}\" alt=\"{0}\"></p>\n",
-                html_escape(&rel(g))
-            )
-        })
-        .collect();
-    let ths: String = head
-        .iter()
-        .map(|h| format!("<th>{}</th>", html_escape(h)))
-        .collect();
-    let html = format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{t}</title>\
-         <style>body{{font-family:sans-serif}}table{{border-collapse:collapse}}\
-         td,th{{border:1px solid #ccc;padding:2px 6px}}</style></head><body>\n\
-         <h1>{t}</h1>\n<p>{n} variants; R, T, A are means over the solves; colour under \
-         natural light at the first viewing angle.</p>\n<h2>Comparison grids</h2>\n{imgs}\
-         <h2>Variants</h2>\n<table><tr>{ths}</tr>\n{trs}</table>\n</body></html>\n",
-        t = html_escape(&format!("Study {} — profile {profile}", study.name)),
-        n = rows.len()
-    );
-    (md, html)
 }

@@ -12,12 +12,19 @@ pub struct Scale {
     pub lo: f64,
     pub hi: f64,
     pub log: bool,
+    /// Tick step of a linear scale (`None`: the 1-2-5 step of its span).
+    pub step: Option<f64>,
 }
 
 impl Scale {
     /// Linear scale from `lo` to `hi` (`hi > lo`).
     pub fn linear(lo: f64, hi: f64) -> Scale {
-        Scale { lo, hi, log: false }
+        Scale {
+            lo,
+            hi,
+            log: false,
+            step: None,
+        }
     }
 
     /// Categories `0 … n − 1`, each centred in its own slot.
@@ -69,6 +76,7 @@ impl Scale {
                 lo: 10f64.powf(min_pos.log10().floor()),
                 hi: 10f64.powf(hi.log10().ceil()),
                 log: true,
+                step: None,
             });
         }
         if zero {
@@ -81,10 +89,25 @@ impl Scale {
             hi += pad;
         }
         let step = tick_step(hi - lo);
-        Some(Scale::linear(
-            (lo / step).floor() * step,
-            (hi / step).ceil() * step,
-        ))
+        Some(Scale {
+            step: Some(step),
+            ..Scale::linear((lo / step).floor() * step, (hi / step).ceil() * step)
+        })
+    }
+
+    /// The same linear scale widened by `frac` of its span at both ends,
+    /// so markers at the ends are drawn whole (a log scale is unchanged).
+    pub fn padded(self, frac: f64) -> Scale {
+        if self.log {
+            return self;
+        }
+        let pad = frac * (self.hi - self.lo);
+        Scale {
+            lo: self.lo - pad,
+            hi: self.hi + pad,
+            log: false,
+            step: Some(self.step.unwrap_or_else(|| tick_step(self.hi - self.lo))),
+        }
     }
 
     /// Position of `v` along the axis, 0 at `lo` and 1 at `hi`; `None` for a
@@ -114,7 +137,7 @@ impl Scale {
                 .map(|d| (10f64.powi(d as i32), decade_label(d)))
                 .collect();
         }
-        let step = tick_step(self.hi - self.lo);
+        let step = self.step.unwrap_or_else(|| tick_step(self.hi - self.lo));
         let decimals = (-step.log10().floor()).max(0.0) as usize;
         let first = (self.lo / step - 1e-9).ceil() as i64;
         let last = (self.hi / step + 1e-9).floor() as i64;
@@ -162,8 +185,16 @@ mod tests {
         let t = s.ticks();
         assert!((t[0].0 - s.lo).abs() < 1e-12 && (t.last().unwrap().0 - s.hi).abs() < 1e-12);
         assert!((3..=11).contains(&t.len()), "{t:?}");
+        // 48 … 141 rounds out to 40 … 160 on a step of 20, which the ticks
+        // keep (the span alone would ask for 50).
+        let l = Scale::covering([(48.0, 0.0), (141.0, 0.0)], false).unwrap();
+        let t = l.ticks();
+        assert_eq!((t[0].0, t.last().unwrap().0), (l.lo, l.hi));
+        assert_eq!((l.lo, l.hi, t.len()), (40.0, 160.0, 7));
         let z = Scale::covering([(0.13, 0.0), (0.47, 0.0)], true).unwrap();
         assert_eq!(z.lo, 0.0);
+        let p = z.padded(0.05);
+        assert!(p.lo < z.lo && p.hi > z.hi && p.ticks() == z.ticks());
     }
 
     #[test]

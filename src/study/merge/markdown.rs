@@ -1,0 +1,81 @@
+//! `summary.md`: the summary page's facts, effects table, plots, grids and
+//! variants in Markdown (see [`super::page`]).
+
+use super::page::{colour_cells, effect_table, PageInput};
+use std::fmt::Write as _;
+
+fn row(cells: &[String]) -> String {
+    format!("| {} |\n", cells.join(" | "))
+}
+
+fn table(head: &[String], rows: &[Vec<String>]) -> String {
+    let mut s = row(head);
+    s += &format!("|{}\n", "---|".repeat(head.len()));
+    for r in rows {
+        s += &row(r);
+    }
+    s
+}
+
+pub(super) fn page(p: &PageInput) -> String {
+    let mut md = format!("# Study `{}` — profile `{}`\n\n", p.study.name, p.profile());
+    for (k, v) in p.facts() {
+        let _ = writeln!(md, "- {k}: {v}");
+    }
+    md += "- files: [summary.h5](summary.h5) (every variant linked), \
+           [summary.html](summary.html)\n\n## Effects\n\n\
+           Mean change of the measured colour over the pairs of variants that differ in one \
+           axis only, ± the standard error of the mean; ΔE00 range over the pairs.\n\n";
+    let (head, rows) = effect_table(p.effects);
+    if rows.is_empty() {
+        md += "No pairs of variants with measured colours.\n\n";
+    } else {
+        let head: Vec<String> = head.iter().map(|h| h.to_string()).collect();
+        md += &table(&head, &rows);
+        md += "\n";
+    }
+    for (h, files) in [("Plots", p.plots), ("Comparison grids", p.grids)] {
+        let _ = writeln!(md, "## {h}\n");
+        for f in files {
+            let _ = writeln!(md, "![{0}]({0})\n", p.rel(f));
+        }
+    }
+    md += "## Variants\n\nR, T, A: mean total reflectance, transmittance and absorption over \
+           the solves from above; L*, C*ab, h°: the measured colour ± s.e.\n\n";
+    let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
+    let mut head: Vec<String> = vec!["#".into(), "name".into()];
+    head.extend(axes.iter().map(|a| a.to_string()));
+    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
+        head.push(h.into());
+    }
+    let rows: Vec<Vec<String>> = p
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let name = match p.variant_files(r.v).iter().find(|(t, _)| t == "tile") {
+                Some((_, f)) => format!("[{}]({f})", r.v.name),
+                None => r.v.name.clone(),
+            };
+            let mut cells = vec![(i + 1).to_string(), name];
+            cells.extend(axes.iter().map(|a| r.v.label(a).unwrap_or("—").to_string()));
+            cells.extend([r.r, r.t, r.a].map(|x| format!("{x:.4}")));
+            match colour_cells(r) {
+                Some((lch, hex)) => {
+                    cells.extend(lch);
+                    cells.push(hex.unwrap_or_else(|| "—".into()));
+                }
+                None => cells.extend(["—", "—", "—", "—"].map(String::from)),
+            }
+            cells.push(
+                p.variant_files(r.v)
+                    .iter()
+                    .map(|(t, f)| format!("[{t}]({f})"))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            );
+            cells
+        })
+        .collect();
+    md + &table(&head, &rows)
+}

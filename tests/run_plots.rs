@@ -93,7 +93,7 @@ fn a_run_writes_and_lists_its_plots() {
 fn plots_are_drawn_from_the_runs_appearance() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene_in(dir.path());
-    let report = inksim::pipeline::run_with(&scene, true).unwrap();
+    let report = inksim::pipeline::run_with(&scene, true, None).unwrap();
     let a = report.appearance.as_ref().unwrap();
     assert_eq!(report.plot_paths.len(), 3);
 

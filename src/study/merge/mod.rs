@@ -184,7 +184,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     let unix_s = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
-    let (md, html) = page::pages(&page::PageInput {
+    let input = page::PageInput {
         study,
         exp,
         rows: &rows,
@@ -192,7 +192,8 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
         grids: &grids,
         plots: &plots,
         unix_s,
-    });
+    };
+    let (md, html) = (markdown::page(&input), page::html_page(&input));
     let summary_md = dir.join("summary.md");
     let summary_html = dir.join("summary.html");
     atomic::write_atomic(&summary_md, md.as_bytes())?;

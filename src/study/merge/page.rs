@@ -7,7 +7,7 @@
 //! holds the same in Markdown.
 
 use super::effects::{Effect, MeanSe};
-use super::{markdown, Row};
+use super::Row;
 use crate::optics::colour::{lab_to_lch, lch_se};
 use crate::study::run;
 use crate::study::sweep::{Expansion, Study, Variant};
@@ -79,10 +79,7 @@ impl PageInput<'_> {
                     .join(", "),
             ),
             ("colour".into(), colour),
-            (
-                "inksim version".into(),
-                env!("CARGO_PKG_VERSION").to_string(),
-            ),
+            ("inksim version".into(), crate::VERSION.to_string()),
             ("merged".into(), utc_date(self.unix_s)),
         ]
     }
@@ -202,12 +199,9 @@ fn tr(cells: &[String], tag: &str) -> String {
     s + "</tr>\n"
 }
 
-/// The Markdown and HTML pages.
-pub(super) fn pages(p: &PageInput) -> (String, String) {
-    (markdown::page(p), html_page(p))
-}
-
-fn html_page(p: &PageInput) -> String {
+/// The HTML page (the Markdown one is `markdown::page`, from the same
+/// input).
+pub(super) fn html_page(p: &PageInput) -> String {
     let e = html_escape;
     let title = format!("Study {} — profile {}", p.study.name, p.profile());
     let mut body = format!("<h1>{}</h1>\n<table class=\"facts\">\n", e(&title));

@@ -180,11 +180,17 @@ fn suffix(message: &str) -> String {
 }
 
 /// One plain progress line (see the module docs).
-/// `t` as an ISO 8601 UTC time to the second, `2026-11-23T21:37:05Z`
-/// (civil date from days since 1970-01-01, proleptic Gregorian).
+/// `t` as an ISO 8601 UTC time to the second, `2026-11-23T21:37:05Z`.
 pub fn utc_stamp(t: SystemTime) -> String {
-    let secs = t.duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs()) as i64;
-    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    let secs = t.duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let [y, m, d, hh, mm, ss] = utc_civil(secs);
+    format!("{y:04}-{m:02}-{d:02}T{hh:02}:{mm:02}:{ss:02}Z")
+}
+
+/// Year, month, day, hour, minute, second (UTC) of a Unix time, by the
+/// civil-from-days algorithm (proleptic Gregorian calendar).
+pub fn utc_civil(unix_s: u64) -> [i64; 6] {
+    let (days, rem) = ((unix_s / 86_400) as i64, (unix_s % 86_400) as i64);
     // Howard Hinnant's days-to-civil.
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
@@ -195,12 +201,7 @@ pub fn utc_stamp(t: SystemTime) -> String {
     let d = doy - (153 * mp + 2) / 5 + 1;
     let m = if mp < 10 { mp + 3 } else { mp - 9 };
     let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
-        rem / 3600,
-        rem % 3600 / 60,
-        rem % 60
-    )
+    [y, m, d, rem / 3600, rem % 3600 / 60, rem % 60]
 }
 
 pub fn plain_line(label: &str, pos: u64, total: u64, elapsed: Duration, message: &str) -> String {

@@ -100,25 +100,10 @@ impl PageInput<'_> {
     }
 }
 
-/// `YYYY-MM-DD HH:MM UTC` of a Unix time (proleptic Gregorian calendar).
+/// `YYYY-MM-DD HH:MM UTC` of a Unix time.
 pub fn utc_date(unix_s: u64) -> String {
-    let days = (unix_s / 86_400) as i64;
-    let secs = unix_s % 86_400;
-    // Howard Hinnant's days → civil date.
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02} {:02}:{:02} UTC",
-        secs / 3600,
-        secs % 3600 / 60
-    )
+    let [y, m, d, hh, mm, _] = crate::output::progress::utc_civil(unix_s);
+    format!("{y:04}-{m:02}-{d:02} {hh:02}:{mm:02} UTC")
 }
 
 /// `+1.23 ± 0.04` (signed) or `1.23 ± 0.04`; no "±" without an s.e.

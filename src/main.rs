@@ -79,6 +79,11 @@ enum Command {
         /// memory estimate) and the number of variants to run.
         #[arg(long)]
         jobs: Option<usize>,
+        /// Study: only the variants with these labels, e.g. `--only pigment=red
+        /// --only pvc=pvc30,pvc50` (repeatable; a variant must match every
+        /// one). Names, seeds and result files are the full study's.
+        #[arg(long, value_name = "AXIS=LABEL[,LABEL…]")]
+        only: Vec<String>,
     },
     /// Study: list the variants, the work each needs (solves, grid, voxels,
     /// realisations), its estimated time and memory, and totals per profile.
@@ -95,6 +100,11 @@ enum Command {
         /// Also list the variants of a shard only.
         #[arg(long)]
         shard: Option<String>,
+        /// Study: only the variants with these labels, e.g. `--only pigment=red
+        /// --only pvc=pvc30,pvc50` (repeatable; a variant must match every
+        /// one). Names, seeds and result files are the full study's.
+        #[arg(long, value_name = "AXIS=LABEL[,LABEL…]")]
+        only: Vec<String>,
     },
     /// Study: write an sbatch script that runs the study as a Slurm job array
     /// (one task per shard), into <study dir>/<name>.sbatch.
@@ -129,6 +139,11 @@ enum Command {
         /// (as given to `run --output-dir`).
         #[arg(long)]
         output_dir: Option<PathBuf>,
+        /// Only the variants with these labels, e.g. `--only pigment=red
+        /// --only pvc=pvc30,pvc50` (repeatable; a variant must match every
+        /// one). Names, seeds and result files are the full study's.
+        #[arg(long, value_name = "AXIS=LABEL[,LABEL…]")]
+        only: Vec<String>,
     },
     /// Build the layer only: particle set and statistics to
     /// <dir>/<name>-geometry.h5, a top view and cross-section to <name>-geometry.png.
@@ -176,22 +191,22 @@ fn real_main() -> Result<ExitCode> {
             profile,
             shard,
             jobs,
+            only,
         } => {
             cli::readable(&config)?;
             if cli::is_study(&config) {
-                return cli::study::run(
-                    &config,
+                let flags = cli::study::RunFlags {
                     output_dir,
-                    profile.as_deref(),
-                    shard.as_deref(),
+                    profile: profile.as_deref(),
+                    shard: shard.as_deref(),
                     jobs,
-                    nthreads,
-                    memory,
-                );
+                    only: cli::selections(&only)?,
+                };
+                return cli::study::run(&config, flags, nthreads, memory);
             }
-            if profile.is_some() || shard.is_some() || jobs.is_some() {
+            if profile.is_some() || shard.is_some() || jobs.is_some() || !only.is_empty() {
                 bail!(
-                    "{}: --profile, --shard and --jobs apply to studies (files with a [study] table)",
+                    "{}: --profile, --shard, --jobs and --only apply to studies (files with a [study] table)",
                     config.display()
                 );
             }
@@ -201,10 +216,12 @@ fn real_main() -> Result<ExitCode> {
             config,
             profile,
             shard,
+            only,
         } => cli::plan::plan(
             &config,
             profile.as_deref(),
             shard.as_deref(),
+            &cli::selections(&only)?,
             nthreads,
             memory,
         )?,
@@ -220,7 +237,13 @@ fn real_main() -> Result<ExitCode> {
             config,
             profile,
             output_dir,
-        } => cli::study::merge(&config, profile.as_deref(), output_dir)?,
+            only,
+        } => cli::study::merge(
+            &config,
+            profile.as_deref(),
+            output_dir,
+            &cli::selections(&only)?,
+        )?,
         Command::Geometry { config, output_dir } => cli::scene::geometry(&config, output_dir)?,
         Command::Check { config } => {
             if cli::is_study(&config) {

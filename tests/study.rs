@@ -597,3 +597,76 @@ fn a_variant_beyond_the_memory_limit_fails_alone_and_the_others_finish() {
     assert_eq!(results.len(), 4);
     assert!(results.keys().all(|k| k.ends_with("cell50")), "{results:?}");
 }
+
+#[test]
+fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", &sweep().toml());
+    let p = p.to_str().unwrap();
+    let (ok, out, err) = inksim_in(dir.path(), &["plan", p, "--only", "pigment=red"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("2 variants (only pigment=red)"), "{out}");
+    assert!(
+        out.contains("red_d150") && !out.contains("yellow_d100"),
+        "{out}"
+    );
+
+    let (ok, _, err) = inksim_in(
+        dir.path(),
+        &[
+            "--threads",
+            "1",
+            "run",
+            p,
+            "--only",
+            "pigment=red",
+            "--only",
+            "d=d100,d150",
+        ],
+    );
+    assert!(ok, "{err}");
+    let done: Vec<String> = results(&dir.path().join("out/quick/variants"))
+        .into_keys()
+        .collect();
+    assert_eq!(done, ["red_d100", "red_d150"]);
+    // The subset merged alone says it is one, in the page and the file.
+    let (ok, _, err) = inksim_in(dir.path(), &["merge", p, "--only", "pigment=red"]);
+    assert!(ok, "{err}");
+    let page = std::fs::read_to_string(dir.path().join("out/quick/summary.md")).unwrap();
+    assert!(
+        page.contains("only pigment=red (a subset of the study)"),
+        "{page}"
+    );
+    let f = hdf5::File::open(dir.path().join("out/quick/summary.h5")).unwrap();
+    let sel: hdf5::types::VarLenUnicode = f.attr("selection").unwrap().read_scalar().unwrap();
+    assert_eq!(sel.as_str(), "pigment=red");
+    assert_eq!(f.dataset("name").unwrap().shape(), [2]);
+    // The whole study merged now lists what the subset left to do.
+    let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
+    assert!(
+        !ok && err.contains("2 of 4 variants are not finished"),
+        "{err}"
+    );
+    // A full run resumes from the subset: only the other two run.
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("2 ran") && out.contains("2 skipped"), "{out}");
+
+    for (args, needle) in [
+        ("colour=red", "no axis `colour`; its axes are pigment, d"),
+        (
+            "pigment=green",
+            "axis `pigment` has no label `green`; its labels are red, yellow",
+        ),
+        ("pigment", "expected AXIS=LABEL"),
+    ] {
+        let (ok, _, err) = inksim_in(dir.path(), &["plan", p, "--only", args]);
+        assert!(!ok && err.contains(needle), "{args}: {err}");
+    }
+    let scene = write(dir.path(), "scene.toml", &base().toml());
+    let (ok, _, err) = inksim_in(
+        dir.path(),
+        &["run", scene.to_str().unwrap(), "--only", "pigment=red"],
+    );
+    assert!(!ok && err.contains("--only apply to studies"), "{err}");
+}

@@ -122,3 +122,11 @@ pub fn shard_of(flag: Option<&str>) -> Result<Shard> {
             .unwrap_or(Shard::ALL)),
     }
 }
+
+/// The `--only AXIS=LABEL[,LABEL…]` flags, parsed (checked against the
+/// study when it is expanded).
+pub fn selections(only: &[String]) -> Result<Vec<inksim::study::sweep::Selection>> {
+    only.iter()
+        .map(|o| inksim::study::sweep::Selection::parse(o).map_err(anyhow::Error::msg))
+        .collect()
+}

@@ -6,7 +6,7 @@ use inksim::config::{Method, Precision};
 use inksim::pipeline::memory::{self, human_bytes, MemoryLimit};
 use inksim::study::plan::{self, human_time};
 use inksim::study::run::{self as srun, Shard, State};
-use inksim::study::sweep::Expansion;
+use inksim::study::sweep::{Expansion, Selection};
 use std::path::Path;
 
 /// `inksim plan STUDY`: the variants of a profile (or of a shard of it) with
@@ -15,6 +15,7 @@ pub fn plan(
     config: &Path,
     profile: Option<&str>,
     shard: Option<&str>,
+    only: &[Selection],
     nthreads: usize,
     limit: Option<MemoryLimit>,
 ) -> Result<()> {
@@ -23,18 +24,19 @@ pub fn plan(
         Some(s) => Shard::parse(s).map_err(anyhow::Error::msg)?,
         None => Shard::ALL,
     };
-    let chosen = study.expand(profile)?;
+    let chosen = study.expand(profile)?.select(&study, only)?;
     let mut others = vec![];
     for p in study.profiles.keys() {
         if Some(p) != chosen.profile.as_ref() {
-            others.push(study.expand(Some(p))?);
+            others.push(study.expand(Some(p))?.select(&study, only)?);
         }
     }
     println!(
-        "study `{}` ({}): {} variants; profile {} → {}",
+        "study `{}` ({}): {} variants{}; profile {} → {}",
         study.name,
         study.path.display(),
         chosen.variants.len(),
+        selected(&chosen),
         chosen.profile.as_deref().unwrap_or("(none)"),
         chosen.study_dir.display()
     );
@@ -187,4 +189,13 @@ pub fn estimates(exp: &Expansion) -> Vec<plan::Estimate> {
         .iter()
         .map(|v| plan::estimate(&v.scene, &cal))
         .collect()
+}
+
+/// " (only pigment=red, pvc=pvc30)" for a selection, else nothing.
+pub(super) fn selected(exp: &Expansion) -> String {
+    if exp.selection.is_empty() {
+        String::new()
+    } else {
+        format!(" (only {})", exp.selection_text())
+    }
 }

@@ -3,24 +3,37 @@
 use anyhow::{bail, Context, Result};
 use inksim::pipeline::memory::{human_bytes, MemoryLimit};
 use inksim::study::run::{self as srun, RunOptions, State};
-use inksim::study::sweep::Expansion;
+use inksim::study::sweep::{Expansion, Selection};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// `inksim run STUDY`: every unfinished variant (of the shard); the exit
-/// code says whether any failed.
+/// The flags of `inksim run` on a study.
+pub struct RunFlags<'a> {
+    pub output_dir: Option<PathBuf>,
+    pub profile: Option<&'a str>,
+    pub shard: Option<&'a str>,
+    pub jobs: Option<usize>,
+    pub only: Vec<Selection>,
+}
+
+/// `inksim run STUDY`: every unfinished variant (of the shard and the
+/// `--only` subset); the exit code says whether any failed.
 pub fn run(
     config: &Path,
-    output_dir: Option<PathBuf>,
-    profile: Option<&str>,
-    shard: Option<&str>,
-    jobs: Option<usize>,
+    flags: RunFlags,
     nthreads: usize,
     memory: Option<MemoryLimit>,
 ) -> Result<ExitCode> {
+    let RunFlags {
+        output_dir,
+        profile,
+        shard,
+        jobs,
+        only,
+    } = flags;
     let study = super::load_study(config, output_dir)?;
     let shard = super::shard_of(shard)?;
-    let exp = study.expand(profile)?;
+    let exp = study.expand(profile)?.select(&study, &only)?;
     let to_run = exp
         .variants
         .iter()
@@ -44,10 +57,11 @@ pub fn run(
         None => srun::default_jobs(nthreads, peak, to_run, memory),
     };
     eprintln!(
-        "[inksim] study {} profile {}: {} variants ({} in shard {}/{}), results in {}",
+        "[inksim] study {} profile {}: {} variants{} ({} in shard {}/{}), results in {}",
         study.name,
         exp.profile.as_deref().unwrap_or("(none)"),
         exp.variants.len(),
+        super::plan::selected(&exp),
         to_run,
         shard.index,
         shard.count,
@@ -115,9 +129,14 @@ pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
 
 /// `inksim merge STUDY`: the summary file, page and grids of a finished
 /// study.
-pub fn merge(config: &Path, profile: Option<&str>, output_dir: Option<PathBuf>) -> Result<()> {
+pub fn merge(
+    config: &Path,
+    profile: Option<&str>,
+    output_dir: Option<PathBuf>,
+    only: &[Selection],
+) -> Result<()> {
     let study = super::load_study(config, output_dir)?;
-    let exp = study.expand(profile)?;
+    let exp = study.expand(profile)?.select(&study, only)?;
     print_merge(&inksim::study::merge::merge(&study, &exp)?);
     Ok(())
 }

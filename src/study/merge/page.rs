@@ -69,7 +69,18 @@ impl PageInput<'_> {
             ("sweep file".into(), self.study.path.display().to_string()),
             ("profile".into(), self.profile().to_string()),
             ("profile settings".into(), settings),
-            ("variants".into(), self.rows.len().to_string()),
+            (
+                "variants".into(),
+                if self.exp.selection.is_empty() {
+                    self.rows.len().to_string()
+                } else {
+                    format!(
+                        "{}, only {} (a subset of the study)",
+                        self.rows.len(),
+                        self.exp.selection_text()
+                    )
+                },
+            ),
             (
                 "realisations per variant".into(),
                 realisations

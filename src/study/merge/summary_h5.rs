@@ -31,6 +31,7 @@ pub(super) fn write_summary_h5(
             ("study", study.name.as_str()),
             ("profile", exp.profile.as_deref().unwrap_or("")),
             ("sweep_file", &study.path.display().to_string()),
+            ("selection", &exp.selection_text()),
         ] {
             let val = vlu(path, v)?;
             f.new_attr::<VarLenUnicode>()

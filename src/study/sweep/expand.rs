@@ -63,6 +63,7 @@ impl Study {
             profile,
             study_dir,
             variants,
+            selection: vec![],
         })
     }
 

@@ -66,8 +66,10 @@ mod check;
 mod expand;
 mod keypath;
 mod raw;
+mod select;
 
 pub use keypath::apply_override;
+pub use select::Selection;
 
 use super::StudyError;
 use crate::config::Scene;
@@ -178,6 +180,8 @@ pub struct Expansion {
     /// `<output_dir>/<profile>` (or `<output_dir>` without profiles).
     pub study_dir: PathBuf,
     pub variants: Vec<Variant>,
+    /// The `--only` restrictions that chose these variants (empty: all).
+    pub selection: Vec<Selection>,
 }
 
 /// Whether TOML `text` is a sweep file (has a `[study]` table).

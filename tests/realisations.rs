@@ -150,3 +150,66 @@ fn bad_targets_are_refused_naming_the_key() {
         assert!(!msg.contains('\n'), "one line: {msg}");
     }
 }
+
+/// A 1 µm layer of red grains at 30 % PVC (parsed only, never run).
+fn layer(fragment_nm: f64, diameter_nm: f64, realisations: i64) -> SceneToml {
+    SceneToml::grains()
+        .thickness_nm(1000.0)
+        .fragment_nm(fragment_nm)
+        .layer_pvc(0.3)
+        .pigment(PigmentToml::builtin("red").diameter_nm(diameter_nm))
+        .cell_nm(20.0)
+        .realisations(realisations)
+}
+
+#[test]
+fn the_fragments_statistical_error_falls_as_one_over_root_grains_times_realisations() {
+    use inksim::pipeline::accuracy::{
+        expected_error, realisations_for, statistical_de00, FRAGMENT_C_MIXTURE, FRAGMENT_C_SINGLE,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let at = |s: SceneToml| s.scene(dir.path());
+    // 0.3 × 1400² × 1000 nm³ over a 200 nm sphere's volume: 140.4 grains.
+    let grains = 0.3 * 1400.0f64.powi(2) * 1000.0 / (std::f64::consts::PI / 6.0 * 200.0f64.powi(3));
+    let base = statistical_de00(&at(layer(1400.0, 200.0, 2)), 2);
+    let exact = FRAGMENT_C_SINGLE * (1.0 / (grains * 2.0)).sqrt();
+    assert!((base - exact).abs() < 1e-12 * exact, "{base} vs {exact}");
+    // Twice the fragment's side (4× the grains) or 4× the realisations halve it.
+    let wide = statistical_de00(&at(layer(2800.0, 200.0, 2)), 2);
+    assert!((wide - base / 2.0).abs() < 1e-12);
+    assert!((statistical_de00(&at(layer(1400.0, 200.0, 8)), 8) - base / 2.0).abs() < 1e-12);
+    // Grains twice as large: 8× fewer, √8× the scatter.
+    let coarse = statistical_de00(&at(layer(1400.0, 400.0, 2)), 2);
+    assert!((coarse - base * 8f64.sqrt()).abs() < 1e-9);
+    // Clusters of 8 grains scatter as 8× fewer grains.
+    let agglo = layer(1400.0, 200.0, 2).raw("pigment.0.agglomeration", "{ cluster_size = 8 }");
+    assert!((statistical_de00(&at(agglo), 2) - base * 8f64.sqrt()).abs() < 1e-9);
+    // A mixture of two pigments, half the PVC each: Σ 1/N = 4/N, and its own constant.
+    let mix = layer(1400.0, 200.0, 2)
+        .pigment(PigmentToml::builtin("yellow").share(1.0).diameter_nm(200.0))
+        .add_pigment(PigmentToml::builtin("blue").share(1.0).diameter_nm(200.0));
+    let m = statistical_de00(&at(mix), 2);
+    let exact = FRAGMENT_C_MIXTURE * (4.0 / (grains * 2.0)).sqrt();
+    assert!((m - exact).abs() < 1e-9 * exact, "{m} vs {exact}");
+    // A dissolved dye is the same in every realisation.
+    let dye = SceneToml::grains()
+        .layer_pvc(0.3)
+        .pigment(PigmentToml::builtin("red").molecular());
+    assert_eq!(statistical_de00(&at(dye.clone()), 2), 0.0);
+    assert!(!expected_error(&at(dye))
+        .iter()
+        .any(|l| l.contains("fragment")));
+    // Realisations for a target, and the row that names the fragment.
+    let s = at(layer(1400.0, 400.0, 2));
+    let one = statistical_de00(&s, 1);
+    let r = realisations_for(&s, 0.5);
+    assert!(
+        statistical_de00(&s, r) <= 0.5 && statistical_de00(&s, r - 1) > 0.5,
+        "{one} {r}"
+    );
+    let text = expected_error(&s).join("\n");
+    assert!(
+        text.contains("fragment 1400 × 1400 nm (17.5 grains), 2 realisation(s)"),
+        "{text}"
+    );
+}

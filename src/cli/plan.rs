@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use inksim::config::{Method, Precision};
+use inksim::pipeline::accuracy;
 use inksim::pipeline::memory::{self, human_bytes, MemoryLimit};
 use inksim::study::plan::{self, human_time};
 use inksim::study::run::{self as srun, Shard, State};
@@ -85,8 +86,8 @@ pub fn plan(
         rates.join(", ")
     );
     println!(
-        "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>10} {:>9}  state",
-        "#", "variant", "solves", "grid", "voxels", "real.", "est. time", "memory"
+        "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>6} {:>10} {:>9}  state",
+        "#", "variant", "solves", "grid", "voxels", "real.", "ΔE00", "est. time", "memory"
     );
     let (mut t_sum, mut s_sum, mut peak, mut n) = (0.0, 0usize, 0.0f64, 0usize);
     let mut over = 0usize;
@@ -94,13 +95,14 @@ pub fn plan(
         let e = plan::estimate(&v.scene, &cal);
         let st = srun::state(v);
         println!(
-            "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>10} {:>9}  {}",
+            "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>6.2} {:>10} {:>9}  {}",
             v.index,
             v.name,
             e.solves,
             format!("{}×{}×{}", e.grid[0], e.grid[1], e.grid[2]),
             e.voxels,
             e.realisations,
+            accuracy::expected_de00(&v.scene),
             human_time(e.seconds),
             human_bytes(e.bytes),
             if memory::fits(&v.scene, limit).is_err() {
@@ -138,17 +140,26 @@ pub fn plan(
             limit.map(|m| m.describe()).unwrap_or_default()
         );
     }
+    println!("expected ΔE00 (column ΔE00): {}", de_summary(&chosen));
+    for target in [1.0, 0.5] {
+        if let Some(line) = statistics_cost(&chosen, &cal, target, t_sum) {
+            println!("{line}");
+        }
+    }
     if let Some(v) = chosen
         .variants
         .iter()
-        .find(|v| !v.scene.is_molecular())
+        .filter(|v| !v.scene.is_molecular())
+        .max_by(|a, b| {
+            accuracy::expected_de00(&a.scene).total_cmp(&accuracy::expected_de00(&b.scene))
+        })
         .or(chosen.variants.first())
     {
         println!(
-            "expected error of this profile's settings (variant {}):",
+            "expected error of this profile's settings, the least certain variant ({}):",
             v.name
         );
-        for line in inksim::pipeline::accuracy::expected_error(&v.scene) {
+        for line in accuracy::expected_error(&v.scene) {
             println!("  {line}");
         }
     }
@@ -160,13 +171,7 @@ pub fn plan(
                 .iter()
                 .map(|e| format!("{}×{}×{}", e.grid[0], e.grid[1], e.grid[2]))
                 .collect();
-            let de = exp
-                .variants
-                .iter()
-                .find(|v| !v.scene.is_molecular())
-                .or(exp.variants.first())
-                .and_then(|v| inksim::pipeline::accuracy::expected_error(&v.scene).pop())
-                .unwrap_or_default();
+            let de = format!("expected ΔE00 {}", de_summary(exp));
             println!(
                 "  {:<10} {} variants, {} solves, grid {}, est. {} total, peak memory {} per \
                  variant; {de}",
@@ -198,4 +203,62 @@ pub(super) fn selected(exp: &Expansion) -> String {
     } else {
         format!(" (only {})", exp.selection_text())
     }
+}
+
+/// "median 0.62, largest 1.85 (red_pvc15_s450); 12 of 22 above 1 ΔE00, 0
+/// above 3" over a profile's variants.
+fn de_summary(exp: &Expansion) -> String {
+    let mut de: Vec<(f64, &str)> = exp
+        .variants
+        .iter()
+        .map(|v| (accuracy::expected_de00(&v.scene), v.name.as_str()))
+        .collect();
+    if de.is_empty() {
+        return String::new();
+    }
+    de.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (worst, name) = de[de.len() - 1];
+    let above = |x: f64| de.iter().filter(|d| d.0 > x).count();
+    format!(
+        "median {:.2}, largest {worst:.2} ({name}); {} of {} variants above 1, {} above 3",
+        de[de.len() / 2].0,
+        above(1.0),
+        de.len(),
+        above(3.0)
+    )
+}
+
+/// What a realisation target of `target` would cost: "fragment s.e. ≤ 0.5
+/// for every variant: `realisations = { target_de00 = 0.5, min = 2, max =
+/// 24 }`, about 3.1× the realisations, est. 32 h of compute (10 h now)", or
+/// `None` when every variant is there already.
+fn statistics_cost(
+    exp: &Expansion,
+    cal: &plan::Calibration,
+    target: f64,
+    now_s: f64,
+) -> Option<String> {
+    let (mut seconds, mut now_r, mut then_r, mut most, mut short) = (0.0, 0, 0, 0, 0);
+    for v in &exp.variants {
+        let e = plan::estimate(&v.scene, cal);
+        let r = accuracy::realisations_for(&v.scene, target).max(e.realisations);
+        if r > e.realisations {
+            short += 1;
+        }
+        seconds += e.seconds / e.realisations.max(1) as f64 * r as f64;
+        now_r += e.realisations;
+        then_r += r;
+        most = most.max(r);
+    }
+    (short > 0).then(|| {
+        format!(
+            "fragment s.e. ≤ {target} for every variant ({short} need more realisations): \
+             `realisations = {{ target_de00 = {target}, min = 2, max = {most} }}`, {:.1}× the \
+             realisations, est. {} of compute ({} now; docs/ACCURACY.md, \"Statistics of the \
+             fragment\")",
+            then_r as f64 / now_r.max(1) as f64,
+            human_time(seconds),
+            human_time(now_s)
+        )
+    })
 }

@@ -1,12 +1,23 @@
-//! Expected error of a scene's fidelity settings, from the measurements of
-//! docs/ACCURACY.md (examples/accuracy.rs, weak layer: red, 15 % PVC,
-//! 100 nm spheres, 1 µm). Each knob's ΔE00 (max over the tile) against its
-//! converged value is interpolated (log–log between measured points, held
-//! beyond them); knobs finer than their reference cost nothing. These are
-//! measurements on one layer, not bounds: denser or larger-grained layers
-//! may differ (the typical and hard cases are not yet measured).
+//! Expected error of a scene's fidelity settings.
+//!
+//! Two kinds of term, summed:
+//! - **Discretisation** (cells, spectral step, tolerance, quadrature): each
+//!   knob's ΔE00 (max over the tile) against its converged value, measured
+//!   on the weak layer of docs/ACCURACY.md (examples/accuracy.rs: red, 15 %
+//!   PVC, 100 nm spheres, 1 µm), interpolated log–log between measured
+//!   points and held beyond them; knobs finer than their reference cost
+//!   nothing. Measurements on one layer, not bounds.
+//! - **Statistics of the fragment** ([`statistical_de00`]): the standard
+//!   error of the 45°/0° colour's mean over the realisations. A fragment
+//!   holds a finite number of grains, so its colour scatters about the
+//!   ensemble's; the scatter falls as 1/√(grains × realisations) (the
+//!   quick study's 300 granular variants give a slope of 0.51 in log–log).
+//!   Per variant: s.e. ≈ C √(Σ_s 1/N_s / R), N_s the independent grains
+//!   (clusters, when agglomerated) of species s in one fragment, R the
+//!   realisations, C calibrated on that study (docs/ACCURACY.md,
+//!   "Statistics of the fragment").
 
-use crate::config::Scene;
+use crate::config::{GrainShape, Scene};
 
 /// Measured (knob value, ΔE00 max) pairs, coarse to fine; the last is the
 /// reference (ΔE = 0).
@@ -26,8 +37,13 @@ const TOLERANCE: [(f64, f64); 5] = [
     (1e-6, 0.0),
     (1e-9, 0.0),
 ];
-/// One realisation against eight.
-const ONE_REALISATION_DE: f64 = 0.85;
+/// The fragment's statistical constant C for one pigment and for a
+/// mixture (a mixture's hue also follows the fragment's composition): the
+/// median over the quick study's granular variants of
+/// s.e. / √(Σ 1/N_s / R) with R = 2, divided by 0.674 (the median of a
+/// two-sample estimate's |z|) — docs/ACCURACY.md.
+pub const FRAGMENT_C_SINGLE: f64 = 7.0;
+pub const FRAGMENT_C_MIXTURE: f64 = 35.0;
 const QUADRATURE: [(f64, f64); 4] = [(2.0, 1.81), (4.0, 0.84), (6.0, 0.04), (12.0, 0.0)];
 
 /// Interpolate ΔE at `x` in a table ordered coarse → fine (`decreasing`:
@@ -62,8 +78,82 @@ fn lookup(table: &[(f64, f64)], x: f64, decreasing: bool) -> f64 {
     0.0
 }
 
+/// Independent grains of each granular species in one fragment: the
+/// species' volume over one grain's (the equal-volume sphere of
+/// `diameter_nm`), over the cluster size when agglomerated.
+pub fn grains_per_fragment(scene: &Scene) -> Vec<f64> {
+    let l = &scene.layer;
+    let volume = l.fragment_x_nm * l.fragment_y_nm * l.thickness_nm;
+    scene
+        .species
+        .iter()
+        .filter(|s| s.shape != GrainShape::Molecular && s.diameter_nm > 0.0)
+        .map(|s| {
+            let grain = std::f64::consts::PI / 6.0 * s.diameter_nm.powi(3);
+            s.volume_fraction * volume / grain / s.cluster_size.max(1) as f64
+        })
+        .collect()
+}
+
+/// The expected standard error of the 45°/0° colour's ΔE00 with
+/// `realisations` fragments (0 without grains: a homogeneous or explicit
+/// layer is the same in every realisation).
+pub fn statistical_de00(scene: &Scene, realisations: usize) -> f64 {
+    let n = grains_per_fragment(scene);
+    if n.is_empty() || scene.structure.is_some() {
+        return 0.0;
+    }
+    let c = if n.len() > 1 {
+        FRAGMENT_C_MIXTURE
+    } else {
+        FRAGMENT_C_SINGLE
+    };
+    let inv: f64 = n.iter().map(|n| 1.0 / n.max(1e-9)).sum();
+    c * (inv / realisations.max(1) as f64).sqrt()
+}
+
+/// Realisations needed for the statistical term to reach `de00`.
+pub fn realisations_for(scene: &Scene, de00: f64) -> usize {
+    let one = statistical_de00(scene, 1);
+    if one <= de00 {
+        1
+    } else {
+        (one / de00).powi(2).ceil() as usize
+    }
+}
+
+/// Realisations a run is expected to make: the count, or with a target
+/// the fewest that reach it by [`statistical_de00`], within the target's
+/// minimum and the scene's maximum.
+pub fn expected_realisations(scene: &Scene) -> usize {
+    match scene.realisation_target {
+        Some(t) => realisations_for(scene, t.de00).clamp(t.min, scene.realisations.max(t.min)),
+        None => scene.realisations,
+    }
+}
+
+/// The expected ΔE00 of a scene: the sum of [`expected_rows`].
+pub fn expected_de00(scene: &Scene) -> f64 {
+    expected_rows(scene).iter().map(|r| r.1).sum()
+}
+
 /// One line per knob: the setting and its measured ΔE00, then the sum.
 pub fn expected_error(scene: &Scene) -> Vec<String> {
+    let rows = expected_rows(scene);
+    let total: f64 = rows.iter().map(|r| r.1).sum();
+    let mut out: Vec<String> = rows
+        .iter()
+        .map(|(k, v)| format!("{k}: ΔE00 ≈ {v:.2}"))
+        .collect();
+    out.push(format!(
+        "expected ΔE00 ≈ {total:.2} (sum of the terms; discretisation measured on a weak \
+         layer, statistics calibrated on the quick study — docs/ACCURACY.md)"
+    ));
+    out
+}
+
+/// The terms of the expected error: (what, ΔE00).
+pub fn expected_rows(scene: &Scene) -> Vec<(String, f64)> {
     let l = &scene.layer;
     let cell = (l.fragment_x_nm / scene.grid.nx as f64).max(l.fragment_y_nm / scene.grid.ny as f64);
     let zc = l.thickness_nm / scene.grid.nz as f64;
@@ -73,12 +163,6 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
     } else {
         f64::INFINITY
     };
-    let real = scene.realisations as f64;
-    let de_real = if real >= 8.0 {
-        0.0
-    } else {
-        ONE_REALISATION_DE * ((1.0 / real - 1.0 / 8.0) / (1.0 - 1.0 / 8.0)).sqrt()
-    };
     let mut rows: Vec<(String, f64)> = Vec::new();
     if !scene.is_molecular() {
         rows.push((
@@ -86,14 +170,41 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
             lookup(&CELL_NM, cell, true),
         ));
         rows.push((format!("z cell {zc:.1} nm"), lookup(&Z_CELL_NM, zc, true)));
-        match scene.realisation_target {
-            // Realisations are added until the colour's ΔE00 standard error
-            // is at most the target (or the most allowed are run).
-            Some(t) => rows.push((
-                format!("realisations up to {} (target s.e.)", scene.realisations),
-                t.de00,
-            )),
-            None => rows.push((format!("realisations {}", scene.realisations), de_real)),
+        let grains = grains_per_fragment(scene);
+        if !grains.is_empty() && scene.structure.is_none() {
+            let fewest = grains.iter().cloned().fold(f64::INFINITY, f64::min);
+            let what = format!(
+                "fragment {:.0} × {:.0} nm ({} grains{}), ",
+                l.fragment_x_nm,
+                l.fragment_y_nm,
+                format_count(fewest),
+                if grains.len() > 1 {
+                    " of the rarest pigment"
+                } else {
+                    ""
+                }
+            );
+            match scene.realisation_target {
+                // Realisations are added until the colour's ΔE00 standard
+                // error is at most the target (or the most allowed are run).
+                Some(t) => {
+                    let r = expected_realisations(scene);
+                    rows.push((
+                        format!(
+                            "{what}realisations {}–{} to an s.e. of {}: about {r} expected",
+                            t.min, scene.realisations, t.de00
+                        ),
+                        statistical_de00(scene, r),
+                    ))
+                }
+                None => rows.push((
+                    format!(
+                        "{what}{} realisation(s): s.e. of the colour",
+                        scene.realisations
+                    ),
+                    statistical_de00(scene, scene.realisations),
+                )),
+            }
         }
         rows.push((
             format!("tolerance {:.0e}", scene.solver.tolerance),
@@ -120,15 +231,16 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
             false,
         ),
     ));
-    let total: f64 = rows.iter().map(|r| r.1).sum();
-    let mut out: Vec<String> = rows
-        .iter()
-        .map(|(k, v)| format!("{k}: ΔE00 ≈ {v:.2}"))
-        .collect();
-    out.push(format!(
-        "expected ΔE00 (max over the tile, sum over knobs) ≈ {total:.2} — measured on a weak layer, docs/ACCURACY.md"
-    ));
-    out
+    rows
+}
+
+/// `140`, `12.3`, `1.3`.
+fn format_count(n: f64) -> String {
+    if n >= 100.0 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.1}")
+    }
 }
 
 #[cfg(test)]

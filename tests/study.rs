@@ -670,3 +670,45 @@ fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
     );
     assert!(!ok && err.contains("--only apply to studies"), "{err}");
 }
+
+#[test]
+fn a_study_with_a_realisation_target_resumes_with_nothing_to_do() {
+    // A loose target stops every variant at its minimum of 2 of at most 3
+    // realisations: fewer solves than the most allowed, and still finished.
+    let dir = tempfile::tempdir().unwrap();
+    let study = sweep().profile_key(
+        "quick",
+        "realisations",
+        common::keys::value("{ target_de00 = 1000.0, min = 2, max = 3 }"),
+    );
+    let p = write(dir.path(), "sweep.toml", &study.toml());
+    let p = p.to_str().unwrap();
+    let per = |v: &inksim::study::sweep::Variant| {
+        inksim::pipeline::planned_solves(&v.scene) / v.scene.realisations
+    };
+    let expanded = Study::load(Path::new(p)).unwrap().expand(None).unwrap();
+    // The plan counts the realisations the target is expected to stop at.
+    let (ok, plan, err) = inksim_in(dir.path(), &["plan", p]);
+    assert!(ok, "{err}");
+    for v in &expanded.variants {
+        assert_eq!(v.scene.realisations, 3);
+        let row = plan
+            .lines()
+            .find(|l| l.split_whitespace().nth(1) == Some(v.name.as_str()))
+            .unwrap_or_else(|| panic!("{plan}"));
+        let solves: usize = row.split_whitespace().nth(2).unwrap().parse().unwrap();
+        assert_eq!(solves, 2 * per(v), "{row}");
+    }
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("4 ran, 0 skipped"), "{out}");
+    let got = results(&dir.path().join("out/quick/variants"));
+    for v in &expanded.variants {
+        assert_eq!(got[&v.name].entries.len(), 2 * per(v), "{}", v.name);
+    }
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("0 ran, 4 skipped"), "{out}\n{err}");
+    let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
+    assert!(ok, "{err}");
+}

@@ -147,12 +147,29 @@ pub fn state(v: &Variant) -> State {
         Ok(s) if s.input_hash != v.scene.provenance.input_hash => State::Mismatch {
             stored: s.input_hash,
         },
-        Ok(s) if s.entries.len() != pipeline::planned_solves(&v.scene) => State::Incomplete {
+        Ok(s) if !complete(&v.scene, s.entries.len()) => State::Incomplete {
             found: s.entries.len(),
             planned: pipeline::planned_solves(&v.scene),
         },
         Ok(_) if !png.is_file() => State::NoTile,
         Ok(_) => State::Done,
+    }
+}
+
+/// Whether a result with `entries` solves is a whole run of `scene`: every
+/// planned solve, or with a realisation target whole realisations between
+/// the target's minimum and the most allowed (the run stops when the
+/// colour is certain enough).
+fn complete(scene: &crate::config::Scene, entries: usize) -> bool {
+    let planned = pipeline::planned_solves(scene);
+    match scene.realisation_target {
+        None => entries == planned,
+        Some(t) => {
+            let per = planned / scene.realisations.max(1);
+            per > 0
+                && entries.is_multiple_of(per)
+                && (t.min.min(scene.realisations)..=scene.realisations).contains(&(entries / per))
+        }
     }
 }
 

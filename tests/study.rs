@@ -287,6 +287,16 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     assert!(ok, "{err}");
     assert!(plan.contains("calibrated now on this machine"), "{plan}");
     assert!(plan.contains("grid 8×8×4: setup"), "{plan}");
+    // The fragment's statistics: 0.15 × 400³ nm³ holds 18.3 grains of
+    // 100 nm and 5.43 of 150 nm, so s.e. ≤ 1 takes ⌈49 / 5.43⌉ = 10
+    // realisations of the coarse variants (C = 7).
+    assert!(
+        plan.contains(
+            "fragment s.e. ≤ 1 for every variant (4 need more realisations): \
+             `realisations = { target_de00 = 1, min = 2, max = 10 }`"
+        ),
+        "{plan}"
+    );
     // Per-variant rows: "#  name  solves  grid  voxels  real. ..."
     let mut planned = BTreeMap::new();
     for l in plan.lines() {
@@ -329,8 +339,23 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         assert_eq!(n, inksim::pipeline::planned_solves(&v.scene));
     }
     let (ok, plan2, _) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
+    // The finished results' mean, averaged with the background's rate
+    // counted as 5 results.
+    let (mut sum, mut n) = (0.0, 0.0);
+    for s in got.values() {
+        for e in &s.entries {
+            sum += (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
+            n += 1.0;
+        }
+    }
+    let measured = sum / n;
+    let blended = (5.0 * inksim::study::plan::MEAN_APPLICATIONS + 4.0 * measured) / 9.0;
     assert!(
-        ok && plan2.contains("mean of the 4 finished result(s)"),
+        ok && plan2.contains(&format!(
+            "applications per solve {blended:.0}: the mean of the 4 finished result(s) of this \
+             study ({measured:.0}), averaged with the background's measured rate (37) counted \
+             as 5 results"
+        )),
         "{plan2}"
     );
 

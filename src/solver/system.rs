@@ -116,8 +116,9 @@ pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
     let er = 0.5 * (lo + hi);
     let rad = eps
         .iter()
-        .map(|e| (e - er).norm())
-        .fold((eps_binder - er).abs(), f64::max);
+        .map(|e| (e - er).norm_sqr())
+        .fold((eps_binder - er).powi(2), f64::max)
+        .sqrt();
     (er, rad)
 }
 
@@ -451,7 +452,11 @@ impl Shift {
             }
             Background::Mean => {
                 let m = mean_eps(eps);
-                let rad = eps.iter().map(|e| (e - m).norm()).fold(0.0, f64::max);
+                let rad = eps
+                    .iter()
+                    .map(|e| (e - m).norm_sqr())
+                    .fold(0.0, f64::max)
+                    .sqrt();
                 let floor = params.mean_loss_floor * rad * rad;
                 (C64::new(m.re, m.im.max(floor).max(1e-9)), None)
             }

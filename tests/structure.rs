@@ -316,3 +316,33 @@ fn conformal_film_over_a_slab_is_the_three_layer_airy_problem() {
     // discretisation error.
     assert!(apart > 10.0 * worst[1], "{apart} vs {worst:?}");
 }
+
+#[test]
+fn bodies_thinner_than_a_cell_are_named_and_the_error_table_is_not_applied() {
+    let dir = tempfile::tempdir().unwrap();
+    // 200 nm fragment at 50 nm cells; z cells of 20 nm.
+    let bodies = [
+        buried_slab(),
+        PrimitiveToml::sphere([100.0, 100.0, 100.0], 60.0).index(1.5, 0.0),
+        PrimitiveToml::sphere([50.0, 50.0, 50.0], 8.0).index(1.5, 0.0),
+    ];
+    let scene = bodies_scene(dir.path(), 20.0, &bodies).scene(dir.path());
+    let lines = pipeline::RunPlan::of(&scene).lines;
+    let warnings: Vec<&String> = lines.iter().filter(|l| l.starts_with("WARNING")).collect();
+    // Only the 16 nm sphere: thinner than the 50 nm cell along x and y and the
+    // 20 nm cell along z; the 120 nm sphere and the slab are resolved.
+    assert_eq!(warnings.len(), 1, "{lines:#?}");
+    assert!(
+        warnings[0].contains(
+            "structure body 2 (sphere) is thinner than one grid cell along x (16.000 nm < cell \
+             50.000 nm), y (16.000 nm < cell 50.000 nm), z (16.000 nm < cell 20.000 nm)"
+        ),
+        "{}",
+        warnings[0]
+    );
+    let text = pipeline::accuracy::expected_error(&scene).join("\n");
+    assert!(
+        text.contains("not estimated for an explicit structure") && !text.contains("lateral cell"),
+        "{text}"
+    );
+}

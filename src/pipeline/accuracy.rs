@@ -139,6 +139,14 @@ pub fn expected_de00(scene: &Scene) -> f64 {
 
 /// One line per knob: the setting and its measured ΔE00, then the sum.
 pub fn expected_error(scene: &Scene) -> Vec<String> {
+    if scene.structure.is_some() {
+        return vec![
+            "not estimated for an explicit structure: the error tables (docs/ACCURACY.md) are \
+             measured on grain layers; halve the cells and the spectral step once to see what \
+             they cost for this one"
+                .to_string(),
+        ];
+    }
     let rows = expected_rows(scene);
     let total: f64 = rows.iter().map(|r| r.1).sum();
     let mut out: Vec<String> = rows

@@ -29,6 +29,7 @@
 pub mod accuracy;
 mod appearance;
 mod eps;
+mod fine_bodies;
 mod grains;
 mod layer;
 pub mod memory;

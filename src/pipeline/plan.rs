@@ -124,6 +124,7 @@ fn layer_lines(scene: &Scene, shortcut: Option<&Result<String, String>>) -> Vec<
                 p.display()
             ),
         });
+        lines.extend(super::fine_bodies::fine_body_lines(scene));
     } else {
         let (packer, why) = Packer::of(scene);
         lines.push(format!("geometry: {packer} ({why})"));

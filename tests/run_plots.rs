@@ -157,3 +157,61 @@ fn geometry_picture_has_a_grey_scale_bar() {
         img.w
     );
 }
+
+#[test]
+fn a_run_writes_exactly_the_outputs_asked_for_and_check_lists_them() {
+    let names = |dir: &std::path::Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    for (outputs, expected) in [
+        ("[]", vec!["plots.h5"]),
+        (
+            "[\"tile\"]",
+            vec![
+                "plots-brdf-plane.png",
+                "plots-brdf-polar.png",
+                "plots-spectra.png",
+                "plots.h5",
+                "plots.png",
+            ],
+        ),
+        (
+            "[\"brdf\"]",
+            vec![
+                "plots-brdf-plane.png",
+                "plots-brdf-polar.png",
+                "plots-orders.png",
+                "plots-spectra.png",
+                "plots.h5",
+                "plots.png",
+            ],
+        ),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let text = SCENE
+            .replace(
+                "outputs = [\"brdf\", \"tile\"]",
+                &format!("outputs = {outputs}"),
+            )
+            .replace("realisations = 2", "realisations = 1");
+        let mut scene = inksim::config::parse_scene(&dir.path().join("s.toml"), &text).unwrap();
+        let out = dir.path().join("out");
+        scene.output.dir = out.clone();
+        // `check` names the same files the run writes.
+        let listed: Vec<String> = inksim::pipeline::output_files(&scene)
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        let mut listed_sorted = listed.clone();
+        listed_sorted.sort();
+        assert_eq!(listed_sorted, expected, "outputs = {outputs}");
+        let rep = inksim::pipeline::run_with(&scene, true, None).unwrap();
+        assert_eq!(names(&out), expected, "outputs = {outputs}");
+        assert_eq!(rep.picture_path.is_some(), expected.contains(&"plots.png"));
+    }
+}

@@ -19,8 +19,12 @@ pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimi
         .map(|e| e.efficiencies.energy_balance.abs())
         .fold(0.0, f64::max);
     println!("results: {}", report.result_path.display());
-    println!("picture: {}", report.picture_path.display());
-    println!("orders: {}", report.orders_picture_path.display());
+    if let Some(p) = &report.picture_path {
+        println!("picture: {}", p.display());
+    }
+    if let Some(p) = &report.orders_picture_path {
+        println!("orders: {}", p.display());
+    }
     for p in &report.plot_paths {
         println!("plot: {}", p.display());
     }
@@ -90,7 +94,10 @@ pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
             .map(|m| format!(" (limit {})", m.describe()))
             .unwrap_or_default()
     );
-    let (h5, png) = inksim::pipeline::result_paths(&scene);
-    println!("would write {} and {}", h5.display(), png.display());
+    let files: Vec<String> = inksim::pipeline::output_files(&scene)
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    println!("would write {}", files.join(", "));
     Ok(())
 }

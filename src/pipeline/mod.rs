@@ -103,17 +103,39 @@ pub fn result_paths(scene: &Scene) -> (PathBuf, PathBuf) {
     )
 }
 
-/// Every file a run of `scene` writes: the result, the picture, the orders
-/// picture and, when asked for, the MERL file.
+/// Every file a run of `scene` writes, and nothing else (`outputs`
+/// decides): the result; the picture `<name>.png` (the tile, or the orders
+/// picture when a BRDF or BTDF but no tile was asked for); the orders
+/// picture `<name>-orders.png` with a BRDF or BTDF; the plots
+/// `<name>-{spectra,brdf-plane,brdf-polar}.png` with any appearance
+/// product; the MERL file when asked for. `outputs = []` writes the result
+/// alone.
 pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
     let (h5, png) = result_paths(scene);
     let d = &scene.output.dir;
-    let mut files = vec![h5, png, d.join(format!("{}-orders.png", scene.output.name))];
-    if scene.appearance.products.merl {
-        files.push(d.join(format!("{}.binary", scene.output.name)));
+    let name = &scene.output.name;
+    let p = scene.appearance.products;
+    let orders = p.brdf || p.btdf;
+    let mut files = vec![h5];
+    if p.tile || orders {
+        files.push(png);
+    }
+    if orders {
+        files.push(d.join(format!("{name}-orders.png")));
+    }
+    if p.brdf || p.btdf || p.tile || p.merl {
+        for suffix in PLOTS {
+            files.push(d.join(format!("{name}-{suffix}.png")));
+        }
+    }
+    if p.merl {
+        files.push(d.join(format!("{name}.binary")));
     }
     files
 }
+
+/// The plots a run with an appearance product draws, as `<name>-<plot>.png`.
+pub const PLOTS: [&str; 3] = ["spectra", "brdf-plane", "brdf-polar"];
 
 /// No output path is taken by something a file cannot replace: the output
 /// folder is a folder (or not there yet) and no result file's name is a

@@ -27,10 +27,12 @@ use super::{check_output_dir, check_output_files, result_paths, PipelineError, S
 /// What a finished run produced.
 pub struct RunReport {
     pub result_path: PathBuf,
-    /// The tile (or the orders picture when no tile was asked for).
-    pub picture_path: PathBuf,
-    /// Every reflected order of every solve, drawn per wavelength and angle.
-    pub orders_picture_path: PathBuf,
+    /// The tile (or the orders picture when a BRDF or BTDF but no tile was
+    /// asked for); None when `outputs` asks for neither.
+    pub picture_path: Option<PathBuf>,
+    /// Every reflected order of every solve, drawn per wavelength and angle
+    /// (with a BRDF or BTDF output).
+    pub orders_picture_path: Option<PathBuf>,
     /// The plots, when the run assembled its appearance:
     /// `<name>-spectra.png` (R, T, A against wavelength),
     /// `<name>-brdf-plane.png` (the BRDF in the plane of incidence) and
@@ -86,7 +88,13 @@ pub fn run_with(
     progress.finish("all solves done");
 
     let pictures = assemble_products(scene, &plan, &layer.entries)?;
-    atomic::write_atomic(&orders_path, &pictures.orders_png)?;
+    // Only what `outputs` asks for (`output_files` lists the same).
+    let products = scene.appearance.products;
+    let orders = products.brdf || products.btdf;
+    let orders_picture_path = orders.then_some(orders_path);
+    if let Some(p) = &orders_picture_path {
+        atomic::write_atomic(p, &pictures.orders_png)?;
+    }
     let mut plot_paths = vec![];
     for (suffix, png) in &pictures.plots {
         let p = scene
@@ -96,10 +104,18 @@ pub fn run_with(
         atomic::write_atomic(&p, png)?;
         plot_paths.push(p);
     }
-    atomic::write_atomic(
-        &picture_path,
-        pictures.tile_png.as_deref().unwrap_or(&pictures.orders_png),
-    )?;
+    let picture = match (&pictures.tile_png, orders) {
+        (Some(tile), _) => Some(tile.as_slice()),
+        (None, true) => Some(pictures.orders_png.as_slice()),
+        (None, false) => None,
+    };
+    let picture_path = match picture {
+        Some(png) => {
+            atomic::write_atomic(&picture_path, png)?;
+            Some(picture_path)
+        }
+        None => None,
+    };
     ResultParts {
         scene,
         geometry: layer.geometry.as_ref(),
@@ -116,7 +132,7 @@ pub fn run_with(
     Ok(RunReport {
         result_path,
         picture_path,
-        orders_picture_path: orders_path,
+        orders_picture_path,
         plot_paths,
         geometry: layer.geometry,
         entries: layer.entries,
@@ -200,9 +216,9 @@ fn assemble_products(
         Some(a) => {
             let name = &scene.output.name;
             vec![
-                ("spectra", render::spectra_png(a, name)?),
-                ("brdf-plane", render::brdf_plane_png(a, name)?),
-                ("brdf-polar", render::brdf_polar_png(a, name)?),
+                (super::PLOTS[0], render::spectra_png(a, name)?),
+                (super::PLOTS[1], render::brdf_plane_png(a, name)?),
+                (super::PLOTS[2], render::brdf_polar_png(a, name)?),
             ]
         }
         None => vec![],

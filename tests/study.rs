@@ -737,3 +737,20 @@ fn a_study_with_a_realisation_target_resumes_with_nothing_to_do() {
     let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
     assert!(ok, "{err}");
 }
+
+#[test]
+fn a_study_whose_variants_ask_for_no_tile_is_refused_before_any_work() {
+    // The merge compares the variants' colours and tiles.
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "sweep.toml",
+        &sweep_of(&base().outputs(&["brdf"])).toml(),
+    );
+    let (ok, _, err) = inksim_in(dir.path(), &["run", p.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("appearance.outputs must include \"tile\" in a study"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
+}

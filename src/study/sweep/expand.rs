@@ -239,6 +239,14 @@ impl Study {
                 p.name, p.origin
             ))
         })?;
+        // The merge compares the variants' colours and tiles.
+        if !scene.appearance.products.tile {
+            return Err(self.err(format!(
+                "variant `{}` ({}): appearance.outputs must include \"tile\" in a study (the \
+                 merge compares the variants' colours and tiles)",
+                p.name, p.origin
+            )));
+        }
         Ok(Variant {
             index,
             id: variant_id(&p.name),

@@ -183,7 +183,11 @@ fn card_lines(m: &h5::MeasuredRecord, ill: Illuminant, so: StandardObserver) -> 
         format!("C*ab {c:.1}{}", pm(lch_se.map(|s| s[1]))),
         format!("h° {h:.0}"),
     ];
+    // Realisations that agree exactly (a variant without grains, e.g. a
+    // dissolved dye) have s.e. 0: the colour is exact, not uncertain.
+    let exact = m.lab_se.is_some_and(|se| se.iter().all(|&s| s == 0.0));
     lines.push(match m.de00_se {
+        _ if exact => "exact: identical realisations, s.e. 0".to_string(),
         Some(se) => format!("ΔE00 s.e. {se:.2}"),
         None => "one realisation: no s.e.".to_string(),
     });
@@ -276,4 +280,33 @@ fn compose(
         }
     }
     c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(lab_se: Option<[f64; 3]>, de00_se: Option<f64>) -> h5::MeasuredRecord {
+        h5::MeasuredRecord {
+            geometry: "45/0".to_string(),
+            lab: [50.0, 10.0, -10.0],
+            xyz: [20.0, 18.0, 25.0],
+            lab_se,
+            de00_se,
+        }
+    }
+
+    fn se_line(m: &h5::MeasuredRecord) -> String {
+        card_lines(m, Illuminant::D50, StandardObserver::TwoDegree)[3].clone()
+    }
+
+    #[test]
+    fn card_lines_say_exact_for_identical_realisations() {
+        let exact = se_line(&record(Some([0.0; 3]), Some(0.0)));
+        assert!(exact.starts_with("exact"), "{exact}");
+        let noisy = se_line(&record(Some([0.1, 0.0, 0.0]), Some(0.12)));
+        assert_eq!(noisy, "ΔE00 s.e. 0.12");
+        let single = se_line(&record(None, None));
+        assert_eq!(single, "one realisation: no s.e.");
+    }
 }

@@ -213,3 +213,35 @@ fn the_fragments_statistical_error_falls_as_one_over_root_grains_times_realisati
         "{text}"
     );
 }
+
+#[test]
+fn a_deterministic_layer_runs_once_and_its_colour_is_exact() {
+    // A dissolved dye: nothing random, so one realisation of the two asked
+    // for, and standard errors of exactly 0 (not unknown).
+    let dir = tempfile::tempdir().unwrap();
+    let rep = SceneToml::grains()
+        .thickness_nm(500.0)
+        .layer_pvc(0.3)
+        .pigment(PigmentToml::builtin("red").molecular())
+        .realisations(2)
+        .wavelengths_nm(&[450.0, 550.0, 650.0])
+        .polar_deg(&[0.0])
+        .outputs(&["tile"])
+        .measurements(&["45/0", "d/8 SCI"])
+        .output(dir.path(), "dye")
+        .run(dir.path());
+    let (measured, _, _) = read_measured(&rep.result_path).unwrap().unwrap();
+    assert_eq!(measured.len(), 2);
+    for m in &measured {
+        assert_eq!(m.lab_se, Some([0.0; 3]), "{}", m.geometry);
+        assert_eq!(m.de00_se, Some(0.0), "{}", m.geometry);
+    }
+    // A granular layer with one realisation has no standard error at all.
+    let grains = scene(dir.path(), "1")
+        .output(dir.path(), "one")
+        .run(dir.path());
+    let (measured, _, _) = read_measured(&grains.result_path).unwrap().unwrap();
+    assert!(measured
+        .iter()
+        .all(|m| m.lab_se.is_none() && m.de00_se.is_none()));
+}

@@ -666,6 +666,13 @@ fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
     let sel: hdf5::types::VarLenUnicode = f.attr("selection").unwrap().read_scalar().unwrap();
     assert_eq!(sel.as_str(), "pigment=red");
     assert_eq!(f.dataset("name").unwrap().shape(), [2]);
+    let grid_height = |dir: &Path| {
+        let png = std::fs::read(dir.join("out/quick/grids/pigment-by-d.png")).unwrap();
+        inksim::output::render::canvas::Canvas::decode_png(&png)
+            .unwrap()
+            .h
+    };
+    let subset_height = grid_height(dir.path());
     // The whole study merged now lists what the subset left to do.
     let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
     assert!(
@@ -676,6 +683,9 @@ fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
     let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
     assert!(ok, "{err}");
     assert!(out.contains("2 ran") && out.contains("2 skipped"), "{out}");
+    // The subset's grid drew only its own row (pigment red), the whole
+    // study's both.
+    assert!(subset_height < grid_height(dir.path()), "{subset_height}");
 
     for (args, needle) in [
         ("colour=red", "no axis `colour`; its axes are pigment, d"),

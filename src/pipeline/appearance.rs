@@ -23,6 +23,7 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         },
         table: plan.table,
         realisations: plan.realisations,
+        deterministic: plan.analytic || scene.structure.is_some(),
         btdf: scene.appearance.products.btdf,
         tile: scene.appearance.products.tile,
         proxy: spectral_proxy(scene),

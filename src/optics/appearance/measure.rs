@@ -166,7 +166,10 @@ pub(super) fn measure(
             let xyz = colour::xyz_from_reflectance(observer, &w, &s)?;
             Ok((xyz, colour::xyz_to_lab(xyz, observer.white_xyz())))
         };
-        let reflectance = reduce(&samples);
+        let mut reflectance = reduce(&samples);
+        if spec.deterministic && reflectance.se.is_none() {
+            reflectance.se = Some(Array1::zeros(reflectance.mean.len()));
+        }
         let (spectrum_wavelengths_nm, spectrum) = spectrum_of(&reflectance.mean);
         let (xyz, lab) = lab_of(&reflectance.mean)?;
         let (mut lab_se, mut de00_se) = (None, None);
@@ -180,6 +183,10 @@ pub(super) fn measure(
             let se = reduce(&as_arrays).se.expect("two or more realisations");
             lab_se = Some([se[0], se[1], se[2]]);
             de00_se = Some(de00_standard_error(&labs, lab));
+        } else if spec.deterministic {
+            // Nothing random in the layer: every realisation is this one.
+            lab_se = Some([0.0; 3]);
+            de00_se = Some(0.0);
         }
         out.push(MeasuredColour {
             geometry: m,

@@ -57,6 +57,10 @@ pub struct AppearanceSpec {
     pub paper_albedo: Option<f64>,
     pub table: TableSpec,
     pub realisations: usize,
+    /// Every realisation would be the same (a homogeneous layer or an
+    /// explicit structure: nothing random): one is run, and the measured
+    /// colours' standard errors are exactly 0 rather than unknown.
+    pub deterministic: bool,
     pub btdf: bool,
     /// Compute the paper term, the sky strip and the colours (the tile).
     pub tile: bool,

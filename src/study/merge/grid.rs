@@ -44,8 +44,17 @@ pub(super) fn draw_grid(
         .map(|a| a.name.as_str())
         .filter(|a| *a != g.rows && *a != g.cols && !g.where_.contains_key(*a))
         .collect();
-    let rows = axis_labels(study, &g.rows, &g.row_labels);
-    let cols = axis_labels(study, &g.cols, &g.col_labels);
+    let mut rows = axis_labels(study, &g.rows, &g.row_labels);
+    let mut cols = axis_labels(study, &g.cols, &g.col_labels);
+    // A subset (`--only`) draws only the labels it selected.
+    for sel in &exp.selection {
+        if sel.axis == g.rows {
+            rows.retain(|l| sel.labels.contains(l));
+        }
+        if sel.axis == g.cols {
+            cols.retain(|l| sel.labels.contains(l));
+        }
+    }
     let fits = |v: &Variant| {
         g.where_.iter().all(|(a, l)| v.label(a) == Some(l))
             && v.label(&g.rows)
@@ -176,18 +185,18 @@ fn colour_card(v: &Variant) -> Result<Option<Canvas>, StudyError> {
 /// The text under a card's patch.
 fn card_lines(m: &h5::MeasuredRecord, ill: Illuminant, so: StandardObserver) -> Vec<String> {
     let [l, c, h] = lab_to_lch(m.lab);
+    // A layer with nothing random (a dissolved dye, an explicit structure)
+    // stores s.e. 0: the colour is exact, not uncertain.
+    let exact = m.lab_se.is_some_and(|se| se.iter().all(|&s| s == 0.0));
     let pm = |se: Option<f64>| se.map_or(String::new(), |s| format!(" ± {s:.2}"));
-    let lch_se = m.lab_se.map(|se| lch_se(m.lab, se));
+    let lch_se = m.lab_se.filter(|_| !exact).map(|se| lch_se(m.lab, se));
     let mut lines = vec![
         format!("L* {l:.1}{}", pm(lch_se.map(|s| s[0]))),
         format!("C*ab {c:.1}{}", pm(lch_se.map(|s| s[1]))),
         format!("h° {h:.0}"),
     ];
-    // Realisations that agree exactly (a variant without grains, e.g. a
-    // dissolved dye) have s.e. 0: the colour is exact, not uncertain.
-    let exact = m.lab_se.is_some_and(|se| se.iter().all(|&s| s == 0.0));
     lines.push(match m.de00_se {
-        _ if exact => "exact: identical realisations, s.e. 0".to_string(),
+        _ if exact => "exact (deterministic)".to_string(),
         Some(se) => format!("ΔE00 s.e. {se:.2}"),
         None => "one realisation: no s.e.".to_string(),
     });

@@ -70,7 +70,8 @@ pub(super) fn write_axis_values(f: &hdf5::File, study: &Study, rows: &[Row]) -> 
 
 /// `colour/<geometry>/{xyz, lab, lch, lab_se, de00_se}` (n × 3, n): each
 /// variant's measured colour (NaN where a variant has none, or a standard
-/// error where it has one realisation), with the illuminant and observer as
+/// error where it has one realisation of a random layer; 0 for a layer with
+/// nothing random), with the illuminant and observer as
 /// attributes of `colour`.
 pub(super) fn write_colours(f: &hdf5::File, rows: &[Row]) -> Result<(), StudyError> {
     let n = rows.len();
@@ -130,7 +131,7 @@ pub(super) fn write_colours(f: &hdf5::File, rows: &[Row]) -> Result<(), StudyErr
             (
                 "lab_se",
                 three(&|x| x.lab_se.unwrap_or(nan3)),
-                "standard errors of L*, a*, b* over the realisations (NaN: one realisation)",
+                "standard errors of L*, a*, b* over the realisations (0: nothing random in the layer; NaN: one realisation of a random layer)",
             ),
         ];
         for (name, data, description) in sets {

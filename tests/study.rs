@@ -764,3 +764,39 @@ fn a_study_whose_variants_ask_for_no_tile_is_refused_before_any_work() {
     );
     assert!(!dir.path().join("out").exists());
 }
+
+#[test]
+fn the_effects_table_takes_the_declared_steps_and_unknown_labels_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    // Declared: d150 → d100 only (against the default d100 → d150); the
+    // pigment axis keeps its default step red → yellow.
+    let study = sweep().raw("axis.1.compare", r#"[["d150", "d100"]]"#);
+    let p = write(dir.path(), "sweep.toml", &study.toml());
+    let p = p.to_str().unwrap();
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok, "{out}\n{err}");
+    let md = std::fs::read_to_string(dir.path().join("out/quick/summary.md")).unwrap();
+    let steps: Vec<&str> = md
+        .lines()
+        .filter(|l| l.starts_with("| d |") || l.starts_with("| pigment |"))
+        .map(|l| l.split('|').nth(2).unwrap().trim())
+        .collect();
+    assert_eq!(steps, ["red → yellow", "d150 → d100"], "{md}");
+
+    for (compare, needle) in [
+        (
+            r#"[["d100", "d999"]]"#,
+            "axis `d` ([[axis]] 2): compare entry 1 names label `d999`, which the axis does not \
+             have; its labels are d100, d150",
+        ),
+        (
+            r#"[["d100"]]"#,
+            "compare entry 1 must be two labels [\"from\", \"to\"], got 1 item(s)",
+        ),
+    ] {
+        let bad = sweep().raw("axis.1.compare", compare);
+        let p = write(dir.path(), "bad.toml", &bad.toml());
+        let (ok, _, err) = inksim_in(dir.path(), &["plan", p.to_str().unwrap()]);
+        assert!(!ok && err.contains(needle), "{err}");
+    }
+}

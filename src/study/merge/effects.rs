@@ -1,6 +1,7 @@
-//! The effects table of a study: for every axis and every step between
-//! neighbouring labels `a → b`, the change of the measured colour between
-//! variants that differ in that axis only.
+//! The effects table of a study: for every axis and every step `a → b` it
+//! compares (the axis's `compare` pairs in the sweep file, else each label
+//! to the next), the change of the measured colour between variants that
+//! differ in that axis only.
 //!
 //! A step's pairs are the variants labelled `a` and `b` on the axis whose
 //! labels on every other axis agree. Over its `n` pairs the table gives the
@@ -96,8 +97,7 @@ pub(super) fn effects(study: &Study, rows: &[Row]) -> Vec<Effect> {
                 .map(|a| r.v.label(&a.name).map(str::to_string))
                 .collect()
         };
-        for step in axis.values.windows(2) {
-            let (from, to) = (&step[0].label, &step[1].label);
+        for (from, to) in &axis.compare {
             let mut d: [Vec<(f64, Option<f64>)>; 4] = Default::default();
             let mut range = (f64::INFINITY, f64::NEG_INFINITY);
             for r1 in rows.iter().filter(|r| r.v.label(&axis.name) == Some(from)) {

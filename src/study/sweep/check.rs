@@ -246,9 +246,42 @@ impl Checker<'_> {
                 )));
             }
         }
+        let compare = match &a.compare {
+            None => values
+                .windows(2)
+                .map(|w| (w[0].label.clone(), w[1].label.clone()))
+                .collect(),
+            Some(pairs) => {
+                let labels: Vec<&str> = values.iter().map(|v| v.label.as_str()).collect();
+                let mut out = Vec::with_capacity(pairs.len());
+                for (j, p) in pairs.iter().enumerate() {
+                    let [from, to] = p.as_slice() else {
+                        return Err(self.err(format!(
+                            "{what}: compare entry {} must be two labels [\"from\", \"to\"], got {} \
+                             item(s)",
+                            j + 1,
+                            p.len()
+                        )));
+                    };
+                    for l in [from, to] {
+                        if !labels.contains(&l.as_str()) {
+                            return Err(self.err(format!(
+                                "{what}: compare entry {} names label `{l}`, which the axis does \
+                                 not have; its labels are {}",
+                                j + 1,
+                                labels.join(", ")
+                            )));
+                        }
+                    }
+                    out.push((from.clone(), to.clone()));
+                }
+                out
+            }
+        };
         Ok(Axis {
             name: a.name.clone(),
             values,
+            compare,
         })
     }
 

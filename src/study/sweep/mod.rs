@@ -98,6 +98,9 @@ pub struct AxisValue {
 pub struct Axis {
     pub name: String,
     pub values: Vec<AxisValue>,
+    /// The steps `from → to` the effects table compares along this axis:
+    /// the sweep file's `compare`, else each label to the next.
+    pub compare: Vec<(String, String)>,
 }
 
 /// A comparison grid declared in the sweep file (or the default ones).

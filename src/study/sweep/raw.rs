@@ -51,6 +51,9 @@ pub(super) struct RawAxis {
     pub values: Option<Vec<Value>>,
     pub labels: Option<Vec<String>>,
     pub value: Option<Vec<RawAxisValue>>,
+    /// The effects table's steps, `[["s100", "s200"], …]` (default: each
+    /// label to the next).
+    pub compare: Option<Vec<Vec<String>>>,
 }
 
 /// `[[axis.value]]`.

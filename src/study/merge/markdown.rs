@@ -24,7 +24,8 @@ pub(super) fn page(p: &PageInput) -> String {
     }
     md += "- files: [summary.h5](summary.h5) (every variant linked), \
            [summary.html](summary.html)\n\n## Effects\n\n\
-           Mean change of the measured colour over the pairs of variants that differ in one \
+           For each step an axis compares (its `compare` pairs, else each label to the next): \
+           mean change of the measured colour over the pairs of variants that differ in that \
            axis only, ± the standard error of the mean; ΔE00 range over the pairs.\n\n";
     let (head, rows) = effect_table(p.effects);
     if rows.is_empty() {

@@ -206,7 +206,8 @@ pub(super) fn html_page(p: &PageInput) -> String {
     }
     body += "</table>\n<p>Files: <a href=\"summary.h5\">summary.h5</a> (every variant \
              linked), <a href=\"summary.md\">summary.md</a>.</p>\n";
-    body += "<h2>Effects</h2>\n<p>Each step between neighbouring labels of an axis: the \
+    body += "<h2>Effects</h2>\n<p>Each step an axis compares (its <code>compare</code> pairs, else each \
+             label to the next): the \
              mean change of the measured colour over the pairs of variants that differ in that \
              axis only, ± the standard error of the mean from the variants' own standard \
              errors; the ΔE00 range over the pairs shows how much the effect depends on the \

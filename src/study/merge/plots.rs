@@ -69,6 +69,14 @@ pub(super) fn draw_plots(
         .iter()
         .filter(|a| !multi || a.name != series_ax.name)
     {
+        // An axis the rows hold one label of (a subset) has nothing to plot
+        // against.
+        let mut labels: Vec<&str> = rows.iter().filter_map(|r| r.v.label(&x_ax.name)).collect();
+        labels.sort_unstable();
+        labels.dedup();
+        if labels.len() < 2 {
+            continue;
+        }
         let series_ax = if multi { Some(series_ax) } else { None };
         let rest: Vec<&Axis> = study
             .axes

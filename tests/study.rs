@@ -673,6 +673,12 @@ fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
             .h
     };
     let subset_height = grid_height(dir.path());
+    // One label on every axis: nothing to plot against.
+    let (ok, out, err) = inksim_in(
+        dir.path(),
+        &["merge", p, "--only", "pigment=red", "--only", "d=d100"],
+    );
+    assert!(ok && !out.contains("plot:"), "{out}\n{err}");
     // The whole study merged now lists what the subset left to do.
     let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
     assert!(

@@ -164,6 +164,7 @@ enum Command {
 
 fn main() -> ExitCode {
     cli::exit_quietly_on_broken_pipe();
+    cli::exit_cleanly_on_interrupt();
     match real_main() {
         Ok(code) => code,
         Err(e) => {

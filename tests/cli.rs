@@ -361,6 +361,33 @@ fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
 }
 
 #[test]
+fn a_second_run_of_the_same_result_refuses_while_the_first_holds_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = tiny().output(&out, "tiny").write(dir.path());
+    // Another run holds the result's lock (as `inksim run` does while it works).
+    let held = inksim::output::lock::OutputLock::try_acquire(&out.join("tiny.h5"))
+        .unwrap()
+        .unwrap();
+    let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(
+        err.contains(&format!(
+            "another inksim run (pid {} on ",
+            std::process::id()
+        )) && err.contains("is writing")
+            && err.contains("tiny.h5; wait for it to finish"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!out.join("tiny.h5").exists());
+    drop(held);
+    let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.join("tiny.h5").is_file());
+}
+
+#[test]
 fn version_names_the_commit_and_log_lines_carry_their_time() {
     let (ok, out, _) = inksim(&["--version"]);
     assert!(ok);

@@ -572,25 +572,36 @@ fn hash_covers_config_and_tables() {
     let h3 = load_scene(&cfg3).unwrap().provenance.input_hash;
     assert_eq!(h1, h2, "same inputs, same hash");
     assert_ne!(h1, h3, "changed table, changed hash");
-    // config text alone changes the hash too
+    // what decides results changes the hash; comments, key order and where
+    // results go do not
     let text = base().toml();
-    let a = parse_text(&text).unwrap().provenance.input_hash;
-    let b = parse_text(&format!("{text}\n# comment\n"))
-        .unwrap()
-        .provenance
-        .input_hash;
-    assert_ne!(a, b);
-    // independent reference: sha256(config text ++ embedded red.csv)
+    let hash = |t: &str| parse_text(t).unwrap().provenance.input_hash;
+    let a = hash(&text);
+    assert_eq!(a, hash(&format!("# a note\n{text}\n# comment\n")));
+    assert_eq!(
+        a,
+        hash(&format!(
+            "{text}\n[output]\ndir = \"elsewhere\"\nname = \"x\"\n"
+        ))
+    );
+    assert_ne!(a, hash(&base().seed(2).toml()));
+    assert_ne!(a, hash(&base().thickness_nm(401.0).toml()));
+    // independent reference: sha256(canonical tables without [output] ++ red.csv)
+    let canonical = |t: &str| {
+        let mut t: toml::Table = t.parse().unwrap();
+        t.remove("output");
+        toml::to_string(&t).unwrap()
+    };
     let red_csv =
         std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/pigments/red.csv")).unwrap();
     let mut h = Sha256::new();
-    h.update(text.as_bytes());
+    h.update(canonical(&text).as_bytes());
     h.update(&red_csv);
     let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
     assert_eq!(a, want);
-    // and for a CSV material: sha256(config text ++ file bytes)
+    // and for a CSV material: sha256(canonical config ++ file bytes)
     let mut h = Sha256::new();
-    h.update(std::fs::read(&cfg1).unwrap());
+    h.update(canonical(&std::fs::read_to_string(&cfg1).unwrap()).as_bytes());
     h.update(INK_CSV.as_bytes());
     let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
     assert_eq!(h1, want);

@@ -575,6 +575,128 @@ fn killed_run_resumes_to_the_uninterrupted_result() {
 }
 
 #[test]
+fn interrupted_run_says_what_is_done_and_resumes_to_the_same_result() {
+    let text = slow_sweep();
+    let whole = tempfile::tempdir().unwrap();
+    let pw = write(whole.path(), "sweep.toml", &text);
+    let (ok, _, err) = inksim_in(
+        whole.path(),
+        &["--threads", "1", "run", pw.to_str().unwrap()],
+    );
+    assert!(ok, "{err}");
+    let reference = results(&whole.path().join("out/quick/variants"));
+
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", &text);
+    let vd = dir.path().join("out/quick/variants");
+    let child = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(["--threads", "1", "run", p.to_str().unwrap(), "--jobs", "1"])
+        .current_dir(dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let first = vd.join("red_d100.h5");
+    let t = Instant::now();
+    while !first.exists() {
+        assert!(t.elapsed() < Duration::from_secs(120), "no result appeared");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // Ctrl-C, as a terminal sends it.
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    let partial = results(&vd);
+    assert!(
+        !partial.is_empty() && partial.len() < 6,
+        "{}",
+        partial.len()
+    );
+    // The count said is the finished results' (one fewer when the signal
+    // lands between a rename and the count's update).
+    let last = err.lines().last().unwrap_or("");
+    let said = |n: usize| last.contains(&format!("{n} of 6 variants of this shard finished"));
+    assert!(
+        last.contains("[inksim] interrupted: ")
+            && (said(partial.len()) || said(partial.len() - 1))
+            && last.contains("run the same command again to resume"),
+        "{err}"
+    );
+    let tmp = |d: &Path| {
+        std::fs::read_dir(d)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.path().extension().is_some_and(|x| x == "tmp"))
+            .count()
+    };
+    assert_eq!(tmp(&vd), 0, "the handler removes its temporary files");
+    let (ok, out, err) = inksim_in(dir.path(), &["run", p.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert_eq!(reported(&out, "ran"), 6 - partial.len(), "{out}");
+    assert_eq!(results(&vd), reference);
+}
+
+/// The count before `word` in the report line `… N ran, M skipped …`.
+fn reported(out: &str, word: &str) -> usize {
+    let line = out.lines().find(|l| l.starts_with("study run:")).unwrap();
+    let before = &line[..line.find(word).unwrap()];
+    before.split_whitespace().last().unwrap().parse().unwrap()
+}
+
+#[test]
+fn concurrent_runs_of_one_study_compute_each_variant_once() {
+    let text = slow_sweep();
+    let whole = tempfile::tempdir().unwrap();
+    let pw = write(whole.path(), "sweep.toml", &text);
+    let (ok, _, err) = inksim_in(
+        whole.path(),
+        &["--threads", "1", "run", pw.to_str().unwrap()],
+    );
+    assert!(ok, "{err}");
+    let reference = results(&whole.path().join("out/quick/variants"));
+    assert_eq!(reference.len(), 6);
+
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", &text);
+    let children: Vec<_> = (0..4)
+        .map(|_| {
+            Command::new(env!("CARGO_BIN_EXE_inksim"))
+                .args(["--threads", "1", "run", p.to_str().unwrap(), "--jobs", "1"])
+                .current_dir(dir.path())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let mut ran = 0;
+    for c in children {
+        let o = c.wait_with_output().unwrap();
+        let out = String::from_utf8_lossy(&o.stdout);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{out}\n{err}");
+        assert_eq!(reported(&out, "failed"), 0, "{out}");
+        ran += reported(&out, "ran");
+    }
+    // Each variant computed once, by one of the four, and bit-identical to
+    // the single run's.
+    assert_eq!(ran, 6);
+    let vd = dir.path().join("out/quick/variants");
+    assert_eq!(results(&vd), reference);
+    let leftovers: Vec<_> = std::fs::read_dir(&vd)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().extension().is_some_and(|x| x == "tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
 fn slurm_script_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let p = write(dir.path(), "sweep.toml", &sweep().toml());

@@ -40,6 +40,27 @@ pub fn exit_quietly_on_broken_pipe() {
     }));
 }
 
+/// Ctrl-C (SIGINT), SIGTERM (a batch system's time limit) and SIGHUP: remove
+/// the temporary files being written (every finished result stays: results
+/// are written atomically), say what is done and how to resume, exit 130.
+pub fn exit_cleanly_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        let removed = inksim::output::atomic::remove_unfinished();
+        let status = inksim::output::progress::status();
+        let status = if status.is_empty() {
+            "finished results are kept".to_string()
+        } else {
+            status
+        };
+        let removed = match removed {
+            0 => String::new(),
+            n => format!(" ({n} unfinished temporary file(s) removed)"),
+        };
+        eprintln!("\n[inksim] interrupted: {status}{removed}");
+        std::process::exit(130);
+    });
+}
+
 /// The error and its causes, `: `-joined; a cause whose text its parent's
 /// message already contains (library errors that name their source) is not
 /// repeated.

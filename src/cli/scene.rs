@@ -1,6 +1,7 @@
 //! The commands on one scene: `run`, `geometry` and `check`.
 
 use anyhow::{Context, Result};
+use inksim::output::lock::{self, OutputLock};
 use inksim::pipeline::memory::{human_bytes, MemoryLimit};
 use std::path::{Path, PathBuf};
 
@@ -11,6 +12,27 @@ pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimi
     if let Some(d) = output_dir {
         scene.output.dir = d;
     }
+    // One writer per result: a second run of the same output refuses at
+    // once (after the output paths are known to be usable).
+    inksim::pipeline::check_output_files(&scene).with_context(|| config.display().to_string())?;
+    let (result_path, _) = inksim::pipeline::result_paths(&scene);
+    let _lock = match OutputLock::try_acquire(&result_path)
+        .with_context(|| config.display().to_string())?
+    {
+        Some(l) => l,
+        None => anyhow::bail!(
+            "{}: another inksim run ({}) is writing {}; wait for it to finish, or give this \
+             run another --output-dir",
+            config.display(),
+            lock::holder(&result_path),
+            result_path.display()
+        ),
+    };
+    inksim::output::progress::set_status(format!(
+        "nothing written ({} is written when all its solves are done); run the same \
+         command again to start over",
+        result_path.display()
+    ));
     let report = inksim::pipeline::run_with(&scene, false, memory)
         .with_context(|| config.display().to_string())?;
     let worst = report

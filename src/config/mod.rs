@@ -56,8 +56,11 @@ pub struct Provenance {
     pub path: PathBuf,
     /// The exact TOML text.
     pub text: String,
-    /// Hex SHA-256 over the config text and the contents of every data file it
-    /// references (pigment tables), so a changed input changes the hash.
+    /// Hex SHA-256 over what decides the results: the config's tables without
+    /// `[output]`, canonically written (comments, layout and key order do not
+    /// count), and the contents of every data file it references (pigment
+    /// tables, structure files), so a changed input changes the hash and a
+    /// moved study or another output folder does not.
     pub input_hash: String,
 }
 

@@ -2,6 +2,7 @@
 //!
 //! - [`h5`]: result and summary files, written atomically;
 //! - [`render`]: PNG pictures (tile, orders, geometry);
+//! - [`lock`]: one writer per result (an OS file lock per output);
 //! - [`merl`]: the BRDF in MERL's binary format for renderers;
 //! - [`progress`]: timestamped progress lines on long work.
 //!
@@ -11,6 +12,7 @@
 pub mod atomic;
 pub mod error;
 pub mod h5;
+pub mod lock;
 pub mod merl;
 pub mod progress;
 pub mod render;

@@ -16,6 +16,25 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+/// What the current long work has done, one line, for an interrupt message.
+static STATUS: Mutex<String> = Mutex::new(String::new());
+
+/// Record what the current work has done so far (e.g. `3 of 6 variants
+/// finished`), for the message printed when the run is interrupted.
+pub fn set_status(line: impl Into<String>) {
+    if let Ok(mut s) = STATUS.lock() {
+        *s = line.into();
+    }
+}
+
+/// The last [`set_status`] line (empty when none).
+pub fn status() -> String {
+    match STATUS.lock() {
+        Ok(s) => s.clone(),
+        Err(e) => e.into_inner().clone(),
+    }
+}
+
 /// Least time between two plain progress lines.
 pub const PLAIN_INTERVAL: Duration = Duration::from_secs(2);
 

@@ -7,6 +7,13 @@
 //! file or a complete one under the final names, at most a stale `*.tmp`
 //! that the next run of that variant removes first.
 //!
+//! A variant is computed under its result's lock ([`lock::OutputLock`]), so
+//! several processes may run one study in one folder at once (two shells, an
+//! array job whose shards overlap): each variant is computed once. A process
+//! that finds a variant locked takes the next one, and when its queue is
+//! empty waits for each locked variant, skips it when the other run finished
+//! it and computes it when that run failed or was killed.
+//!
 //! Before running, each variant's [`State`] is read from its files: it is
 //! skipped only when its result file reads back ([`h5::read_summary`]), its
 //! stored `input_hash` equals the hash of the variant's exact scene text,
@@ -20,8 +27,10 @@
 //! a variant's seed is a function of its name.
 
 use super::sweep::Variant;
+use crate::output::atomic::stale_temporaries;
 use crate::output::h5;
-use crate::output::progress::Progress;
+use crate::output::lock::{self, OutputLock};
+use crate::output::progress::{self, Progress};
 use crate::pipeline;
 use crate::pipeline::memory::{LimitSource, MemoryLimit};
 use std::path::PathBuf;
@@ -279,31 +288,89 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
         jobs
     ));
     let results: Mutex<Vec<Option<Result<f64, String>>>> = Mutex::new(vec![None; mine.len()]);
+    // Variants another process holds the lock of: taken up after the queue.
+    let deferred: Mutex<Vec<usize>> = Mutex::new(Vec::new());
     let next = AtomicUsize::new(0);
+    let finished = AtomicUsize::new(mine.len() - todo.len());
+    let status = |finished: usize| {
+        progress::set_status(format!(
+            "{finished} of {} variants of this shard finished ({} before this run); run the \
+             same command again to resume: finished variants are not redone",
+            mine.len(),
+            mine.len() - todo.len()
+        ))
+    };
+    status(mine.len() - todo.len());
+    let finish = |i: usize, r: Option<Result<f64, String>>| {
+        if !matches!(r, Some(Err(_))) {
+            status(finished.fetch_add(1, Ordering::SeqCst) + 1);
+        }
+        let name = &mine[i].name;
+        let msg = match &r {
+            None => format!("{name} finished by another run"),
+            Some(Ok(t)) => format!("{name} done in {t:.1} s"),
+            Some(Err(e)) => format!("{name} FAILED: {e}"),
+        };
+        if !matches!(r, Some(Ok(_))) {
+            progress.log(&format!("[inksim] {msg}"));
+        }
+        progress.inc(1, &msg);
+        if let Ok(mut g) = results.lock() {
+            g[i] = r;
+        }
+    };
+    // Run variant `i` while holding its lock, unless a run that held it
+    // before us finished it (its state is read again under the lock).
+    let run_locked = |i: usize, lock: OutputLock| {
+        let v = mine[i];
+        let now = state(v);
+        if now == State::Done {
+            finish(i, None);
+            return;
+        }
+        progress.log(&format!("[inksim] start {}: {}", v.name, now.reason()));
+        let r = run_one(v, opts.memory);
+        drop(lock);
+        finish(i, Some(r));
+    };
     std::thread::scope(|s| {
         for _ in 0..jobs {
-            s.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                let Some(&i) = todo.get(k) else { break };
-                let v = mine[i];
-                progress.log(&format!(
-                    "[inksim] start {} ({}/{}): {}",
-                    v.name,
-                    k + 1,
-                    todo.len(),
-                    states[i].reason()
-                ));
-                let r = run_one(v, opts.memory);
-                let msg = match &r {
-                    Ok(t) => format!("{} done in {t:.1} s", v.name),
-                    Err(e) => format!("{} FAILED: {e}", v.name),
-                };
-                if r.is_err() {
-                    progress.log(&format!("[inksim] {msg}"));
+            s.spawn(|| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(&i) = todo.get(k) else { break };
+                    let (h5_path, _) = paths(mine[i]);
+                    match OutputLock::try_acquire(&h5_path) {
+                        Ok(Some(lock)) => run_locked(i, lock),
+                        Ok(None) => {
+                            progress.log(&format!(
+                                "[inksim] {} is being computed by another run ({}); coming \
+                                 back to it after the other variants",
+                                mine[i].name,
+                                lock::holder(&h5_path)
+                            ));
+                            if let Ok(mut d) = deferred.lock() {
+                                d.push(i);
+                            }
+                        }
+                        Err(e) => finish(i, Some(Err(e.to_string()))),
+                    }
                 }
-                progress.inc(1, &msg);
-                if let Ok(mut g) = results.lock() {
-                    g[i] = Some(r);
+                // Then wait for each variant another run holds: it is
+                // skipped when that run finishes it, redone when it failed.
+                // (The guard is released inside `pop`, not held over the wait.)
+                let pop = || deferred.lock().ok().and_then(|mut d| d.pop());
+                while let Some(i) = pop() {
+                    let (h5_path, _) = paths(mine[i]);
+                    progress.log(&format!(
+                        "[inksim] waiting for {} ({})",
+                        mine[i].name,
+                        lock::holder(&h5_path)
+                    ));
+                    match OutputLock::acquire(&h5_path) {
+                        Ok(lock) => run_locked(i, lock),
+                        Err(e) => finish(i, Some(Err(e.to_string()))),
+                    }
                 }
             });
         }
@@ -331,10 +398,12 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
 fn run_one(v: &Variant, memory: Option<MemoryLimit>) -> Result<f64, String> {
     let t = Instant::now();
     let (h5, png) = paths(v);
+    // The caller holds the variant's lock: temporaries of its files are
+    // left by a killed run.
     for p in [&h5, &png] {
-        let mut tmp = p.clone().into_os_string();
-        tmp.push(".tmp");
-        let _ = std::fs::remove_file(PathBuf::from(tmp));
+        for tmp in stale_temporaries(p) {
+            let _ = std::fs::remove_file(tmp);
+        }
     }
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         pipeline::run_with(&v.scene, true, memory)

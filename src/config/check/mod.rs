@@ -25,7 +25,8 @@
 //!   `pigment.agglomeration = { cluster_size }` in `[1, MAX_CLUSTER_SIZE]`;
 //!   `layer.relief_fraction` in `[0, MAX_RELIEF_FRACTION]`;
 //!   `layer.equilibrate_sweeps` in `[0, MAX_EQUILIBRATE_SWEEPS]`.
-//! - `Provenance::input_hash` is SHA-256 over the config text followed by each
+//! - `Provenance::input_hash` is SHA-256 over the config's tables without
+//!   `[output]`, in a canonical form (sorted keys, no comments), followed by each
 //!   pigment's table text, in pigment order, then each structure primitive's
 //!   table text or the bytes of the structure's HDF5 file.
 //! - `[structure]` (explicit layer) and `[[pigment]]` exclude each other.

@@ -12,6 +12,21 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 const DEFAULT_SEED: u64 = 1;
+
+/// What of a config's text decides its results: the parsed tables without
+/// `[output]` (where results go changes nothing in them), written back in
+/// one canonical form (sorted keys, no comments or layout), so that moving
+/// a study, `--output-dir`, comments and key order keep its results valid.
+fn result_defining_text(text: &str) -> String {
+    match text.parse::<toml::Table>() {
+        Ok(mut t) => {
+            t.remove("output");
+            toml::to_string(&t).unwrap_or_else(|_| text.to_string())
+        }
+        // Unreachable for a checked config (it parsed); hash the text as is.
+        Err(_) => text.to_string(),
+    }
+}
 const MAX_REALISATIONS: i64 = 10_000;
 
 impl Checker<'_> {
@@ -85,7 +100,7 @@ impl Checker<'_> {
         self.coverage(wl_key, &wavelengths_nm, &materials)?;
 
         let mut hasher = Sha256::new();
-        hasher.update(text.as_bytes());
+        hasher.update(result_defining_text(text).as_bytes());
         for s in &species {
             hasher.update(s.material.table_bytes());
         }

@@ -641,6 +641,34 @@ fn interrupted_run_says_what_is_done_and_resumes_to_the_same_result() {
     assert_eq!(results(&vd), reference);
 }
 
+#[test]
+fn a_moved_study_resumes_instead_of_starting_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(dir.path(), "sweep.toml", &sweep().toml());
+    let (ok, out, err) = inksim_in(dir.path(), &["run", p.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert_eq!(reported(&out, "ran"), 4, "{out}");
+    let before = results(&dir.path().join("out/quick/variants"));
+    std::fs::rename(dir.path().join("out"), dir.path().join("moved")).unwrap();
+    let (ok, out, err) = inksim_in(
+        dir.path(),
+        &["run", p.to_str().unwrap(), "--output-dir", "moved"],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(reported(&out, "ran"), 0, "{out}");
+    assert_eq!(reported(&out, "skipped"), 4, "{out}");
+    assert_eq!(results(&dir.path().join("moved/quick/variants")), before);
+    // A change that decides results is still noticed.
+    let changed = sweep_of(&base().thickness_nm(410.0)).toml();
+    let p = write(dir.path(), "sweep.toml", &changed);
+    let (ok, out, err) = inksim_in(
+        dir.path(),
+        &["run", p.to_str().unwrap(), "--output-dir", "moved"],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(reported(&out, "ran"), 4, "{out}");
+}
+
 /// The count before `word` in the report line `… N ran, M skipped …`.
 fn reported(out: &str, word: &str) -> usize {
     let line = out.lines().find(|l| l.starts_with("study run:")).unwrap();

@@ -87,6 +87,50 @@ fn wavelength_outside_pigment_data_is_named() {
 }
 
 #[test]
+fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
+    expect_error(
+        tiny().raw(
+            "pigment.0.material",
+            r#"{ builtin = "red", index = [1.5, 0.0] }"#,
+        ),
+        "a material is a table with exactly one of `builtin`, `csv`, `index` (e.g. material = \
+         { builtin = \"red\" }); this one gives more than one",
+    );
+    expect_error(
+        tiny().raw("pigment.0.material", "{}"),
+        "this one gives none",
+    );
+    expect_error(
+        tiny().raw("pigment.0.shape", r#""rice""#),
+        "expected a grain shape: { kind = \"sphere\" }",
+    );
+    expect_error(
+        tiny().raw("pigment.0.shape", r#""rice""#),
+        r#"got string "rice""#,
+    );
+    expect_error(
+        tiny().raw("pigment.0.shape", "{ aspect = 3.0 }"),
+        "`shape` is missing `kind`: expected a grain shape",
+    );
+    expect_error(
+        tiny().raw("layer.surface", r#""rough""#),
+        "expected a surface: { kind = \"flat\" }",
+    );
+}
+
+#[test]
+fn limits_and_numbers_read_as_written() {
+    // The grain limit is the packer's, not (0, 1).
+    expect_error(
+        tiny().pvc(1.0),
+        "key `pigment[0].pvc`: must be in (0, 0.55] (the most the packer reaches), got 1",
+    );
+    // Huge and tiny numbers in exponent form, not 301 digits.
+    expect_error(tiny().diameter_nm(1e300), "got 1e300");
+    expect_error(tiny().tolerance(1e-300), "1e-300");
+}
+
+#[test]
 fn unwritable_output_folder_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = tiny().write(dir.path());

@@ -563,6 +563,26 @@ fn bad_csv_error_names_file_and_line() {
 }
 
 #[test]
+fn a_spreadsheet_table_with_a_byte_order_mark_loads_and_absurd_values_are_refused() {
+    // Spreadsheet exports start with a UTF-8 byte-order mark.
+    let (_d, cfg) = csv_scene(&format!(
+        "\u{feff}{}",
+        INK_CSV.replace("# measured ink\n", "")
+    ));
+    let m = load_scene(&cfg).unwrap().species[0].material.clone();
+    assert_eq!(m.wavelengths_nm(), [400.0, 500.0, 700.0]);
+    for (bad, said) in [
+        ("500,2.0,1e308", "line 4: k must be in [0, 10], got 1e308"),
+        ("500,0,0.5", "line 4: n must be in (0, 10], got 0"),
+        ("500,2.0,-0.5", "line 4: k must be in [0, 10], got -0.5"),
+    ] {
+        let (_d, cfg) = csv_scene(&INK_CSV.replace("500,2.0,0.5", bad));
+        let e = load_scene(&cfg).unwrap_err().to_string();
+        assert!(e.contains("data/ink.csv") && e.contains(said), "{e}");
+    }
+}
+
+#[test]
 fn hash_covers_config_and_tables() {
     let (_d1, cfg1) = csv_scene(INK_CSV);
     let (_d2, cfg2) = csv_scene(INK_CSV);

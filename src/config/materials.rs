@@ -3,7 +3,8 @@
 //!
 //! Tables are plain CSV: optional `#` comment lines, the header
 //! `wavelength_nm,n,k`, then at least two rows with strictly increasing
-//! wavelengths, `n > 0` and `k >= 0`. Between rows `n` and `k` are linearly
+//! wavelengths, `0 < n <= 10` and `0 <= k <= 10`; a UTF-8 byte-order mark
+//! before the header is ignored. Between rows `n` and `k` are linearly
 //! interpolated (each separately); outside the table there is no value, so a
 //! caller can never silently extrapolate.
 //!
@@ -14,9 +15,14 @@
 //! are embedded in the binary. The raw table text is kept so that results can
 //! be tied to the exact data they came from (see [`Material::table_bytes`]).
 
+use super::check::num;
 use num_complex::Complex64;
 use std::fmt;
 use std::path::{Path, PathBuf};
+
+/// Largest n and k a table may give (the constant `index` form allows the
+/// same); larger values are typing errors, not materials.
+pub const MAX_INDEX: f64 = 10.0;
 
 /// Names of the built-in tables, in a fixed order: the Gaussian-band
 /// stand-ins (constant n' = 1.4) and their Kramers–Kronig-consistent
@@ -190,7 +196,9 @@ impl Material {
         };
         let mut header_seen = false;
         let (mut wl, mut n, mut k) = (Vec::new(), Vec::new(), Vec::new());
-        for (idx, raw) in text.lines().enumerate() {
+        // A UTF-8 byte-order mark (spreadsheet exports) is not part of the header.
+        let body = text.strip_prefix('\u{feff}').unwrap_or(text);
+        for (idx, raw) in body.lines().enumerate() {
             let line_no = idx + 1;
             let line = raw.trim();
             if line.is_empty() || line.starts_with('#') {
@@ -232,7 +240,7 @@ impl Material {
             if w <= 0.0 {
                 return Err(line_err(
                     line_no,
-                    format!("wavelength_nm must be > 0, got {w}"),
+                    format!("wavelength_nm must be > 0, got {}", num(w)),
                 ));
             }
             if let Some(&prev) = wl.last() {
@@ -243,11 +251,17 @@ impl Material {
                     ));
                 }
             }
-            if nn <= 0.0 {
-                return Err(line_err(line_no, format!("n must be > 0, got {nn}")));
+            if !(nn > 0.0 && nn <= MAX_INDEX) {
+                return Err(line_err(
+                    line_no,
+                    format!("n must be in (0, {MAX_INDEX}], got {}", num(nn)),
+                ));
             }
-            if kk < 0.0 {
-                return Err(line_err(line_no, format!("k must be >= 0, got {kk}")));
+            if !(0.0..=MAX_INDEX).contains(&kk) {
+                return Err(line_err(
+                    line_no,
+                    format!("k must be in [0, {MAX_INDEX}], got {}", num(kk)),
+                ));
             }
             wl.push(w);
             n.push(nn);

@@ -80,13 +80,14 @@ pub fn parse_scene(path: &Path, text: &str) -> Result<Scene, ConfigError> {
 
 /// The toml error on one line: `line L, column C: message; more`.
 fn parse_message(text: &str, e: &toml::de::Error) -> String {
-    let msg = e
-        .message()
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-        .collect::<Vec<_>>()
-        .join("; ");
+    let msg = in_config_terms(
+        &e.message()
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect::<Vec<_>>()
+            .join("; "),
+    );
     match e.span() {
         Some(span) => {
             let mut start = span.start.min(text.len());
@@ -96,9 +97,114 @@ fn parse_message(text: &str, e: &toml::de::Error) -> String {
             let before = &text[..start];
             let line = before.matches('\n').count() + 1;
             let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            let msg = match msg.as_str() {
+                "missing field `kind`" => missing_kind(text.lines().nth(line - 1).unwrap_or("")),
+                _ => msg,
+            };
             format!("line {line}, column {col}: {msg}")
         }
         None => msg,
+    }
+}
+
+/// The tables a tagged key takes, by the name of its raw type.
+const TAGGED: [(&str, &str); 6] = [
+    (
+        "RawShape",
+        "a grain shape: { kind = \"sphere\" }, { kind = \"molecular\" }, or \
+         { kind = \"rice\" | \"cylinder\", aspect, spheres }",
+    ),
+    (
+        "RawSize",
+        "a size distribution: { kind = \"fixed\" }, { kind = \"normal\", sigma } or \
+         { kind = \"log-normal\", sigma }",
+    ),
+    (
+        "RawBody",
+        "a body: { kind = \"slab\", z_nm }, { kind = \"box\", min_nm, max_nm }, \
+         { kind = \"sphere\", center_nm, radius_nm } or { kind = \"cylinder\", … }",
+    ),
+    (
+        "RawSurface",
+        "a surface: { kind = \"flat\" }, { kind = \"conformal\", film_nm } or \
+         { kind = \"rough\", rms_nm, correlation_nm }",
+    ),
+    (
+        "RawSubstrate",
+        "a substrate: { kind = \"paper\", albedo } or { kind = \"none\" }",
+    ),
+    (
+        "RawStructure",
+        "a structure: kind = \"primitives\" with [[structure.primitive]] tables, or \
+         kind = \"hdf5\" with file",
+    ),
+];
+
+/// serde's wording for the config's enums put in the config's terms: a
+/// tagged key given as a bare string or without `kind`, a material with
+/// none or several of its kinds.
+fn in_config_terms(msg: &str) -> String {
+    const MATERIAL: &str = "a material is a table with exactly one of `builtin`, `csv`, \
+                            `index` (e.g. material = { builtin = \"red\" })";
+    if msg.contains("wanted exactly 1 element, more than 1 element") {
+        return format!("{MATERIAL}; this one gives more than one");
+    }
+    if msg.contains("wanted exactly 1 element, found 0 elements") {
+        return format!("{MATERIAL}; this one gives none");
+    }
+    for (raw, wanted) in TAGGED {
+        if msg.contains(&format!("expected internally tagged enum {raw}")) {
+            let got = msg
+                .strip_prefix("invalid type: ")
+                .and_then(|m| m.split(", expected").next())
+                .map(|g| format!(", got {g}"))
+                .unwrap_or_default();
+            return format!("expected {wanted}{got}");
+        }
+    }
+    msg.to_string()
+}
+
+/// A tagged table without `kind`, on the line `key = { … }`: name the key
+/// and the kinds it takes.
+fn missing_kind(line: &str) -> String {
+    // `shape = { … }` or a table header `[pigment.shape]`.
+    let line = line.trim();
+    let key = match line.strip_prefix('[') {
+        Some(h) => h.trim_matches(|c| c == '[' || c == ']').rsplit('.').next(),
+        None => line.split('=').next(),
+    }
+    .unwrap_or("")
+    .trim();
+    let raw: &[&str] = match key {
+        "shape" => &["RawShape", "RawBody"],
+        "size" => &["RawSize"],
+        "surface" => &["RawSurface"],
+        "substrate" => &["RawSubstrate"],
+        _ => &[],
+    };
+    let kinds: Vec<&str> = TAGGED
+        .iter()
+        .filter(|(r, _)| raw.contains(r))
+        .map(|(_, w)| *w)
+        .collect();
+    match kinds.is_empty() {
+        true => "missing `kind`, the key that says which form this table takes".into(),
+        false => format!(
+            "`{key}` is missing `kind`: expected {}",
+            kinds.join("; or ")
+        ),
+    }
+}
+
+/// A number as a message shows it: as written for ordinary magnitudes, in
+/// exponent form (`1e300`, `1e-9`) for very large or small ones.
+pub(crate) fn num(v: f64) -> String {
+    let a = v.abs();
+    if v.is_finite() && v != 0.0 && !(1e-4..1e7).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -121,7 +227,7 @@ impl Checker<'_> {
         if ok {
             Ok(v)
         } else {
-            Err(self.invalid(key, format!("must be in {range}, got {v}")))
+            Err(self.invalid(key, format!("must be in {range}, got {}", num(v))))
         }
     }
 
@@ -141,8 +247,9 @@ impl Checker<'_> {
                 return Err(self.invalid(
                     k,
                     format!(
-                        "values must be strictly increasing, got {v} after {}",
-                        list[i - 1]
+                        "values must be strictly increasing, got {} after {}",
+                        num(v),
+                        num(list[i - 1])
                     ),
                 ));
             }

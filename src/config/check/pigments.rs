@@ -105,8 +105,23 @@ impl Checker<'_> {
             } else {
                 key("pvc")
             };
-            let volume_fraction = self.range(&vf_key, vf, vf > 0.0 && vf < 1.0, "(0, 1)")?;
             let shape = self.shape(p.shape.as_ref(), &key("shape"))?;
+            // Grains are packed (at most MAX_PVC); a dissolved dye is not.
+            let volume_fraction = if shape == GrainShape::Molecular {
+                self.range(
+                    &vf_key,
+                    vf,
+                    vf > 0.0 && vf < 1.0,
+                    "(0, 1) (a dissolved dye)",
+                )?
+            } else {
+                self.range(
+                    &vf_key,
+                    vf,
+                    vf > 0.0 && vf <= MAX_PVC,
+                    &format!("(0, {MAX_PVC}] (the most the packer reaches)"),
+                )?
+            };
             // A molecular pigment's diameter is not used (documented).
             let diameter_nm = match (shape, p.diameter_nm) {
                 (GrainShape::Molecular, _) => 0.0,

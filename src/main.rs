@@ -194,8 +194,8 @@ fn real_main() -> Result<ExitCode> {
             jobs,
             only,
         } => {
-            cli::readable(&config)?;
-            if cli::is_study(&config) {
+            let config = cli::ConfigFile::read(&config)?;
+            if config.is_study() {
                 let flags = cli::study::RunFlags {
                     output_dir,
                     profile: profile.as_deref(),
@@ -219,7 +219,7 @@ fn real_main() -> Result<ExitCode> {
             shard,
             only,
         } => cli::plan::plan(
-            &config,
+            &cli::ConfigFile::read(&config)?,
             profile.as_deref(),
             shard.as_deref(),
             &cli::selections(&only)?,
@@ -233,21 +233,31 @@ fn real_main() -> Result<ExitCode> {
             cpus,
             partition,
             script,
-        } => cli::slurm::slurm(&config, profile.as_deref(), shards, cpus, partition, script)?,
+        } => cli::slurm::slurm(
+            &cli::ConfigFile::read(&config)?,
+            profile.as_deref(),
+            shards,
+            cpus,
+            partition,
+            script,
+        )?,
         Command::Merge {
             config,
             profile,
             output_dir,
             only,
         } => cli::study::merge(
-            &config,
+            &cli::ConfigFile::read(&config)?,
             profile.as_deref(),
             output_dir,
             &cli::selections(&only)?,
         )?,
-        Command::Geometry { config, output_dir } => cli::scene::geometry(&config, output_dir)?,
+        Command::Geometry { config, output_dir } => {
+            cli::scene::geometry(&cli::ConfigFile::read(&config)?, output_dir)?
+        }
         Command::Check { config } => {
-            if cli::is_study(&config) {
+            let config = cli::ConfigFile::read(&config)?;
+            if config.is_study() {
                 cli::study::check(&config, memory)?;
             } else {
                 cli::scene::check(&config, memory)?;

@@ -432,6 +432,42 @@ fn a_second_run_of_the_same_result_refuses_while_the_first_holds_it() {
 }
 
 #[test]
+fn a_config_is_read_once_so_standard_input_works() {
+    use std::io::Write;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    let text = tiny().output(&dir.path().join("out"), "tiny").toml();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(["check", "/dev/stdin"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(text.as_bytes())
+        .unwrap();
+    let o = child.wait_with_output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.starts_with("/dev/stdin: valid"), "{out}");
+    // Not configs: a folder, an endless device.
+    let (ok, _, err) = inksim(&["check", dir.path().to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("cannot read: is a folder, not a config file"),
+        "{err}"
+    );
+    let (ok, _, err) = inksim(&["check", "/dev/zero"]);
+    assert!(
+        !ok && err.contains("larger than 16 MiB, not a config file"),
+        "{err}"
+    );
+}
+
+#[test]
 fn version_names_the_commit_and_log_lines_carry_their_time() {
     let (ok, out, _) = inksim(&["--version"]);
     assert!(ok);

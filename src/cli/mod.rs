@@ -78,35 +78,77 @@ pub fn chain(e: &anyhow::Error) -> String {
     out
 }
 
-/// Whether `path` is a study file (has a [study] table); unreadable files
-/// are left to the scene loader, which names them.
-pub fn is_study(path: &Path) -> bool {
-    std::fs::read_to_string(path)
-        .map(|t| inksim::study::is_study_text(&t))
-        .unwrap_or(false)
+/// Largest config file read (a config is a few kB; this refuses `/dev/zero`
+/// and other non-configs before they fill the memory).
+const MAX_CONFIG_BYTES: u64 = 16 << 20;
+
+/// A config file, read once: standard input, a pipe or a process
+/// substitution (`<(…)`) cannot be read a second time.
+pub struct ConfigFile {
+    pub path: PathBuf,
+    pub text: String,
 }
 
-/// The config file exists and can be read; else one line naming it.
-pub fn readable(path: &Path) -> Result<()> {
-    std::fs::File::open(path)
-        .map(|_| ())
-        .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))
-}
-
-/// Read and check a study; `output_dir` (from `--output-dir`) replaces its
-/// `study.output_dir`.
-pub fn load_study(path: &Path, output_dir: Option<PathBuf>) -> Result<Study> {
-    readable(path)?;
-    anyhow::ensure!(
-        is_study(path),
-        "{}: not a study (no [study] table); `inksim run` and `inksim check` take a scene",
-        path.display()
-    );
-    let mut study = Study::load(path)?;
-    if let Some(d) = output_dir {
-        study.output_dir = d;
+impl ConfigFile {
+    /// Read `path`; one line naming it when it cannot be read, is a folder,
+    /// is too large or is not UTF-8 text.
+    pub fn read(path: &Path) -> Result<ConfigFile> {
+        use std::io::Read;
+        let fail = |what: String| anyhow::anyhow!("{}: cannot read: {what}", path.display());
+        let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()))?;
+        if file.metadata().is_ok_and(|m| m.is_dir()) {
+            return Err(fail("is a folder, not a config file".into()));
+        }
+        let mut bytes = Vec::new();
+        file.take(MAX_CONFIG_BYTES + 1)
+            .read_to_end(&mut bytes)
+            .map_err(|e| fail(e.to_string()))?;
+        if bytes.len() as u64 > MAX_CONFIG_BYTES {
+            return Err(fail(format!(
+                "larger than {} MiB, not a config file",
+                MAX_CONFIG_BYTES >> 20
+            )));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            fail(format!(
+                "not UTF-8 text (byte {})",
+                e.utf8_error().valid_up_to()
+            ))
+        })?;
+        Ok(ConfigFile {
+            path: path.to_path_buf(),
+            text,
+        })
     }
-    Ok(study)
+
+    pub fn display(&self) -> std::path::Display<'_> {
+        self.path.display()
+    }
+
+    /// Whether it is a study (has a [study] table).
+    pub fn is_study(&self) -> bool {
+        inksim::study::is_study_text(&self.text)
+    }
+
+    /// The scene it describes.
+    pub fn scene(&self) -> Result<inksim::config::Scene> {
+        Ok(inksim::config::parse_scene(&self.path, &self.text)?)
+    }
+
+    /// The study it describes; `output_dir` (from `--output-dir`) replaces
+    /// its `study.output_dir`.
+    pub fn study(&self, output_dir: Option<PathBuf>) -> Result<Study> {
+        anyhow::ensure!(
+            self.is_study(),
+            "{}: not a study (no [study] table); `inksim run` and `inksim check` take a scene",
+            self.display()
+        );
+        let mut study = Study::parse(&self.path, &self.text)?;
+        if let Some(d) = output_dir {
+            study.output_dir = d;
+        }
+        Ok(study)
+    }
 }
 
 /// Most worker threads per core `--threads` is allowed (more only queue).

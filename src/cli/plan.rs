@@ -1,6 +1,7 @@
 //! `inksim plan`: what a study costs, per variant and per profile, by a
 //! time model calibrated now on this machine.
 
+use super::ConfigFile;
 use anyhow::Result;
 use inksim::config::{Method, Precision};
 use inksim::pipeline::accuracy;
@@ -8,19 +9,18 @@ use inksim::pipeline::memory::{self, human_bytes, MemoryLimit};
 use inksim::study::plan::{self, human_time};
 use inksim::study::run::{self as srun, Shard, State};
 use inksim::study::sweep::{Expansion, Selection};
-use std::path::Path;
 
 /// `inksim plan STUDY`: the variants of a profile (or of a shard of it) with
 /// their work, estimated time and memory, and totals per profile.
 pub fn plan(
-    config: &Path,
+    config: &ConfigFile,
     profile: Option<&str>,
     shard: Option<&str>,
     only: &[Selection],
     nthreads: usize,
     limit: Option<MemoryLimit>,
 ) -> Result<()> {
-    let study = super::load_study(config, None)?;
+    let study = config.study(None)?;
     let shard = match shard {
         Some(s) => Shard::parse(s).map_err(anyhow::Error::msg)?,
         None => Shard::ALL,

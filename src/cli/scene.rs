@@ -1,14 +1,19 @@
 //! The commands on one scene: `run`, `geometry` and `check`.
 
+use super::ConfigFile;
 use anyhow::{Context, Result};
 use inksim::output::lock::{self, OutputLock};
 use inksim::pipeline::memory::{human_bytes, MemoryLimit};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// `inksim run SCENE`: the whole pipeline; prints where the results went and
 /// the worst energy balance.
-pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimit>) -> Result<()> {
-    let mut scene = inksim::config::load_scene(config)?;
+pub fn run(
+    config: &ConfigFile,
+    output_dir: Option<PathBuf>,
+    memory: Option<MemoryLimit>,
+) -> Result<()> {
+    let mut scene = config.scene()?;
     if let Some(d) = output_dir {
         scene.output.dir = d;
     }
@@ -58,8 +63,8 @@ pub fn run(config: &Path, output_dir: Option<PathBuf>, memory: Option<MemoryLimi
 }
 
 /// `inksim geometry SCENE`: the layer only.
-pub fn geometry(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
-    let mut scene = inksim::config::load_scene(config)?;
+pub fn geometry(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
+    let mut scene = config.scene()?;
     if let Some(d) = output_dir {
         scene.output.dir = d;
     }
@@ -73,8 +78,8 @@ pub fn geometry(config: &Path, output_dir: Option<PathBuf>) -> Result<()> {
 }
 
 /// `inksim check SCENE`: validate and print what a run would compute.
-pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
-    let scene = inksim::config::load_scene(config)?;
+pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
+    let scene = config.scene()?;
     inksim::pipeline::memory::fits(&scene, memory)
         .and_then(|()| inksim::pipeline::check_output_files(&scene))
         .with_context(|| config.display().to_string())?;

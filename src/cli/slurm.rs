@@ -1,6 +1,7 @@
 //! `inksim slurm`: a ready sbatch script running a study as a Slurm job
 //! array.
 
+use super::ConfigFile;
 use anyhow::{Context, Result};
 use inksim::study::slurm;
 use std::path::{Path, PathBuf};
@@ -8,14 +9,14 @@ use std::path::{Path, PathBuf};
 /// `inksim slurm STUDY`: write the sbatch job-array script, its memory and
 /// time limits from the plan's estimates.
 pub fn slurm(
-    config: &Path,
+    config: &ConfigFile,
     profile: Option<&str>,
     shards: Option<usize>,
     cpus: usize,
     partition: Option<String>,
     script: Option<PathBuf>,
 ) -> Result<()> {
-    let study = super::load_study(config, None)?;
+    let study = config.study(None)?;
     anyhow::ensure!(cpus >= 1, "--cpus must be at least 1");
     let exp = study.expand(profile)?;
     let n = exp.variants.len();

@@ -1,10 +1,11 @@
 //! The commands on a study: `run`, `check` and `merge`.
 
+use super::ConfigFile;
 use anyhow::{bail, Context, Result};
 use inksim::pipeline::memory::{human_bytes, MemoryLimit};
 use inksim::study::run::{self as srun, RunOptions, State};
 use inksim::study::sweep::{Expansion, Selection};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// The flags of `inksim run` on a study.
@@ -19,7 +20,7 @@ pub struct RunFlags<'a> {
 /// `inksim run STUDY`: every unfinished variant (of the shard and the
 /// `--only` subset); the exit code says whether any failed.
 pub fn run(
-    config: &Path,
+    config: &ConfigFile,
     flags: RunFlags,
     nthreads: usize,
     memory: Option<MemoryLimit>,
@@ -31,7 +32,7 @@ pub fn run(
         jobs,
         only,
     } = flags;
-    let study = super::load_study(config, output_dir)?;
+    let study = config.study(output_dir)?;
     let shard = super::shard_of(shard)?;
     let exp = study.expand(profile)?.select(&study, &only)?;
     let to_run = exp
@@ -95,8 +96,8 @@ pub fn run(
 /// `inksim check STUDY`: expand every profile (which validates every
 /// variant's scene), hold every variant to the memory limit and say how
 /// many variants each has.
-pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
-    let study = super::load_study(config, None)?;
+pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
+    let study = config.study(None)?;
     let profiles: Vec<Option<String>> = if study.profiles.is_empty() {
         vec![None]
     } else {
@@ -130,12 +131,12 @@ pub fn check(config: &Path, memory: Option<MemoryLimit>) -> Result<()> {
 /// `inksim merge STUDY`: the summary file, page and grids of a finished
 /// study.
 pub fn merge(
-    config: &Path,
+    config: &ConfigFile,
     profile: Option<&str>,
     output_dir: Option<PathBuf>,
     only: &[Selection],
 ) -> Result<()> {
-    let study = super::load_study(config, output_dir)?;
+    let study = config.study(output_dir)?;
     let exp = study.expand(profile)?.select(&study, only)?;
     print_merge(&inksim::study::merge::merge(&study, &exp)?);
     Ok(())

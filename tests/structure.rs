@@ -233,6 +233,75 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
 }
 
 #[test]
+fn check_reads_a_structure_file_as_a_run_would() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = slab_scene(dir.path(), 10.0)
+        .structure_file("eps.h5")
+        .wavelengths_nm(&[450.0, 600.0]);
+    let cfg = text.write(dir.path());
+    let h5 = dir.path().join("eps.h5");
+    std::fs::write(&h5, "").unwrap();
+    let g = pipeline::grid_of(&text.scene(dir.path()));
+    let grid = |v: f64| ndarray::Array3::<f64>::from_elem((g.nz, g.ny, g.nx), v);
+    let write = |sets: &[(&str, ndarray::Array3<f64>)]| {
+        let f = hdf5::File::create(&h5).unwrap();
+        for (name, a) in sets {
+            f.new_dataset_builder().with_data(a).create(*name).unwrap();
+        }
+    };
+    let check = || {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_inksim"))
+            .args(["check", cfg.to_str().unwrap()])
+            .output()
+            .unwrap();
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    write(&[("eps_re", grid(2.4)), ("eps_im", grid(0.0))]);
+    let (ok, err) = check();
+    assert!(ok, "{err}");
+    let mut nan = grid(2.4);
+    nan[[0, 0, 0]] = f64::NAN;
+    let mut gain = grid(0.0);
+    gain[[1, 0, 0]] = -0.1;
+    let cases: Vec<(Box<dyn Fn()>, &str)> = vec![
+        (
+            Box::new(|| std::fs::write(&h5, "not hdf5").unwrap()),
+            "HDF5",
+        ),
+        (Box::new(|| std::fs::write(&h5, "").unwrap()), "HDF5"),
+        (Box::new(|| write(&[("eps_re", grid(2.4))])), "eps_im"),
+        (
+            Box::new(|| {
+                let small = ndarray::Array3::<f64>::zeros((g.nz, g.ny, g.nx + 1));
+                write(&[("eps_re", small.clone()), ("eps_im", small)])
+            }),
+            "scene's grid",
+        ),
+        (
+            Box::new(|| write(&[("eps_re", nan.clone()), ("eps_im", grid(0.0))])),
+            "must be finite",
+        ),
+        (
+            Box::new(|| write(&[("eps_re", grid(2.4)), ("eps_im", gain.clone())])),
+            "Im ε ≥ 0",
+        ),
+    ];
+    for (make, said) in cases {
+        make();
+        let (ok, err) = check();
+        assert!(!ok, "{said}");
+        assert!(
+            err.contains("eps.h5") && err.contains(said),
+            "{said}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}
+
+#[test]
 fn structure_input_errors_name_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("s.toml");

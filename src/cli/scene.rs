@@ -82,6 +82,7 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     let scene = config.scene()?;
     inksim::pipeline::memory::fits(&scene, memory)
         .and_then(|()| inksim::pipeline::check_output_files(&scene))
+        .and_then(|()| inksim::pipeline::check_inputs(&scene))
         .with_context(|| config.display().to_string())?;
     let g = scene.grid;
     println!("{}: valid", config.display());

@@ -109,6 +109,7 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
         for v in &exp.variants {
             inksim::pipeline::memory::fits(&v.scene, memory)
                 .and_then(|()| inksim::pipeline::check_output_files(&v.scene))
+                .and_then(|()| inksim::pipeline::check_inputs(&v.scene))
                 .with_context(|| {
                     format!(
                         "{}: profile {}, variant {}",

@@ -160,6 +160,18 @@ pub fn check_output_files(scene: &Scene) -> Result<(), PipelineError> {
     Ok(())
 }
 
+/// The data files a run reads, read and checked as the run reads them: a
+/// structure's ε grid (an HDF5 file with `eps_re`, `eps_im` of the scene's
+/// grid shape, finite, Im ε ≥ 0, a grid for every wavelength). Pigment
+/// tables are read and checked when the config is loaded. Called by `check`,
+/// so that a bad file is found before any run starts.
+pub fn check_inputs(scene: &Scene) -> Result<(), PipelineError> {
+    if let Some(crate::config::Structure::Hdf5(path)) = &scene.structure {
+        crate::raster::structure::EpsGrid::read(path, &grid_of(scene), &scene.wavelengths_nm)?;
+    }
+    Ok(())
+}
+
 /// Make sure the output folder exists and accepts files.
 pub fn check_output_dir(dir: &Path) -> Result<(), PipelineError> {
     let err = |m: String| PipelineError::Output {

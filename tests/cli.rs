@@ -128,6 +128,13 @@ fn limits_and_numbers_read_as_written() {
     // Huge and tiny numbers in exponent form, not 301 digits.
     expect_error(tiny().diameter_nm(1e300), "got 1e300");
     expect_error(tiny().tolerance(1e-300), "1e-300");
+    // Grains so small the layer would hold more than a packer can place.
+    expect_error(
+        tiny().diameter_nm(1e-9),
+        "1e-9 nm grains at PVC 0.15 make about 2.9e34 grains in this layer, more than the \
+         2000000 a layer may hold",
+    );
+    expect_error(tiny().diameter_nm(2.0), "make about 3580986 grains");
 }
 
 #[test]

@@ -6,7 +6,7 @@ use super::{Checker, REL_EPS};
 use crate::config::raw::{RawOrientation, RawPigment, RawShape, RawSize};
 use crate::config::{
     ConfigError, GrainOrientation, GrainShape, GrainSize, Layer, Species, MAX_CLUSTER_SIZE,
-    MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA, MAX_PVC,
+    MAX_GRAINS, MAX_LOG_NORMAL_SIGMA, MAX_NORMAL_SIGMA, MAX_PVC,
 };
 use std::collections::HashMap;
 
@@ -133,6 +133,28 @@ impl Checker<'_> {
                     &format!("(0, {max_d}] nm (at most the layer thickness and the fragment size)"),
                 )?,
             };
+            if diameter_nm > 0.0 {
+                let volume = layer.thickness_nm * layer.fragment_x_nm * layer.fragment_y_nm;
+                let grains =
+                    volume_fraction * volume / (std::f64::consts::PI / 6.0 * diameter_nm.powi(3));
+                if grains > MAX_GRAINS as f64 {
+                    return Err(self.invalid(
+                        key("diameter_nm"),
+                        format!(
+                            "{} nm grains at PVC {volume_fraction} make about {} grains in this \
+                             layer, more than the {MAX_GRAINS} a layer may hold; use larger \
+                             grains or a smaller fragment, or shape = {{ kind = \"molecular\" }} \
+                             for a dye dissolved in the binder",
+                            super::num(diameter_nm),
+                            if grains < 1e7 {
+                                format!("{grains:.0}")
+                            } else {
+                                format!("{grains:.1e}")
+                            }
+                        ),
+                    ));
+                }
+            }
             let orientation = match p.orientation {
                 None | Some(RawOrientation::Random) => GrainOrientation::Random,
                 Some(RawOrientation::InPlane) => GrainOrientation::InPlane,

@@ -266,7 +266,8 @@ fn check_reads_a_structure_file_as_a_run_would() {
     nan[[0, 0, 0]] = f64::NAN;
     let mut gain = grid(0.0);
     gain[[1, 0, 0]] = -0.1;
-    let cases: Vec<(Box<dyn Fn()>, &str)> = vec![
+    type Case<'a> = (Box<dyn Fn() + 'a>, &'a str);
+    let cases: Vec<Case> = vec![
         (
             Box::new(|| std::fs::write(&h5, "not hdf5").unwrap()),
             "HDF5",

@@ -237,6 +237,15 @@ pub fn preview_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
              disc) and a uniform white sky; linear sRGB (D65), white facing the light = 1, \
              clipped."
         ),
+        format!(
+            "Layer BRDF solved at θi = {}°; interpolated between, held beyond.",
+            a.spec
+                .illumination_deg
+                .iter()
+                .map(|d| format!("{d}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
     ];
     let lines: Vec<(String, f64)> = caption
         .iter()

@@ -103,7 +103,7 @@ impl PageInput<'_> {
         let (h5, tile) = run::paths(v);
         let dir = h5.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut files = vec![("h5".to_string(), h5), ("tile".to_string(), tile)];
-        for what in ["orders", "spectra", "brdf-plane", "brdf-polar"] {
+        for what in ["orders", "spectra", "brdf-plane", "brdf-polar", "preview"] {
             files.push((what.into(), dir.join(format!("{}-{what}.png", v.name))));
         }
         files

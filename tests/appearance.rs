@@ -420,6 +420,29 @@ fn preview_of_bare_paper_shows_its_albedo_beside_the_white_diffuser() {
 }
 
 #[test]
+fn preview_shows_the_lights_mirror_image_only_where_the_layer_reflects() {
+    // The light's mirror image lies where the normal bisects the light and
+    // the view, 22.5° towards the upper left: pixel (80, 80) of the first
+    // sphere. A clear binder of index 1.5 reflects ~4 % there, which the
+    // 3° disc makes far brighter than white; a binder of index 1 nothing.
+    use inksim::output::render::Canvas;
+    let highlight = |binder: f64| {
+        let dir = tempfile::tempdir().unwrap();
+        slab_scene(dir.path(), binder, 4)
+            .outputs(&["preview"])
+            .run(dir.path());
+        let png = std::fs::read(dir.path().join("slab-preview.png")).unwrap();
+        Canvas::decode_png(&png)
+            .unwrap()
+            .get(16 + 80, 16 + 80)
+            .unwrap()
+    };
+    assert_eq!(highlight(1.5), [255; 3]);
+    let none = highlight(1.0);
+    assert!(none.iter().all(|&c| c < 250), "{none:?}");
+}
+
+#[test]
 fn merl_export_stays_bounded_at_grazing_angles() {
     // The BRDF is the table's density over its coverage, finite up to the
     // horizon: no bin at grazing angles may exceed the largest value seen

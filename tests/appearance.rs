@@ -384,6 +384,65 @@ fn merl_export_of_bare_paper_is_albedo_over_pi_everywhere() {
 }
 
 #[test]
+fn preview_of_bare_paper_shows_its_albedo_beside_the_white_diffuser() {
+    // A clear slab of index 1 on paper of albedo 0.9 is the paper alone: a
+    // Lambertian 0.9, so where the sphere faces the light (radiance 0.75 from
+    // the light + 0.25 from the sky for albedo 1) it shows 0.9 of the white
+    // diffuser's 1, and no specular reflection. The preview alone asks for
+    // the paper term.
+    use inksim::output::render::Canvas;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = slab_scene(dir.path(), 1.0, 4).outputs(&["preview"]);
+    scene.run(dir.path());
+    let png = std::fs::read(dir.path().join("slab-preview.png")).unwrap();
+    let files = pipeline::output_files(&scene.scene(dir.path()));
+    assert!(files.iter().any(|f| f.ends_with("slab-preview.png")));
+    let c = Canvas::decode_png(&png).unwrap();
+    // Spheres of 220 px from (16, 16) and (252, 16); the normal towards the
+    // light, 45° from the view towards the upper left, is at a quarter of
+    // the diameter from the left and from the top.
+    let at = |x0: i64| c.get(x0 + 55, 16 + 55).unwrap();
+    let expect = inksim::optics::colour::encode_srgb8([0.9; 3]);
+    for (got, want) in [(at(16), expect), (at(252), [255; 3])] {
+        for ch in 0..3 {
+            assert!(
+                (got[ch] as i32 - want[ch] as i32).abs() <= 2,
+                "{got:?} vs {want:?}"
+            );
+        }
+    }
+    // Grey: the paper is white, the slab clear.
+    let g = at(16);
+    assert!(
+        g.iter().max().unwrap() - g.iter().min().unwrap() <= 1,
+        "{g:?}"
+    );
+}
+
+#[test]
+fn preview_shows_the_lights_mirror_image_only_where_the_layer_reflects() {
+    // The light's mirror image lies where the normal bisects the light and
+    // the view, 22.5° towards the upper left: pixel (80, 80) of the first
+    // sphere. A clear binder of index 1.5 reflects ~4 % there, which the
+    // 3° disc makes far brighter than white; a binder of index 1 nothing.
+    use inksim::output::render::Canvas;
+    let highlight = |binder: f64| {
+        let dir = tempfile::tempdir().unwrap();
+        slab_scene(dir.path(), binder, 4)
+            .outputs(&["preview"])
+            .run(dir.path());
+        let png = std::fs::read(dir.path().join("slab-preview.png")).unwrap();
+        Canvas::decode_png(&png)
+            .unwrap()
+            .get(16 + 80, 16 + 80)
+            .unwrap()
+    };
+    assert_eq!(highlight(1.5), [255; 3]);
+    let none = highlight(1.0);
+    assert!(none.iter().all(|&c| c < 250), "{none:?}");
+}
+
+#[test]
 fn merl_export_stays_bounded_at_grazing_angles() {
     // The BRDF is the table's density over its coverage, finite up to the
     // horizon: no bin at grazing angles may exceed the largest value seen

@@ -956,3 +956,74 @@ fn the_effects_table_takes_the_declared_steps_and_unknown_labels_are_refused() {
         assert!(!ok && err.contains(needle), "{err}");
     }
 }
+
+#[test]
+fn each_grid_picture_has_a_de00_heat_map_to_its_reference_cell() {
+    use inksim::optics::colour::{delta_e2000, delta_e2000_se};
+    use inksim::study::merge::de00_maps;
+    let dir = tempfile::tempdir().unwrap();
+    // Two realisations, so the colours carry standard errors; an absolute
+    // output folder, so this process finds what the run wrote.
+    let out = dir.path().join("out");
+    let study = sweep()
+        .profile_key("quick", "realisations", 2)
+        .set("study.output_dir", out.to_str().unwrap());
+    let p = write(dir.path(), "sweep.toml", &study.toml());
+    let (ok, _, err) = inksim_in(dir.path(), &["run", p.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let study = Study::load(&p).unwrap();
+    let exp = study.expand(None).unwrap();
+    let maps = de00_maps(&study, &exp).unwrap();
+    let grids = out.join("quick/grids");
+    assert_eq!(maps.len(), study.grids.len());
+    let colour = |name: &str| {
+        let path = out.join(format!("quick/variants/{name}.h5"));
+        let (records, _, _) = inksim::output::h5::read_measured(&path).unwrap().unwrap();
+        records.into_iter().find(|m| m.geometry == "45/0").unwrap()
+    };
+    for m in &maps {
+        // The merge wrote the heat map beside its grid.
+        assert_eq!(m.file, m.grid_file.replace(".png", "-de00.png"));
+        assert!(grids.join(&m.grid_file).is_file(), "{}", m.grid_file);
+        let png = std::fs::read(grids.join(&m.file)).unwrap();
+        let c = inksim::output::render::canvas::Canvas::decode_png(&png).unwrap();
+        assert!(c.w > 300 && c.h > 150, "{} × {}", c.w, c.h);
+        // The reference is the first row and column, at 0.
+        assert_eq!(m.reference, (0, 0));
+        assert_eq!((m.rows.len(), m.cols.len()), (2, 2));
+        let r = m.cells[0][0].as_ref().unwrap();
+        assert_eq!((r.de00, r.se), (0.0, None));
+        let rc = colour(&r.variant);
+        for (i, line) in m.cells.iter().enumerate() {
+            for (j, cell) in line.iter().enumerate() {
+                let cell = cell.as_ref().unwrap();
+                let own = colour(&cell.variant);
+                assert_eq!(cell.lab, own.lab);
+                // The picture's ΔE00 is the colour module's, of the two
+                // colours read independently from the result files.
+                assert_eq!(cell.de00, delta_e2000(rc.lab, own.lab), "{i} {j}");
+                if (i, j) != (0, 0) {
+                    assert!(cell.de00 > 0.0);
+                    let se =
+                        delta_e2000_se(rc.lab, rc.lab_se.unwrap(), own.lab, own.lab_se.unwrap());
+                    assert_eq!(cell.se, Some(se));
+                    assert!(se > 0.0);
+                    assert_eq!(cell.near_zero(), cell.de00 <= 2.0 * se);
+                }
+                // The colour bar covers every value.
+                assert!(m.scale.lo <= cell.de00 && cell.de00 <= m.scale.hi);
+            }
+        }
+        assert_eq!(m.scale.lo, 0.0);
+        // summary.html shows the heat map right after its grid.
+        let html = std::fs::read_to_string(out.join("quick/summary.html")).unwrap();
+        let g = html
+            .find(&format!("src=\"grids/{}\"", m.grid_file))
+            .unwrap();
+        let h = html.find(&format!("src=\"grids/{}\"", m.file)).unwrap();
+        // No other picture between them (only the heat map's own <img).
+        assert!(g < h && html[g..h].matches("<img").count() == 1, "{html}");
+        let md = std::fs::read_to_string(out.join("quick/summary.md")).unwrap();
+        assert!(md.contains(&format!("(grids/{})", m.file)), "{md}");
+    }
+}

@@ -154,6 +154,9 @@ fn print_merge(r: &inksim::study::merge::MergeReport) {
     for g in &r.grids {
         println!("grid: {}", g.display());
     }
+    for m in &r.de00_maps {
+        println!("ΔE00 map: {}", m.display());
+    }
     for p in &r.plots {
         println!("plot: {}", p.display());
     }

@@ -373,6 +373,9 @@ pub struct Products {
     pub tile: bool,
     /// The BRDF exported in MERL's binary format (RGB, isotropic).
     pub merl: bool,
+    /// A rendered preview: a sphere of layer + substrate under one light
+    /// and a white sky (`<name>-preview.png`).
+    pub preview: bool,
 }
 
 /// How the far field becomes appearance.

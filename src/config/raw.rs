@@ -323,6 +323,7 @@ pub enum RawProduct {
     Btdf,
     Tile,
     Merl,
+    Preview,
 }
 
 /// `{ kind = "paper", albedo = 0.9 }` or `{ kind = "none" }`.

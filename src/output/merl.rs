@@ -100,54 +100,80 @@ fn directions(ih: usize, id: usize, ip: usize) -> ([f64; 3], [f64; 3]) {
     (wi, wo)
 }
 
-/// The MERL binary file of an appearance result.
-pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
-    let sp = &a.spec;
-    let (nl, ni) = (sp.wavelengths_nm.len(), sp.illumination_deg.len());
-    if ni == 0 || nl == 0 {
-        return Err(MerlError::NoData);
-    }
-    let obs = Observer::cie1931_d65();
-    let w = channel_weights(&obs, &sp.wavelengths_nm)?;
-    let nt = sp.table.n();
-    // RGB density tables per illumination angle.
-    let tab = &a.brdf_table.mean;
-    let mut rgb_tab = vec![[0.0f64; 3]; ni * nt * nt];
-    for i in 0..ni {
-        for k in 0..nt * nt {
-            let (j, q) = (k / nt, k % nt);
-            let mut c = [0.0; 3];
-            for (l, wl) in w.iter().enumerate() {
-                let d = tab[[l, i, j, q]];
-                for ch in 0..3 {
-                    c[ch] += wl[ch] * d;
-                }
-            }
-            rgb_tab[i * nt * nt + k] = c;
+/// The diffuse BRDF of layer + substrate in linear sRGB (D65, white
+/// balanced), at any pair of directions: what the MERL table samples and
+/// the preview renders (the approximations of the module docs).
+pub struct RgbBrdf<'a> {
+    a: &'a Appearance,
+    /// Linear sRGB weights of each wavelength.
+    w: Vec<[f64; 3]>,
+    /// RGB density tables, (illumination, j, i) flattened.
+    rgb_tab: Vec<[f64; 3]>,
+    /// Node coverage (share of each node's kernel above the horizon).
+    coverage: Vec<f64>,
+    /// Paper factor per wavelength, `albedo / (π (1 − albedo r_dd↑))`.
+    paper: Option<Vec<f64>>,
+}
+
+impl<'a> RgbBrdf<'a> {
+    pub fn new(a: &'a Appearance) -> Result<Self, MerlError> {
+        let sp = &a.spec;
+        let (nl, ni) = (sp.wavelengths_nm.len(), sp.illumination_deg.len());
+        if ni == 0 || nl == 0 {
+            return Err(MerlError::NoData);
         }
+        let obs = Observer::cie1931_d65();
+        let w = channel_weights(&obs, &sp.wavelengths_nm)?;
+        let nt = sp.table.n();
+        let tab = &a.brdf_table.mean;
+        let mut rgb_tab = vec![[0.0f64; 3]; ni * nt * nt];
+        for i in 0..ni {
+            for k in 0..nt * nt {
+                let (j, q) = (k / nt, k % nt);
+                let mut c = [0.0; 3];
+                for (l, wl) in w.iter().enumerate() {
+                    let d = tab[[l, i, j, q]];
+                    for ch in 0..3 {
+                        c[ch] += wl[ch] * d;
+                    }
+                }
+                rgb_tab[i * nt * nt + k] = c;
+            }
+        }
+        let paper: Option<Vec<f64>> = a.paper.as_ref().map(|p| {
+            (0..nl)
+                .map(|l| p.albedo / (PI * (1.0 - p.albedo * p.r_dd_up.mean[l])))
+                .collect()
+        });
+        let coverage: Vec<f64> = (0..nt * nt)
+            .map(|k| table::node_coverage(sp.table, k % nt, k / nt))
+            .collect();
+        Ok(RgbBrdf {
+            a,
+            w,
+            rgb_tab,
+            coverage,
+            paper,
+        })
     }
-    // Transmittance from above versus polar angle, for the paper term.
-    let t_of = |l: usize, theta: f64| {
+
+    /// Transmittance from above at polar angle `theta` (deg), wavelength `l`.
+    fn t_of(&self, l: usize, theta: f64) -> f64 {
+        let sp = &self.a.spec;
         let (k, f) = bracket(&sp.above_deg, theta);
-        let t = &a.transmittance.mean;
+        let t = &self.a.transmittance.mean;
         if sp.above_deg.len() == 1 {
             t[[l, 0]]
         } else {
             t[[l, k]] * (1.0 - f) + t[[l, k + 1]] * f
         }
-    };
-    let paper: Option<Vec<f64>> = a.paper.as_ref().map(|p| {
-        (0..nl)
-            .map(|l| p.albedo / (PI * (1.0 - p.albedo * p.r_dd_up.mean[l])))
-            .collect()
-    });
-    let (cell, half) = (sp.table.cell, sp.table.half as f64);
-    // Node coverage (share of each node's kernel above the horizon): the
-    // BRDF is the density over it (optics::farfield::table).
-    let coverage: Vec<f64> = (0..nt * nt)
-        .map(|k| table::node_coverage(sp.table, k % nt, k / nt))
-        .collect();
-    let density = |i: usize, sx: f64, sy: f64| -> [f64; 3] {
+    }
+
+    /// RGB density of illumination angle `i` at projected direction (sx, sy).
+    fn density(&self, i: usize, sx: f64, sy: f64) -> [f64; 3] {
+        let sp = &self.a.spec;
+        let nt = sp.table.n();
+        let (cell, half) = (sp.table.cell, sp.table.half as f64);
         let (x, y) = (sx / cell + half, sy / cell + half);
         let max = (nt - 1) as f64;
         if !(x >= 0.0 && y >= 0.0 && x <= max && y <= max) {
@@ -166,21 +192,89 @@ pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
         ];
         let cov: f64 = w
             .iter()
-            .map(|&(jj, qq, wt)| coverage[jj * nt + qq] * wt)
+            .map(|&(jj, qq, wt)| self.coverage[jj * nt + qq] * wt)
             .sum();
         if cov <= 0.0 {
             return [0.0; 3];
         }
         std::array::from_fn(|ch| {
             w.iter()
-                .map(|&(jj, qq, wt)| rgb_tab[i * nt * nt + jj * nt + qq][ch] * wt)
+                .map(|&(jj, qq, wt)| self.rgb_tab[i * nt * nt + jj * nt + qq][ch] * wt)
                 .sum::<f64>()
                 / cov
         })
-    };
+    }
+
+    /// The diffuse BRDF (1/sr, linear sRGB) for light arriving from unit
+    /// direction `wi` (towards the light) seen from `wo` (towards the
+    /// viewer), both in the layer's frame (z the normal); 0 below the
+    /// horizon.
+    pub fn eval(&self, wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
+        if wi[2] <= 0.0 || wo[2] <= 0.0 {
+            return [0.0; 3];
+        }
+        let sp = &self.a.spec;
+        let ni = sp.illumination_deg.len();
+        let az = sp.azimuth_deg.to_radians();
+        let theta_i = wi[2].min(1.0).acos().to_degrees();
+        let theta_o = wo[2].min(1.0).acos().to_degrees();
+        // Light travels along −wi; rotate so it travels along the solved
+        // azimuth `az`; the viewer's lateral direction follows.
+        let phi_travel = (-wi[1]).atan2(-wi[0]);
+        let rot = az - phi_travel;
+        let (s, c) = rot.sin_cos();
+        let (sx, sy) = (c * wo[0] - s * wo[1], s * wo[0] + c * wo[1]);
+        let (k, f) = bracket(&sp.illumination_deg, theta_i);
+        let d0 = self.density(k, sx, sy);
+        let d1 = if ni > 1 {
+            self.density(k + 1, sx, sy)
+        } else {
+            d0
+        };
+        let mut rgb = [0.0; 3];
+        for ch in 0..3 {
+            rgb[ch] = d0[ch] * (1.0 - f) + d1[ch] * f;
+        }
+        if let Some(pk) = &self.paper {
+            for (l, wl) in self.w.iter().enumerate() {
+                let v = pk[l] * self.t_of(l, theta_i) * self.t_of(l, theta_o);
+                for ch in 0..3 {
+                    rgb[ch] += wl[ch] * v;
+                }
+            }
+        }
+        rgb
+    }
+
+    /// The specular (0,0) order's reflectance at polar angle `theta` (deg),
+    /// coherent plus incoherent, linear sRGB; interpolated between the
+    /// angles solved from above, held beyond them.
+    pub fn specular(&self, theta: f64) -> [f64; 3] {
+        let sp = &self.a.spec;
+        let (k, f) = bracket(&sp.above_deg, theta);
+        let r = |l: usize, a: usize| {
+            self.a.specular_coherent[[l, a]] + self.a.specular_incoherent[[l, a]]
+        };
+        let mut rgb = [0.0; 3];
+        for (l, wl) in self.w.iter().enumerate() {
+            let v = if sp.above_deg.len() == 1 {
+                r(l, 0)
+            } else {
+                r(l, k) * (1.0 - f) + r(l, k + 1) * f
+            };
+            for ch in 0..3 {
+                rgb[ch] += wl[ch] * v;
+            }
+        }
+        rgb
+    }
+}
+
+/// The MERL binary file of an appearance result.
+pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
+    let brdf = RgbBrdf::new(a)?;
     let n = N_TH * N_TD * N_PD;
     let mut out = vec![0.0f64; 3 * n];
-    let az = sp.azimuth_deg.to_radians();
     for ih in 0..N_TH {
         for id in 0..N_TD {
             for ip in 0..N_PD {
@@ -188,29 +282,7 @@ pub fn encode(a: &Appearance) -> Result<Vec<u8>, MerlError> {
                 if wi[2] <= 0.0 || wo[2] <= 0.0 {
                     continue;
                 }
-                let theta_i = wi[2].min(1.0).acos().to_degrees();
-                let theta_o = wo[2].min(1.0).acos().to_degrees();
-                // Light travels along −wi; rotate so it travels along the
-                // solved azimuth `az`; the viewer's lateral direction follows.
-                let phi_travel = (-wi[1]).atan2(-wi[0]);
-                let rot = az - phi_travel;
-                let (s, c) = rot.sin_cos();
-                let (sx, sy) = (c * wo[0] - s * wo[1], s * wo[0] + c * wo[1]);
-                let (k, f) = bracket(&sp.illumination_deg, theta_i);
-                let d0 = density(k, sx, sy);
-                let d1 = if ni > 1 { density(k + 1, sx, sy) } else { d0 };
-                let mut rgb = [0.0; 3];
-                for ch in 0..3 {
-                    rgb[ch] = d0[ch] * (1.0 - f) + d1[ch] * f;
-                }
-                if let Some(pk) = &paper {
-                    for l in 0..nl {
-                        let v = pk[l] * t_of(l, theta_i) * t_of(l, theta_o);
-                        for ch in 0..3 {
-                            rgb[ch] += w[l][ch] * v;
-                        }
-                    }
-                }
+                let rgb = brdf.eval(wi, wo);
                 let idx = ip + N_PD * (id + N_TD * ih);
                 for ch in 0..3 {
                     out[ch * n + idx] = rgb[ch].max(0.0) / SCALE[ch];

@@ -3,7 +3,9 @@
 //! - [`h5`]: result and summary files, written atomically;
 //! - [`render`]: PNG pictures (tile, orders, geometry);
 //! - [`lock`]: one writer per result (an OS file lock per output);
-//! - [`merl`]: the BRDF in MERL's binary format for renderers;
+//! - [`merl`]: the BRDF in MERL's binary format for renderers (and
+//!   [`merl::RgbBrdf`], that BRDF in RGB at any pair of directions, which
+//!   `render`'s preview shades a sphere with);
 //! - [`progress`]: timestamped progress lines on long work.
 //!
 //! Imports from every earlier stage (`config` … `optics`), never from

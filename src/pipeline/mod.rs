@@ -123,13 +123,16 @@ pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
     if orders {
         files.push(d.join(format!("{name}-orders.png")));
     }
-    if p.brdf || p.btdf || p.tile || p.merl {
+    if p.brdf || p.btdf || p.tile || p.merl || p.preview {
         for suffix in PLOTS {
             files.push(d.join(format!("{name}-{suffix}.png")));
         }
     }
     if p.merl {
         files.push(d.join(format!("{name}.binary")));
+    }
+    if p.preview {
+        files.push(d.join(format!("{name}-preview.png")));
     }
     files
 }

@@ -52,7 +52,9 @@ impl RunPlan {
         let explicit = scene.structure.is_some();
         let (above, extra) = above_angles(scene);
         let paper = matches!(scene.substrate, Substrate::Paper { .. });
-        let below = (scene.appearance.products.tile && paper)
+        // The paper term: for the tile's colours and the preview.
+        let products = scene.appearance.products;
+        let below = ((products.tile || products.preview) && paper)
             .then(|| Hemisphere::new(scene.appearance.quadrature_points));
         let shortcut = if scene.is_molecular() || explicit {
             None
@@ -233,7 +235,7 @@ fn solve_lines(
         lines.push("solves from below: skipped — no substrate".to_string());
     } else {
         lines.push(
-            "solves from below: skipped — no tile requested, nothing uses the paper term"
+            "solves from below: skipped — no tile or preview requested, nothing uses the paper term"
                 .to_string(),
         );
     }
@@ -291,6 +293,9 @@ fn product_lines(scene: &Scene) -> Vec<String> {
     ];
     if products.merl {
         lines.push("MERL export: written beside the result (approximation: see docs)".to_string());
+    }
+    if products.preview {
+        lines.push("preview: a rendered sphere, <name>-preview.png".to_string());
     }
     lines
 }

@@ -182,7 +182,8 @@ fn assemble_products(
         .collect();
     let orders_png = render::diffuse_brdf_png(&above, &scene.output.name)?;
     let products = scene.appearance.products;
-    let wants_appearance = products.brdf || products.btdf || products.tile || products.merl;
+    let wants_appearance =
+        products.brdf || products.btdf || products.tile || products.merl || products.preview;
     let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
     let appearance = if wants_appearance {
         Some(appearance::assemble(
@@ -231,6 +232,15 @@ fn assemble_products(
                 .dir
                 .join(format!("{}.binary", scene.output.name)),
             &merl,
+        )?;
+    }
+    if let (Some(a), true) = (appearance.as_ref(), products.preview) {
+        atomic::write_atomic(
+            &scene
+                .output
+                .dir
+                .join(format!("{}-preview.png", scene.output.name)),
+            &render::preview_png(a, &scene.output.name)?,
         )?;
     }
     Ok(RunProducts {

@@ -40,6 +40,7 @@ impl Checker<'_> {
                 RawProduct::Btdf => products.btdf = true,
                 RawProduct::Tile => products.tile = true,
                 RawProduct::Merl => products.merl = true,
+                RawProduct::Preview => products.preview = true,
             }
         }
         let brdf_cell = match raw.and_then(|a| a.brdf_cell) {

@@ -52,6 +52,7 @@ pub mod canvas;
 mod colour_bar;
 mod geometry;
 pub mod plot;
+mod preview;
 mod spectra;
 pub mod tile;
 
@@ -61,6 +62,7 @@ pub use canvas::{text_width, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
 use colour_bar::colour_bar;
 pub use colour_bar::superscript;
 pub use geometry::geometry_png;
+pub use preview::preview_png;
 pub use spectra::spectra_png;
 
 /// Radius of a panel's disk of directions, in pixels.
@@ -108,6 +110,8 @@ pub enum RenderError {
     Decode(#[from] png::DecodingError),
     #[error("render: unsupported PNG ({0}); need 8-bit RGB or RGBA")]
     Format(String),
+    #[error("render: preview: {0}")]
+    Preview(String),
 }
 
 /// Where the panels of a picture lie; computed from the entries alone.

@@ -32,12 +32,28 @@ fn axis_labels(study: &Study, axis: &str, only: &Option<Vec<String>>) -> Vec<Str
     }
 }
 
-/// The pictures of one grid declaration: (file name, title, canvas).
-pub(super) fn draw_grid(
+/// One picture of a grid declaration: its name, title, labels and the
+/// variant of each cell (the same for the grid and its ΔE00 heat map).
+pub(super) struct GridPicture<'a> {
+    /// File name without extension: `<grid>[__<axis>-<label>…]`.
+    pub stem: String,
+    pub title: String,
+    /// The axes of the rows and the columns.
+    pub rows_axis: String,
+    pub cols_axis: String,
+    pub rows: Vec<String>,
+    pub cols: Vec<String>,
+    /// `cells[row][col]`: the variant there, if any.
+    pub cells: Vec<Vec<Option<&'a Variant>>>,
+}
+
+/// The pictures of one grid declaration, one per combination of the labels
+/// of the split axes among the variants that fit it, in expansion order.
+pub(super) fn pictures<'a>(
     study: &Study,
-    exp: &Expansion,
+    exp: &'a Expansion,
     g: &GridDecl,
-) -> Result<Vec<(String, String, Canvas)>, StudyError> {
+) -> Vec<GridPicture<'a>> {
     let split: Vec<&str> = study
         .axes
         .iter()
@@ -87,28 +103,10 @@ pub(super) fn draw_grid(
                         .all(|(a, l)| v.label(a) == l.as_deref())
             })
         };
-        let mut tiles: Vec<Vec<Option<Canvas>>> = vec![];
-        for r in &rows {
-            let mut line = vec![];
-            for c in &cols {
-                line.push(match cell(r, c) {
-                    Some(v) => Some(match colour_card(v)? {
-                        Some(card) => card,
-                        None => {
-                            let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
-                                StudyError::Io(h5::IoError::File {
-                                    path: run::paths(v).1,
-                                    source,
-                                })
-                            })?;
-                            shrink(&Canvas::decode_png(&bytes)?, CELL_PX)
-                        }
-                    }),
-                    None => None,
-                });
-            }
-            tiles.push(line);
-        }
+        let cells = rows
+            .iter()
+            .map(|r| cols.iter().map(|c| cell(r, c)).collect())
+            .collect();
         let mut fixed: Vec<String> = g.where_.iter().map(|(a, l)| format!("{a} {l}")).collect();
         let mut suffix = String::new();
         for (a, l) in split.iter().zip(&combo) {
@@ -127,13 +125,56 @@ pub(super) fn draw_grid(
                 format!(" ({})", fixed.join(", "))
             }
         );
+        out.push(GridPicture {
+            stem: format!("{}{suffix}", g.name),
+            title,
+            rows_axis: g.rows.clone(),
+            cols_axis: g.cols.clone(),
+            rows: rows.clone(),
+            cols: cols.clone(),
+            cells,
+        });
+    }
+    out
+}
+
+/// The pictures of one grid declaration: (file name, title, canvas).
+pub(super) fn draw_grid(
+    study: &Study,
+    exp: &Expansion,
+    g: &GridDecl,
+) -> Result<Vec<(String, String, Canvas)>, StudyError> {
+    let mut out = vec![];
+    for pic in pictures(study, exp, g) {
+        let mut tiles: Vec<Vec<Option<Canvas>>> = vec![];
+        for line_cells in &pic.cells {
+            let mut line = vec![];
+            for cell in line_cells {
+                line.push(match cell {
+                    Some(v) => Some(match colour_card(v)? {
+                        Some(card) => card,
+                        None => {
+                            let bytes = std::fs::read(run::paths(v).1).map_err(|source| {
+                                StudyError::Io(h5::IoError::File {
+                                    path: run::paths(v).1,
+                                    source,
+                                })
+                            })?;
+                            shrink(&Canvas::decode_png(&bytes)?, CELL_PX)
+                        }
+                    }),
+                    None => None,
+                });
+            }
+            tiles.push(line);
+        }
         let subtitle = format!(
             "rows: {}, columns: {}; cells: {CARD_GEOMETRY} colour ± s.e.; \
              corner mark: outside sRGB (C*ab reduced for display)",
-            g.rows, g.cols
+            pic.rows_axis, pic.cols_axis
         );
-        let canvas = compose(&title, &subtitle, &rows, &cols, &tiles);
-        out.push((format!("{}{suffix}.png", g.name), title, canvas));
+        let canvas = compose(&pic.title, &subtitle, &pic.rows, &pic.cols, &tiles);
+        out.push((format!("{}.png", pic.stem), pic.title, canvas));
     }
     Ok(out)
 }

@@ -35,10 +35,17 @@ pub(super) fn page(p: &PageInput) -> String {
         md += &table(&head, &rows);
         md += "\n";
     }
-    for (h, files) in [("Plots", p.plots), ("Comparison grids", p.grids)] {
-        let _ = writeln!(md, "## {h}\n");
-        for f in files {
-            let _ = writeln!(md, "![{0}]({0})\n", p.rel(f));
+    md += "## Plots\n\n";
+    for f in p.plots {
+        let _ = writeln!(md, "![{0}]({0})\n", p.rel(f));
+    }
+    md += "## Comparison grids\n\nEach grid of colours is followed by its ΔE00 heat map: \
+           the CIEDE2000 difference of every cell to the grid's reference cell ± its standard \
+           error, hatched and marked ≈ where it is within two standard errors of 0.\n\n";
+    for (k, f) in p.grids.iter().enumerate() {
+        let _ = writeln!(md, "![{0}]({0})\n", p.rel(f));
+        if let Some(Some(m)) = p.grid_maps.get(k) {
+            let _ = writeln!(md, "ΔE00 to the reference cell: ![{0}]({0})\n", p.rel(m));
         }
     }
     md += "## Variants\n\nR, T, A: mean total reflectance, transmittance and absorption over \

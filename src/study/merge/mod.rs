@@ -26,6 +26,11 @@
 //!   each cell is the variant's 45°/0° colour card (its tile, shrunk to at
 //!   most [`CELL_PX`] pixels, where the result has no measured colour), with
 //!   row and column labels; an empty cell is grey with a dash.
+//! - `grids/<grid>[__<axis>-<label>…]-de00.png`: beside each grid picture
+//!   with measured colours, a heat map of the CIEDE2000 difference of every
+//!   cell to the grid's reference cell (the first row and column), ± its
+//!   standard error, cells within two standard errors of 0 hatched
+//!   ([`de00`]).
 //! - `plots/<axis>[__<axis>-<label>…].png`: L* and C*ab against each axis
 //!   ([`plots`]).
 //! - `summary.md` and `summary.html`: facts of the run, the effects table
@@ -35,13 +40,14 @@
 //! Merge refuses to run until every variant is finished, and lists what is
 //! missing and why.
 //!
-//! - `grid`: the comparison-grid pictures.
+//! - `grid`: the comparison-grid pictures; `de00` their ΔE00 heat maps.
 //! - `plots`: the study plots.
 //! - `effects`: the effects table's numbers.
 //! - `summary_h5`: the summary HDF5 file; `summary_values` its typed axis
 //!   values and measured colours.
 //! - `page`, `markdown`: the HTML and Markdown pages.
 
+mod de00;
 mod effects;
 mod grid;
 mod markdown;
@@ -50,6 +56,7 @@ mod plots;
 mod summary_h5;
 mod summary_values;
 
+pub use de00::{de00_maps, draw as draw_de00_map, De00Cell, De00Map};
 pub use grid::{shrink, CELL_PX};
 
 use super::run::{self, State};
@@ -66,6 +73,9 @@ pub struct MergeReport {
     pub summary_md: PathBuf,
     pub summary_html: PathBuf,
     pub grids: Vec<PathBuf>,
+    /// The ΔE00 heat map of each grid picture (`grids/…-de00.png`), in the
+    /// order of `grids`, where the picture has measured colours.
+    pub de00_maps: Vec<PathBuf>,
     /// L* and C*ab against each axis (`plots/`).
     pub plots: Vec<PathBuf>,
 }
@@ -170,6 +180,20 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             grids.push(p);
         }
     }
+    // Each grid picture's heat map, by the grid picture it belongs to.
+    let mut grid_maps: Vec<Option<PathBuf>> = vec![None; grids.len()];
+    let mut de00_maps = vec![];
+    for m in de00::de00_maps(study, exp)? {
+        let p = grids_dir.join(&m.file);
+        atomic::write_atomic(&p, &de00::draw(&m).encode_png(&m.title)?)?;
+        if let Some(k) = grids
+            .iter()
+            .position(|g| *g == grids_dir.join(&m.grid_file))
+        {
+            grid_maps[k] = Some(p.clone());
+        }
+        de00_maps.push(p);
+    }
     let plots_dir = dir.join("plots");
     let mut plots = vec![];
     let profile = exp.profile.as_deref().unwrap_or("");
@@ -190,6 +214,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
         rows: &rows,
         effects: &effects,
         grids: &grids,
+        grid_maps: &grid_maps,
         plots: &plots,
         unix_s,
     };
@@ -203,6 +228,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
         summary_md,
         summary_html,
         grids,
+        de00_maps,
         plots,
     })
 }

@@ -1,6 +1,7 @@
 //! `summary.html`: what was run (inksim version, date, sweep file, profile
 //! and its settings, colour conditions), the effects table, the study plots
-//! and the comparison grids scaled to the page, the table of the variants
+//! and the comparison grids scaled to the page, each followed by its ΔE00
+//! heat map, the table of the variants
 //! (labels, R, T, A, L*, C*ab, h° ± s.e., a swatch) and links to every
 //! result file. Every link is relative to the study folder and names a file
 //! that exists when the page is written. `summary.md` (see [`markdown`])
@@ -21,6 +22,8 @@ pub(super) struct PageInput<'a> {
     pub rows: &'a [Row<'a>],
     pub effects: &'a [Effect],
     pub grids: &'a [PathBuf],
+    /// The ΔE00 heat map of each grid picture, parallel to `grids`.
+    pub grid_maps: &'a [Option<PathBuf>],
     pub plots: &'a [PathBuf],
     /// Seconds since 1970-01-01 UTC of the merge.
     pub unix_s: u64,
@@ -100,7 +103,7 @@ impl PageInput<'_> {
         let (h5, tile) = run::paths(v);
         let dir = h5.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut files = vec![("h5".to_string(), h5), ("tile".to_string(), tile)];
-        for what in ["orders", "spectra", "brdf-plane", "brdf-polar"] {
+        for what in ["orders", "spectra", "brdf-plane", "brdf-polar", "preview"] {
             files.push((what.into(), dir.join(format!("{}-{what}.png", v.name))));
         }
         files
@@ -223,21 +226,29 @@ pub(super) fn html_page(p: &PageInput) -> String {
         }
         body += "</table>\n";
     }
-    for (h, files, class) in [
-        ("Plots", p.plots, "pics"),
-        ("Comparison grids", p.grids, "pics wide"),
-    ] {
-        let _ = writeln!(body, "<h2>{h}</h2>\n<div class=\"{class}\">");
-        for f in files {
-            let r = e(&p.rel(f));
-            let _ = writeln!(
-                body,
-                "<figure><a href=\"{r}\"><img src=\"{r}\" alt=\"{r}\"></a>\
-                 <figcaption>{r}</figcaption></figure>"
-            );
-        }
-        body += "</div>\n";
+    let figure = |f: &Path, caption: &str| {
+        let r = e(&p.rel(f));
+        format!(
+            "<figure><a href=\"{r}\"><img src=\"{r}\" alt=\"{r}\"></a>\
+             <figcaption>{caption}<a href=\"{r}\">{r}</a></figcaption></figure>\n"
+        )
+    };
+    body += "<h2>Plots</h2>\n<div class=\"pics\">\n";
+    for f in p.plots {
+        body += &figure(f, "");
     }
+    body += "</div>\n<h2>Comparison grids</h2>\n<p>Each grid of colours is followed by its \
+             ΔE00 heat map: the CIEDE2000 difference of every cell to the grid's reference \
+             cell ± its standard error, hatched and marked ≈ where it is within two standard \
+             errors of 0 — differences an sRGB patch cannot show.</p>\n\
+             <div class=\"pics wide\">\n";
+    for (k, f) in p.grids.iter().enumerate() {
+        body += &figure(f, "");
+        if let Some(Some(m)) = p.grid_maps.get(k) {
+            body += &figure(m, "ΔE00 to the reference cell: ");
+        }
+    }
+    body += "</div>\n";
     body += &variants_html(p);
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\

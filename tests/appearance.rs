@@ -420,6 +420,68 @@ fn preview_of_bare_paper_shows_its_albedo_beside_the_white_diffuser() {
 }
 
 #[test]
+fn preview_has_the_tiles_colour_where_the_solved_wavelengths_miss_the_band() {
+    // A dye absorbing in a band at 550 nm, solved at 450 and 650 nm only:
+    // the solved wavelengths see no absorption (linear weights would render
+    // it grey), the tile's colour carries the band through the spectral
+    // proxy (magenta). Viewed at 60°, the tile's one viewing angle, the
+    // sphere's side away from the light is lit by the sky alone (radiance
+    // 0.25 for white): there the preview must show 0.25 × the tile's sky
+    // colour. Where it faces the viewer, lit by the light too, it is magenta.
+    use inksim::optics::colour::{encode_srgb8, gamut, lab_to_lch, Observer};
+    use inksim::output::render::Canvas;
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from("wavelength_nm,n,k\n");
+    for wl in (380..=780).step_by(5) {
+        let k = 0.4 * (-((wl as f64 - 550.0) / 30.0).powi(2)).exp();
+        text.push_str(&format!("{wl},1.5,{k}\n"));
+    }
+    std::fs::write(dir.path().join("dye.csv"), text).unwrap();
+    let rep = SceneToml::slab()
+        .seed(3)
+        .fragment_nm(1000.0)
+        .binder_index(1.5)
+        .pigment(PigmentToml::csv("dye", "dye.csv").pvc(0.3).molecular())
+        .cell_nm(50.0)
+        .wavelengths_nm(&[450.0, 650.0])
+        .polar_deg(&[0.0, 20.0, 40.0, 60.0])
+        .viewing_deg(&[60.0])
+        .quadrature_points(4)
+        .paper(0.9)
+        .outputs(&["preview"])
+        .output(dir.path(), "dye")
+        .run(dir.path());
+    let a = rep.appearance.unwrap();
+    let lab = a.colours.as_ref().unwrap().natural_lab[0];
+    let [_, chroma, hue] = lab_to_lch(lab);
+    assert!(chroma > 20.0 && !(60.0..=300.0).contains(&hue), "{lab:?}");
+    let (ill, std_obs) = a.colour_conditions.unwrap();
+    let obs = Observer::standard(ill, std_obs);
+    let target = gamut::lab_to_linear_srgb(&obs, gamut::map_lab(&obs, lab).lab);
+    let png = std::fs::read(dir.path().join("dye-preview.png")).unwrap();
+    assert!(
+        !dir.path().join("dye.png").exists(),
+        "no tile was asked for"
+    );
+    let c = Canvas::decode_png(&png).unwrap();
+    // The normal at θo = 60° towards the lower right, (0.61, −0.61, 0.5),
+    // faces away from the light: pixel (177, 177) of the first sphere.
+    let shadow = c.get(16 + 177, 16 + 177).unwrap();
+    let want = encode_srgb8(target.map(|v| 0.25 * v));
+    for ch in 0..3 {
+        assert!(
+            (shadow[ch] as i32 - want[ch] as i32).abs() <= 3,
+            "preview {shadow:?} vs tile × 0.25 {want:?}"
+        );
+    }
+    let front = c.get(16 + 110, 16 + 110).unwrap();
+    assert!(
+        front[1] as i32 + 60 < front[0].min(front[2]) as i32,
+        "{front:?}"
+    );
+}
+
+#[test]
 fn preview_shows_the_lights_mirror_image_only_where_the_layer_reflects() {
     // The light's mirror image lies where the normal bisects the light and
     // the view, 22.5° towards the upper left: pixel (80, 80) of the first

@@ -25,7 +25,8 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         realisations: plan.realisations,
         deterministic: plan.analytic || scene.structure.is_some(),
         btdf: scene.appearance.products.btdf,
-        tile: scene.appearance.products.tile,
+        // The preview's colour is matched to the tile's (output::render::preview).
+        tile: scene.appearance.products.tile || scene.appearance.products.preview,
         proxy: spectral_proxy(scene),
         measurements: if scene.appearance.products.tile {
             scene.appearance.measurements.clone()

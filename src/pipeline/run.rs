@@ -194,12 +194,13 @@ fn assemble_products(
     } else {
         None
     };
+    // Colours are computed for the preview too; the tile is drawn when asked.
     let tile_png = match appearance.as_ref() {
         Some(
             a @ Appearance {
                 colours: Some(c), ..
             },
-        ) => Some(render::tile::tile_png(
+        ) if products.tile => Some(render::tile::tile_png(
             &c.tile_srgb8,
             &c.tile_lab,
             &a.spec.viewing_deg,
@@ -240,7 +241,7 @@ fn assemble_products(
                 .output
                 .dir
                 .join(format!("{}-preview.png", scene.output.name)),
-            &render::preview_png(a, &scene.output.name)?,
+            &render::preview_png(a, &obs, &scene.output.name)?,
         )?;
     }
     Ok(RunProducts {

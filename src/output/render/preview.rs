@@ -4,7 +4,8 @@
 //! (upper left) and a uniform white sky.
 //!
 //! The camera is orthographic. At each surface point the radiance (linear
-//! sRGB, D65, white balanced as in the MERL export) is
+//! sRGB, white balanced as in the MERL export, then matched to the tile's
+//! colour as below) is
 //! - the diffuse BRDF of layer + paper ([`RgbBrdf::eval`]) times the light's
 //!   irradiance times cos θi;
 //! - the sky: the directional-hemispherical reflectance of the diffuse BRDF
@@ -13,6 +14,18 @@
 //! - the specular (0,0) order's reflectance at θo times the sky's radiance,
 //!   and the light's mirror image: the light drawn as a disc of
 //!   [`LIGHT_RADIUS_DEG`] where the mirror direction falls inside it.
+//!
+//! **Colour.** The RGB BRDF weights the solved wavelengths linearly, so it
+//! misses the absorption bands between them that the tile's colour carries
+//! through the spectral proxy (a magenta of C*ab ≈ 100 on the tile renders
+//! pink from three wavelengths), and its specular order, a thin film's
+//! fringes sampled at a few wavelengths, can be strongly coloured where the
+//! fine spectrum averages them out. The layer's reflection (diffuse and
+//! specular) is therefore scaled per channel so that its colour under the
+//! sky alone, at the first viewing angle, is the tile's sky colour there
+//! (gamut mapped as the tile draws it): gain = tile / (diffuse + specular),
+//! within [[`GAIN_MIN`], [`GAIN_MAX`]]. The caption gives the gains. Without a tile
+//! colour (no paper term) the BRDF is drawn as it is and the caption says so.
 //!
 //! The light and sky are scaled so that the white diffuser facing the light
 //! has radiance 1 (0.75 from the light, 0.25 from the sky); values above 1
@@ -27,7 +40,7 @@ use std::f64::consts::PI;
 use super::canvas::{wrap, Canvas, GLYPH_HEIGHT, SMALL_HEIGHT};
 use super::RenderError;
 use crate::optics::appearance::Appearance;
-use crate::optics::colour::encode_srgb8;
+use crate::optics::colour::{encode_srgb8, gamut, Observer};
 use crate::output::merl::{MerlError, RgbBrdf};
 
 /// Diameter of a sphere, pixels.
@@ -43,6 +56,9 @@ const PAD: usize = 16;
 const INK: [u8; 3] = [20, 20, 20];
 /// Samples per pixel side (anti-aliasing of the outline).
 const SUPER: usize = 3;
+/// Range of the per-channel colour gains (module docs).
+pub const GAIN_MIN: f64 = 0.0;
+pub const GAIN_MAX: f64 = 20.0;
 
 /// Unit vector towards the light: 45° from the view direction (+z),
 /// from the upper left (x right, y up).
@@ -81,12 +97,15 @@ struct Layer<'a> {
     brdf: RgbBrdf<'a>,
     /// Directional-hemispherical reflectance at θo = 0°, 2°, …, 90°.
     sky: Vec<[f64; 3]>,
+    /// Per-channel gain of the reflection, `None` where no tile colour
+    /// was there to match (module docs).
+    gain: Option<[f64; 3]>,
 }
 
 const SKY_STEP_DEG: f64 = 2.0;
 
 impl<'a> Layer<'a> {
-    fn new(a: &'a Appearance) -> Result<Self, MerlError> {
+    fn new(a: &'a Appearance, obs: &Observer) -> Result<Self, MerlError> {
         let brdf = RgbBrdf::new(a)?;
         // Midpoint rule in μ = cos θi and in φ.
         let (nm, np) = (24, 48);
@@ -111,22 +130,57 @@ impl<'a> Layer<'a> {
                 acc.map(|v| v * w)
             })
             .collect();
-        Ok(Layer { brdf, sky })
+        let mut layer = Layer {
+            brdf,
+            sky,
+            gain: None,
+        };
+        layer.gain = layer.tile_gain(a, obs);
+        Ok(layer)
     }
-}
 
-impl Surface for Layer<'_> {
-    fn brdf(&self, wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
-        self.brdf.eval(wi, wo)
+    /// Gains that give the sky colour at the first viewing angle the tile's
+    /// colour (module docs).
+    fn tile_gain(&self, a: &Appearance, obs: &Observer) -> Option<[f64; 3]> {
+        let lab = *a.colours.as_ref()?.natural_lab.first()?;
+        let theta = *a.spec.viewing_deg.first()?;
+        let target = gamut::lab_to_linear_srgb(obs, gamut::map_lab(obs, lab).lab);
+        let (diffuse, spec) = (self.sky_diffuse(theta), self.brdf.specular(theta));
+        Some(std::array::from_fn(|ch| {
+            let solved = diffuse[ch] + spec[ch];
+            if solved > 1e-9 {
+                (target[ch] / solved).clamp(GAIN_MIN, GAIN_MAX)
+            } else {
+                1.0
+            }
+        }))
     }
-    fn sky(&self, theta_o_deg: f64) -> [f64; 3] {
+
+    /// Sky reflectance of the diffuse BRDF as solved (no gain).
+    fn sky_diffuse(&self, theta_o_deg: f64) -> [f64; 3] {
         let x = (theta_o_deg / SKY_STEP_DEG).clamp(0.0, (self.sky.len() - 1) as f64);
         let k = (x.floor() as usize).min(self.sky.len() - 2);
         let f = x - k as f64;
         std::array::from_fn(|ch| self.sky[k][ch] * (1.0 - f) + self.sky[k + 1][ch] * f)
     }
+
+    fn gain(&self) -> [f64; 3] {
+        self.gain.unwrap_or([1.0; 3])
+    }
+}
+
+impl Surface for Layer<'_> {
+    fn brdf(&self, wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
+        let (f, g) = (self.brdf.eval(wi, wo), self.gain());
+        std::array::from_fn(|ch| f[ch] * g[ch])
+    }
+    fn sky(&self, theta_o_deg: f64) -> [f64; 3] {
+        let (s, g) = (self.sky_diffuse(theta_o_deg), self.gain());
+        std::array::from_fn(|ch| s[ch] * g[ch])
+    }
     fn specular(&self, theta_o_deg: f64) -> [f64; 3] {
-        self.brdf.specular(theta_o_deg)
+        let (s, g) = (self.brdf.specular(theta_o_deg), self.gain());
+        std::array::from_fn(|ch| s[ch] * g[ch])
     }
 }
 
@@ -222,9 +276,10 @@ fn sphere(img: &mut Canvas, s: &dyn Surface, x0: usize, y0: usize) {
     }
 }
 
-/// The preview picture of an appearance result (module docs).
-pub fn preview_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
-    let layer = Layer::new(a).map_err(|e| RenderError::Preview(e.to_string()))?;
+/// The preview picture of an appearance result (module docs); `obs` is the
+/// observer and illuminant of its colours (the tile's).
+pub fn preview_png(a: &Appearance, obs: &Observer, name: &str) -> Result<Vec<u8>, RenderError> {
+    let layer = Layer::new(a, obs).map_err(|e| RenderError::Preview(e.to_string()))?;
     let w = 2 * SPHERE_PX + 3 * PAD;
     let paper = match a.spec.paper_albedo {
         Some(p) => format!("on paper of albedo {p}"),
@@ -234,8 +289,11 @@ pub fn preview_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
         format!("{name}: layer {paper} (left), white diffuser (right)"),
         format!(
             "One light 45° from the view (upper left, its mirror image a {LIGHT_RADIUS_DEG}° \
-             disc) and a uniform white sky; linear sRGB (D65), white facing the light = 1, \
-             clipped."
+             disc) and a uniform white sky; sRGB ({}), white facing the light = 1, clipped.",
+            match obs.conditions() {
+                Some((ill, o)) => format!("{ill}, {}°", o.degrees()),
+                None => "custom observer".into(),
+            }
         ),
         format!(
             "Layer BRDF solved at θi = {}°; interpolated between, held beyond.",
@@ -246,6 +304,16 @@ pub fn preview_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
+        match layer.gain {
+            Some(g) => format!(
+                "Colour matched to the tile's sky colour at θo = {}°: RGB gains \
+                 {:.2}, {:.2}, {:.2} (the solved wavelengths alone miss the bands between).",
+                a.spec.viewing_deg[0], g[0], g[1], g[2]
+            ),
+            None => "Colour from the solved wavelengths alone (no tile colour to match: \
+                     the layer has no paper term)."
+                .to_string(),
+        },
     ];
     let lines: Vec<(String, f64)> = caption
         .iter()

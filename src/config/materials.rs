@@ -378,9 +378,12 @@ mod tests {
             ("wavelength,n,k\n400,1,0\n", "line 1"),
             (
                 "# c\nwavelength_nm,n,k\n400,1,0\n500,0,0\n",
-                "line 4: n must be > 0",
+                "line 4: n must be in (0, 10], got 0",
             ),
-            ("wavelength_nm,n,k\n400,1,-1\n", "line 2: k must be >= 0"),
+            (
+                "wavelength_nm,n,k\n400,1,-1\n",
+                "line 2: k must be in [0, 10], got -1",
+            ),
             ("wavelength_nm,n,k\n400,1\n", "line 2: expected 3 fields"),
             ("wavelength_nm,n,k\n400,x,0\n", "line 2: n: `x`"),
             ("wavelength_nm,n,k\n400,1,inf\n", "line 2: k: `inf`"),

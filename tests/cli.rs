@@ -432,10 +432,17 @@ fn a_second_run_of_the_same_result_refuses_while_the_first_holds_it() {
     );
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!out.join("tiny.h5").exists());
+    // What a killed run left beside the result is kept while the other run
+    // holds it, and removed by the next run that holds it.
+    let stale = out.join("tiny.h5.4242-1.tmp");
+    std::fs::write(&stale, b"half a file").unwrap();
+    let (ok, _, _) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(!ok && stale.exists());
     drop(held);
     let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.join("tiny.h5").is_file());
+    assert!(!stale.exists());
 }
 
 #[test]

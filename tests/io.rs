@@ -480,11 +480,18 @@ fn existing_result_is_replaced_and_no_temp_file_remains() {
     assert_eq!(s.entries.len(), 1);
     assert_eq!(dir_names(dir.path()), vec!["r.h5"]);
 
-    // A stale temp file from a crashed run does not disturb the next write.
-    fs::write(dir.path().join("r.h5.tmp"), b"garbage").unwrap();
+    // A stale temp file from a crashed run does not disturb the next write,
+    // which writes its own; the stale one is left to the holder of the
+    // output's lock (the run), which finds it.
+    let stale = dir.path().join("r.h5.4242-1.tmp");
+    fs::write(&stale, b"garbage").unwrap();
     write_result(&path, &set(&g, &e, "third", None)).unwrap();
     assert_eq!(read_summary(&path).unwrap().input_hash, "third");
-    assert_eq!(dir_names(dir.path()), vec!["r.h5"]);
+    assert_eq!(dir_names(dir.path()), vec!["r.h5", "r.h5.4242-1.tmp"]);
+    assert_eq!(
+        inksim::output::atomic::stale_temporaries(&path),
+        vec![stale]
+    );
 }
 
 #[test]

@@ -33,6 +33,12 @@ pub fn run(
             result_path.display()
         ),
     };
+    // Holding the lock, remove what a killed run of this result left.
+    for p in inksim::pipeline::output_files(&scene) {
+        for tmp in inksim::output::atomic::stale_temporaries(&p) {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
     inksim::output::progress::set_status(format!(
         "nothing written ({} is written when all its solves are done); run the same \
          command again to start over",
@@ -83,6 +89,12 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     inksim::pipeline::memory::fits(&scene, memory)
         .and_then(|()| inksim::pipeline::check_output_files(&scene))
         .and_then(|()| inksim::pipeline::check_inputs(&scene))
+        .and_then(|()| {
+            inksim::pipeline::disk::preflight(
+                &scene.output.dir,
+                inksim::pipeline::disk::estimate_bytes(&scene),
+            )
+        })
         .with_context(|| config.display().to_string())?;
     let g = scene.grid;
     println!("{}: valid", config.display());
@@ -126,6 +138,10 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
         .iter()
         .map(|p| p.display().to_string())
         .collect();
-    println!("would write {}", files.join(", "));
+    println!(
+        "would write {} (about {} in all)",
+        files.join(", "),
+        human_bytes(inksim::pipeline::disk::estimate_bytes(&scene))
+    );
     Ok(())
 }

@@ -40,6 +40,15 @@ pub fn run(
         .iter()
         .filter(|v| shard.contains(v.index))
         .count();
+    // The results still to write must fit the disk, before any solve.
+    let need: f64 = exp
+        .variants
+        .iter()
+        .filter(|v| shard.contains(v.index) && srun::state(v) != State::Done)
+        .map(|v| inksim::pipeline::disk::estimate_bytes(&v.scene))
+        .sum();
+    inksim::pipeline::disk::preflight(&exp.study_dir, need)
+        .with_context(|| config.display().to_string())?;
     let peak = peak_bytes(&exp);
     let jobs = match jobs {
         Some(0) => bail!("--jobs must be at least 1"),
@@ -119,11 +128,24 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
                     )
                 })?;
         }
+        let need: f64 = exp
+            .variants
+            .iter()
+            .map(|v| inksim::pipeline::disk::estimate_bytes(&v.scene))
+            .sum();
+        inksim::pipeline::disk::preflight(&exp.study_dir, need).with_context(|| {
+            format!(
+                "{}: profile {}",
+                config.display(),
+                p.as_deref().unwrap_or("(none)")
+            )
+        })?;
         println!(
-            "profile {}: {} variants, all valid scenes; results in {}",
+            "profile {}: {} variants, all valid scenes; results in {} (about {} on disk)",
             p.as_deref().unwrap_or("(none)"),
             exp.variants.len(),
-            exp.study_dir.display()
+            exp.study_dir.display(),
+            human_bytes(need)
         );
     }
     Ok(())

@@ -6,7 +6,8 @@
 //! - [`merl`]: the BRDF in MERL's binary format for renderers (and
 //!   [`merl::RgbBrdf`], that BRDF in RGB at any pair of directions, which
 //!   `render`'s preview shades a sphere with);
-//! - [`progress`]: timestamped progress lines on long work.
+//! - [`progress`]: timestamped progress lines on long work;
+//! - [`space`]: the free space of an output's file system.
 //!
 //! Imports from every earlier stage (`config` … `optics`), never from
 //! `pipeline` or `study`.
@@ -18,3 +19,4 @@ pub mod lock;
 pub mod merl;
 pub mod progress;
 pub mod render;
+pub mod space;

@@ -178,9 +178,11 @@ fn admit(scene: &Scene, limit: Option<MemoryLimit>, reserve: bool) -> Result<(),
     Ok(())
 }
 
-/// `12 MB`, `3.4 GB`, `1.2 TB`.
+/// `800 kB`, `12 MB`, `3.4 GB`, `1.2 TB`.
 pub fn human_bytes(b: f64) -> String {
-    if b < 1e9 {
+    if b < 1e6 {
+        format!("{:.0} kB", b / 1e3)
+    } else if b < 1e9 {
         format!("{:.0} MB", b / 1e6)
     } else if b < 1e12 {
         format!("{:.1} GB", b / 1e9)
@@ -255,6 +257,7 @@ mod tests {
         assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32), 141.0);
         assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64), 453.0);
         assert_eq!(human_bytes(2.5e9), "2.5 GB");
+        assert_eq!(human_bytes(2.05e5), "205 kB");
         assert_eq!(human_bytes(2.2e14), "220.0 TB");
     }
 }

@@ -24,10 +24,13 @@
 //!   ([`run_geometry`]);
 //! - [`memory`]: the memory model of a run and the preflight against the
 //!   memory limit;
+//! - [`disk`]: the bytes a run writes and the preflight against the free
+//!   disk space;
 //! - [`accuracy`]: the expected error of a scene's fidelity settings.
 
 pub mod accuracy;
 mod appearance;
+pub mod disk;
 mod eps;
 mod fine_bodies;
 mod grains;

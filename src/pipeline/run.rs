@@ -67,6 +67,7 @@ pub fn run_with(
     check_output_files(scene)?;
     check_output_dir(&scene.output.dir)?;
     memory::preflight(scene, limit)?;
+    super::disk::preflight(&scene.output.dir, super::disk::estimate_bytes(scene))?;
     let mut plan = RunPlan::of(scene);
     let total = plan.solves(scene) as u64;
     let progress = if quiet {

@@ -58,6 +58,21 @@ pub fn stale_temporaries(target: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
+/// The output a temporary file is written for (`<name>` of
+/// `<name>.<pid>-<n>.tmp` or `<name>.tmp`); any other path is itself.
+pub fn output_of(path: &Path) -> PathBuf {
+    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return path.to_path_buf();
+    };
+    // The suffix starts at one of the name's dots.
+    for (i, _) in name.match_indices('.') {
+        if i > 0 && is_temp_suffix(&name[i..]) {
+            return path.with_file_name(&name[..i]);
+        }
+    }
+    path.to_path_buf()
+}
+
 /// `.tmp` or `.<digits>-<digits>.tmp`.
 fn is_temp_suffix(rest: &str) -> bool {
     let Some(mid) = rest.strip_suffix(".tmp") else {
@@ -248,5 +263,15 @@ mod tests {
             .collect();
         stale.sort();
         assert_eq!(stale, ["r.h5.77-3.tmp", "r.h5.tmp"]);
+        // Errors name the output a temporary file was for.
+        for (tmp, out) in [
+            ("d/r.h5.77-3.tmp", "d/r.h5"),
+            ("d/r.h5.tmp", "d/r.h5"),
+            ("d/r.tile.png.1-0.tmp", "d/r.tile.png"),
+            ("d/r.h5.7tmp", "d/r.h5.7tmp"),
+            ("d/r.h5", "d/r.h5"),
+        ] {
+            assert_eq!(output_of(Path::new(tmp)), Path::new(out));
+        }
     }
 }

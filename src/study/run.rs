@@ -405,12 +405,18 @@ fn run_one(v: &Variant, memory: Option<MemoryLimit>) -> Result<f64, String> {
             let _ = std::fs::remove_file(tmp);
         }
     }
-    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+    guarded(|| {
         pipeline::run_with(&v.scene, true, memory)
-    }));
-    match r {
-        Ok(Ok(_)) => Ok(t.elapsed().as_secs_f64()),
-        Ok(Err(e)) => Err(e.to_string()),
+            .map(|_| t.elapsed().as_secs_f64())
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// `f`'s result, with a panic inside it (on this thread or a rayon worker
+/// it waits on) turned into an error naming the panic's message.
+fn guarded<T>(f: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(r) => r,
         Err(p) => Err(format!(
             "internal error (panic): {}",
             p.downcast_ref::<String>()
@@ -453,6 +459,39 @@ pub fn jobs_memory_holds(peak_bytes: f64, memory: Option<MemoryLimit>) -> usize 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_panic_inside_a_variant_becomes_its_error_and_the_next_one_runs() {
+        use rayon::prelude::*;
+        // A panic in a rayon worker (where the solvers' loops run) reaches
+        // the variant's thread and is caught there; the same thread then
+        // runs the next variant as usual.
+        let r: Result<f64, String> = guarded(|| {
+            let s: usize = (0..64usize)
+                .into_par_iter()
+                .map(|i| {
+                    if i == 37 {
+                        panic!("index {i} out of range");
+                    }
+                    i
+                })
+                .sum();
+            Ok(s as f64)
+        });
+        assert_eq!(
+            r,
+            Err("internal error (panic): index 37 out of range".into())
+        );
+        assert_eq!(
+            guarded(|| -> Result<(), String> { std::panic::panic_any(7u8) }),
+            Err("internal error (panic): ?".into())
+        );
+        assert_eq!(guarded(|| Ok::<_, String>(2.0)), Ok(2.0));
+        assert_eq!(
+            guarded(|| Err::<f64, _>("bad".to_string())),
+            Err("bad".into())
+        );
+    }
 
     #[test]
     fn shards_parse_and_partition() {

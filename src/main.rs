@@ -32,7 +32,7 @@ use std::process::ExitCode;
     version = inksim::VERSION,
     about,
     long_about,
-    after_help = "Examples:\n  inksim run configs/demo.toml                 run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml               validate and show the work a run would do\n  inksim --threads 1 run scene.toml            same numbers for any thread count\n  inksim plan configs/study.toml               variants, work, estimated time and memory per profile\n  inksim run configs/study.toml --profile quick    run (or resume) the whole study\n  inksim run configs/study.toml --shard 0/4    run a quarter of it\n  inksim slurm configs/study.toml --shards 16  write an sbatch job-array script\n  inksim merge configs/study.toml              summary.h5, comparison grids, summary.md/html"
+    after_help = "Examples:\n  inksim run configs/demo.toml                 run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml               validate and show the work a run would do\n  inksim --threads 1 run scene.toml            same numbers for any thread count\n  inksim plan configs/study.toml               variants, work, estimated time and memory per profile\n  inksim run configs/study.toml --profile quick    run (or resume) the whole study\n  inksim run configs/study.toml --shard 0/4    run a quarter of it\n  inksim slurm configs/study.toml --shards 16  write an sbatch job-array script\n  inksim merge configs/study.toml              summary.h5, comparison grids, summary.md/html\n  inksim export runs/demo/demo.h5              spectra and colours as CSV (or a study: colours.csv)"
 )]
 struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
@@ -154,6 +154,33 @@ enum Command {
         #[arg(long)]
         output_dir: Option<PathBuf>,
     },
+    /// Write a result's numbers, or a study's colours, as CSV tables.
+    ///
+    /// For a result file (<dir>/<name>.h5): <name>-solves.csv (every solve:
+    /// side, realisation, wavelength, angles, R, T, A, energy balance,
+    /// method, iterations, residual), and where the result has them
+    /// <name>-spectra.csv (ensemble-mean R, T, A ± standard errors per
+    /// wavelength and angle) and <name>-colours.csv (CIELAB, LCh ± standard
+    /// errors and XYZ of the measurement geometries and of every tile cell,
+    /// with illuminant and observer). For a study config: colours.csv in the
+    /// study folder, one row per finished variant and measurement geometry,
+    /// with the variant's label on every axis. Columns are described in
+    /// docs/FORMAT.md.
+    Export {
+        /// A result file (.h5) or a study file (TOML with a [study] table).
+        target: PathBuf,
+        /// Study: the profile to export (default: study.profile).
+        #[arg(long)]
+        profile: Option<String>,
+        /// Study: its results are here instead of its [study] output_dir (as
+        /// given to `run --output-dir`).
+        #[arg(long)]
+        output_dir: Option<PathBuf>,
+        /// Write the CSV files into this folder instead (default: beside the
+        /// result file; the study folder).
+        #[arg(long)]
+        to: Option<PathBuf>,
+    },
     /// Validate a scene (or every variant of a study) and print what a run
     /// would compute, without running it.
     Check {
@@ -255,6 +282,12 @@ fn real_main() -> Result<ExitCode> {
         Command::Geometry { config, output_dir } => {
             cli::scene::geometry(&cli::ConfigFile::read(&config)?, output_dir)?
         }
+        Command::Export {
+            target,
+            profile,
+            output_dir,
+            to,
+        } => cli::export::export(&target, profile.as_deref(), output_dir, to)?,
         Command::Check { config } => {
             let config = cli::ConfigFile::read(&config)?;
             if config.is_study() {

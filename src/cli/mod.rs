@@ -12,6 +12,7 @@
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
 
+pub mod export;
 pub mod plan;
 pub mod scene;
 pub mod slurm;

@@ -7,13 +7,15 @@
 //!   [`merl::RgbBrdf`], that BRDF in RGB at any pair of directions, which
 //!   `render`'s preview shades a sphere with);
 //! - [`progress`]: timestamped progress lines on long work;
-//! - [`space`]: the free space of an output's file system.
+//! - [`space`]: the free space of an output's file system;
+//! - [`export`]: a result's numbers as CSV tables.
 //!
 //! Imports from every earlier stage (`config` … `optics`), never from
 //! `pipeline` or `study`.
 
 pub mod atomic;
 pub mod error;
+pub mod export;
 pub mod h5;
 pub mod lock;
 pub mod merl;

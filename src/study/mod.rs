@@ -19,9 +19,11 @@
 //! - [`run`]: runs the variants (in parallel, sharded, resumable).
 //! - [`merge`]: the summary HDF5, the comparison grids and the summary page.
 //! - [`slurm`]: a ready sbatch array script.
+//! - [`export`]: the variants' measured colours as one CSV table.
 //!
 //! The user documentation of the format and the commands is docs/STUDY.md.
 
+pub mod export;
 pub mod merge;
 pub mod plan;
 pub mod run;

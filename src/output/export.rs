@@ -1,0 +1,309 @@
+//! `inksim export`: a result file's numbers as CSV tables, for a
+//! spreadsheet or any tool without HDF5.
+//!
+//! From `<name>.h5` (each only when the result has what it holds):
+//! - `<name>-solves.csv`: every solve, one row each — `side` (`above`, the
+//!   ink side; `below`, the layer flipped for the paper term),
+//!   `realisation`, `wavelength_nm`, `polar_deg`, `azimuth_deg`,
+//!   `reflectance`, `transmittance`, `absorption` (fractions of the
+//!   incident power), `energy_balance`, `method`, `iterations`, `residual`;
+//! - `<name>-spectra.csv` (with appearance products): the ensemble means
+//!   from above per wavelength and polar angle, `reflectance`,
+//!   `transmittance`, `absorption` and their standard errors `*_se`
+//!   (empty for one realisation);
+//! - `<name>-colours.csv` (with the tile): one row per colour —
+//!   `geometry` (`45/0`, `d/8 SCI`, `d/8 SCE` for the measurement
+//!   geometries; `sky`, the tile's strip under a uniform white sky, and
+//!   `brdf`, its square lit from `illumination_deg`, per `viewing_deg`),
+//!   `illuminant`, `observer_deg`, CIELAB `L_star`, `a_star`, `b_star`,
+//!   `C_star_ab`, `h_deg`, their standard errors `L_star_se`, `a_star_se`,
+//!   `b_star_se` and `de00_se` (empty for one realisation), and CIE `X`,
+//!   `Y`, `Z` (Y of the perfect diffuser = 100; measurement geometries only).
+//!
+//! Numbers are written in the shortest form that reads back to the same
+//! f64; a text field with a comma or a quote is quoted.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::error::IoError;
+use super::h5::{read_appearance, read_measured, read_summary};
+use crate::optics::colour::lab_to_lch;
+use crate::optics::farfield::Side;
+
+/// A CSV table being written: a header, then rows.
+pub struct Csv {
+    text: String,
+    columns: usize,
+}
+
+impl Csv {
+    pub fn new(header: &[&str]) -> Csv {
+        let mut c = Csv {
+            text: String::new(),
+            columns: header.len(),
+        };
+        c.row(header.iter().map(|h| h.to_string()).collect());
+        c
+    }
+
+    /// Append a row of already formatted fields (quoted here if need be).
+    pub fn row(&mut self, fields: Vec<String>) {
+        debug_assert_eq!(fields.len(), self.columns);
+        let line: Vec<String> = fields.into_iter().map(quoted).collect();
+        let _ = writeln!(self.text, "{}", line.join(","));
+    }
+
+    pub fn into_text(self) -> String {
+        self.text
+    }
+}
+
+/// A number as CSV: its shortest round-trip form (in exponent form when
+/// very small or large), empty for NaN.
+pub fn num(x: f64) -> String {
+    if x.is_nan() {
+        String::new()
+    } else if x != 0.0 && !(1e-4..1e15).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or(String::new(), num)
+}
+
+fn quoted(s: String) -> String {
+    if s.contains([',', '"', '\n']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s
+    }
+}
+
+/// The CSV tables of the result file `path`: (file suffix, text), in the
+/// order of the module docs.
+pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError> {
+    let summary = read_summary(path)?;
+    let mut solves = Csv::new(&[
+        "side",
+        "realisation",
+        "wavelength_nm",
+        "polar_deg",
+        "azimuth_deg",
+        "reflectance",
+        "transmittance",
+        "absorption",
+        "energy_balance",
+        "method",
+        "iterations",
+        "residual",
+    ]);
+    for e in &summary.entries {
+        solves.row(vec![
+            match e.side {
+                Side::Above => "above",
+                Side::Below => "below",
+            }
+            .into(),
+            e.realisation.to_string(),
+            num(e.wavelength_nm),
+            num(e.polar_deg),
+            num(e.azimuth_deg),
+            num(e.total_reflectance),
+            num(e.total_transmittance),
+            num(e.absorption),
+            num(e.energy_balance),
+            e.method.to_string(),
+            e.iterations.to_string(),
+            num(e.residual),
+        ]);
+    }
+    let mut tables = vec![("solves", solves.into_text())];
+    let Some(a) = read_appearance(path)? else {
+        return Ok(tables);
+    };
+    let extra = Extra::read(path)?;
+    let mut spectra = Csv::new(&[
+        "wavelength_nm",
+        "polar_deg",
+        "reflectance",
+        "reflectance_se",
+        "transmittance",
+        "transmittance_se",
+        "absorption",
+        "absorption_se",
+    ]);
+    let se =
+        |s: &Option<ndarray::Array2<f64>>, l: usize, k: usize| opt(s.as_ref().map(|s| s[[l, k]]));
+    for (l, &wl) in a.wavelengths_nm.iter().enumerate() {
+        for (k, &polar) in a.above_deg.iter().enumerate() {
+            spectra.row(vec![
+                num(wl),
+                num(polar),
+                num(a.reflectance[[l, k]]),
+                se(&extra.reflectance_se, l, k),
+                num(a.transmittance[[l, k]]),
+                se(&extra.transmittance_se, l, k),
+                num(a.absorption[[l, k]]),
+                se(&extra.absorption_se, l, k),
+            ]);
+        }
+    }
+    tables.push(("spectra", spectra.into_text()));
+    let Some(tile) = &a.tile_lab else {
+        return Ok(tables);
+    };
+    let mut colours = Csv::new(&[
+        "geometry",
+        "viewing_deg",
+        "illumination_deg",
+        "illuminant",
+        "observer_deg",
+        "L_star",
+        "a_star",
+        "b_star",
+        "C_star_ab",
+        "h_deg",
+        "L_star_se",
+        "a_star_se",
+        "b_star_se",
+        "de00_se",
+        "X",
+        "Y",
+        "Z",
+    ]);
+    let (ill, obs) = extra.conditions.clone().unwrap_or_default();
+    let lab_row = |geometry: &str,
+                   view: String,
+                   illum: String,
+                   lab: [f64; 3],
+                   lab_se: Option<[f64; 3]>,
+                   de00_se: Option<f64>,
+                   xyz: Option<[f64; 3]>| {
+        let lch = lab_to_lch(lab);
+        let mut f = vec![geometry.to_string(), view, illum, ill.clone(), obs.clone()];
+        f.extend(lab.iter().map(|&v| num(v)));
+        f.extend([num(lch[1]), num(lch[2])]);
+        f.extend((0..3).map(|c| opt(lab_se.map(|s| s[c]))));
+        f.push(opt(de00_se));
+        f.extend((0..3).map(|c| opt(xyz.map(|x| x[c]))));
+        f
+    };
+    if let Some((records, _, _)) = read_measured(path)? {
+        for r in records {
+            colours.row(lab_row(
+                &r.geometry,
+                String::new(),
+                String::new(),
+                r.lab,
+                r.lab_se,
+                r.de00_se,
+                Some(r.xyz),
+            ));
+        }
+    }
+    for (o, &view) in a.viewing_deg.iter().enumerate() {
+        for c in 0..tile.dim().1 {
+            let at = |t: &ndarray::Array3<f64>| [t[[o, c, 0]], t[[o, c, 1]], t[[o, c, 2]]];
+            let (geometry, illum) = match c {
+                0 => ("sky", String::new()),
+                _ => ("brdf", num(a.illumination_deg[c - 1])),
+            };
+            colours.row(lab_row(
+                geometry,
+                num(view),
+                illum,
+                at(tile),
+                extra.tile_lab_se.as_ref().map(at),
+                extra.tile_de00_se.as_ref().map(|s| s[[o, c]]),
+                None,
+            ));
+        }
+    }
+    tables.push(("colours", colours.into_text()));
+    Ok(tables)
+}
+
+/// What [`read_appearance`] does not read: standard errors and the colour
+/// conditions.
+struct Extra {
+    reflectance_se: Option<ndarray::Array2<f64>>,
+    transmittance_se: Option<ndarray::Array2<f64>>,
+    absorption_se: Option<ndarray::Array2<f64>>,
+    tile_lab_se: Option<ndarray::Array3<f64>>,
+    tile_de00_se: Option<ndarray::Array2<f64>>,
+    /// (illuminant, observer degrees) as written.
+    conditions: Option<(String, String)>,
+}
+
+impl Extra {
+    fn read(path: &Path) -> Result<Extra, IoError> {
+        let hdf = |source| IoError::Hdf5 {
+            path: path.to_path_buf(),
+            source,
+        };
+        let g = hdf5::File::open(path)
+            .and_then(|f| f.group("appearance"))
+            .map_err(hdf)?;
+        let two = |name: &str| -> Result<Option<ndarray::Array2<f64>>, IoError> {
+            if !g.link_exists(name) {
+                return Ok(None);
+            }
+            g.dataset(name)
+                .and_then(|d| d.read())
+                .map(Some)
+                .map_err(hdf)
+        };
+        let tile_lab_se = if g.link_exists("tile_lab_se") {
+            Some(
+                g.dataset("tile_lab_se")
+                    .and_then(|d| d.read())
+                    .map_err(hdf)?,
+            )
+        } else {
+            None
+        };
+        let conditions = match (g.attr("illuminant"), g.attr("observer_deg")) {
+            (Ok(i), Ok(o)) => {
+                let ill: hdf5::types::VarLenUnicode = i.read_scalar().map_err(hdf)?;
+                let obs: u32 = o.read_scalar().map_err(hdf)?;
+                Some((ill.to_string(), obs.to_string()))
+            }
+            _ => None,
+        };
+        Ok(Extra {
+            reflectance_se: two("reflectance_se")?,
+            transmittance_se: two("transmittance_se")?,
+            absorption_se: two("absorption_se")?,
+            tile_lab_se,
+            tile_de00_se: two("tile_de00_se")?,
+            conditions,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fields_are_quoted_only_when_they_must_be_and_numbers_read_back() {
+        let mut c = Csv::new(&["a", "b"]);
+        c.row(vec!["d/8 SCI".into(), "x,y".into()]);
+        c.row(vec!["say \"hi\"".into(), num(0.1 + 0.2)]);
+        c.row(vec![num(f64::NAN), opt(None)]);
+        c.row(vec![num(2.4e-9), num(-0.0)]);
+        let t = c.into_text();
+        assert_eq!(
+            t,
+            "a,b\nd/8 SCI,\"x,y\"\n\"say \"\"hi\"\"\",0.30000000000000004\n,\n2.4e-9,-0\n"
+        );
+        assert_eq!("0.30000000000000004".parse::<f64>().unwrap(), 0.1 + 0.2);
+        for x in [2.4e-9, 1.0 / 3.0, 1e300, -7.25e-12, 123456.0] {
+            assert_eq!(num(x).parse::<f64>().unwrap(), x);
+        }
+    }
+}

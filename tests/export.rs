@@ -1,0 +1,203 @@
+//! `inksim export`: the CSV tables hold exactly the numbers of the result
+//! files, one row per solve, per spectrum point and per colour.
+use std::collections::HashMap;
+use std::path::Path;
+use std::process::Command;
+
+mod common;
+use common::scene::{PigmentToml, SceneToml};
+use common::study::StudyToml;
+use inksim::output::h5::{read_appearance, read_measured, read_summary};
+
+fn inksim_in(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(args)
+        .current_dir(dir)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT")
+        .output()
+        .expect("run inksim");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+/// A CSV table as rows of column → field (no field of ours is quoted).
+fn table(path: &Path) -> Vec<HashMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(f.len(), header.len(), "{l}");
+            header
+                .iter()
+                .cloned()
+                .zip(f.iter().map(|s| s.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+fn num(row: &HashMap<String, String>, col: &str) -> f64 {
+    row[col]
+        .parse()
+        .unwrap_or_else(|_| panic!("{col}: `{}`", row[col]))
+}
+
+/// Red spheres on paper, two realisations, with the tile.
+fn scene() -> SceneToml {
+    SceneToml::grains()
+        .seed(3)
+        .realisations(2)
+        .thickness_nm(400.0)
+        .fragment_nm(500.0)
+        .pvc(0.15)
+        .diameter_nm(150.0)
+        .z_cell_nm(40.0)
+        .wavelengths_nm(&[450.0, 600.0])
+        .polar_deg(&[0.0, 40.0])
+        .tolerance(1e-6)
+        .quadrature_points(3)
+        .paper(0.8)
+        .outputs(&["brdf", "tile"])
+}
+
+#[test]
+fn a_result_exports_its_solves_spectra_and_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = scene().output(&out, "red").write(dir.path());
+    let (ok, _, err) = inksim_in(dir.path(), &["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let h5 = out.join("red.h5");
+    let csv_dir = dir.path().join("csv");
+    let (ok, stdout, err) = inksim_in(
+        dir.path(),
+        &[
+            "export",
+            h5.to_str().unwrap(),
+            "--to",
+            csv_dir.to_str().unwrap(),
+        ],
+    );
+    assert!(ok, "{err}");
+    assert_eq!(stdout.lines().count(), 3, "{stdout}");
+
+    // Every solve, from above and from below, in the file's order.
+    let s = read_summary(&h5).unwrap();
+    let solves = table(&csv_dir.join("red-solves.csv"));
+    assert_eq!(solves.len(), s.entries.len());
+    assert!(solves.iter().any(|r| r["side"] == "below"));
+    for (r, e) in solves.iter().zip(&s.entries) {
+        assert_eq!(num(r, "wavelength_nm"), e.wavelength_nm);
+        assert_eq!(num(r, "reflectance"), e.total_reflectance);
+        assert_eq!(num(r, "energy_balance"), e.energy_balance);
+        assert_eq!(r["method"], e.method.to_string());
+    }
+
+    // Ensemble means with standard errors (two realisations).
+    let a = read_appearance(&h5).unwrap().unwrap();
+    let spectra = table(&csv_dir.join("red-spectra.csv"));
+    assert_eq!(spectra.len(), a.wavelengths_nm.len() * a.above_deg.len());
+    for (k, r) in spectra.iter().enumerate() {
+        let (l, p) = (k / a.above_deg.len(), k % a.above_deg.len());
+        assert_eq!(num(r, "polar_deg"), a.above_deg[p]);
+        assert_eq!(num(r, "transmittance"), a.transmittance[[l, p]]);
+        assert!(num(r, "reflectance_se") >= 0.0);
+    }
+
+    // The measurement geometries, then every tile cell.
+    let (measured, illuminant, _) = read_measured(&h5).unwrap().unwrap();
+    let colours = table(&csv_dir.join("red-colours.csv"));
+    let tile = a.tile_lab.unwrap();
+    assert_eq!(colours.len(), measured.len() + tile.dim().0 * tile.dim().1);
+    for (r, m) in colours.iter().zip(&measured) {
+        assert_eq!(r["geometry"], m.geometry);
+        assert_eq!(r["illuminant"], illuminant);
+        assert_eq!(num(r, "L_star"), m.lab[0]);
+        assert_eq!(num(r, "Y"), m.xyz[1]);
+        assert_eq!(num(r, "de00_se"), m.de00_se.unwrap());
+        let c = (m.lab[1].powi(2) + m.lab[2].powi(2)).sqrt();
+        assert!((num(r, "C_star_ab") - c).abs() < 1e-9);
+    }
+    let sky = &colours[measured.len()];
+    assert_eq!(sky["geometry"], "sky");
+    assert_eq!(num(sky, "b_star"), tile[[0, 0, 2]]);
+    assert!(num(sky, "L_star_se") > 0.0 && sky["X"].is_empty());
+    let cell = &colours[measured.len() + 1];
+    assert_eq!(cell["geometry"], "brdf");
+    assert_eq!(num(cell, "illumination_deg"), a.illumination_deg[0]);
+    assert_eq!(num(cell, "a_star"), tile[[0, 1, 1]]);
+}
+
+#[test]
+fn a_result_without_appearance_exports_its_solves_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = scene()
+        .realisations(1)
+        .outputs(&[])
+        .output(&out, "bare")
+        .write(dir.path());
+    assert!(inksim_in(dir.path(), &["run", cfg.to_str().unwrap()]).0);
+    let (ok, stdout, err) = inksim_in(dir.path(), &["export", "out/bare.h5"]);
+    assert!(ok, "{err}");
+    assert_eq!(stdout.trim(), "solves: out/bare-solves.csv");
+    assert_eq!(table(&out.join("bare-solves.csv")).len(), 4);
+    // A scene config, and a file that is not a result, get one line each.
+    for (arg, want) in [
+        (
+            cfg.to_str().unwrap(),
+            "export takes a result file (.h5) or a study",
+        ),
+        ("out/bare-solves.csv", "bare-solves.csv"),
+        ("out/none.h5", "none.h5"),
+    ] {
+        let (ok, _, err) = inksim_in(dir.path(), &["export", arg]);
+        assert!(!ok && err.contains(want), "{arg}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}
+
+#[test]
+fn a_study_exports_every_finished_variants_colours_with_its_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = scene()
+        .realisations(1)
+        .pigment(PigmentToml::builtin("red").named("p").diameter_nm(150.0))
+        .outputs(&["tile"]);
+    let study = StudyToml::new("t", 5, "out", &base).axis("pvc", "pigment.0.pvc", "[0.1, 0.2]");
+    std::fs::write(dir.path().join("study.toml"), study.toml()).unwrap();
+    let (ok, _, err) = inksim_in(dir.path(), &["run", "study.toml"]);
+    assert!(ok, "{err}");
+    let (ok, stdout, err) = inksim_in(dir.path(), &["export", "study.toml"]);
+    assert!(ok, "{err}");
+    let path = stdout.trim().strip_prefix("colours: ").unwrap().to_string();
+    let rows = table(&dir.path().join(&path));
+    assert_eq!(rows.len(), 2 * 3, "two variants × three geometries");
+    let labels: Vec<&str> = rows.iter().map(|r| r["pvc"].as_str()).collect();
+    assert_eq!(labels.iter().filter(|l| **l == labels[0]).count(), 3);
+    let variants = Path::new(&path).parent().unwrap().join("variants");
+    let name = &rows[0]["variant"];
+    let (m, _, _) = read_measured(&dir.path().join(&variants).join(format!("{name}.h5")))
+        .unwrap()
+        .unwrap();
+    assert_eq!(num(&rows[0], "L_star"), m[0].lab[0]);
+    assert!(
+        rows[0]["de00_se"].is_empty(),
+        "one realisation: no standard error"
+    );
+
+    // A variant not finished has no rows, and the user is told.
+    std::fs::remove_file(dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
+    let (ok, _, err) = inksim_in(dir.path(), &["export", "study.toml"]);
+    assert!(
+        ok && err.contains("1 of 2 variants are not finished"),
+        "{err}"
+    );
+    assert_eq!(table(&dir.path().join(&path)).len(), 3);
+}

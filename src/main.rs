@@ -59,6 +59,10 @@ enum Command {
     /// <study.output_dir>/<profile>/variants/<name>.h5 (+ .png), each written
     /// atomically. A failed variant does not stop the others; the exit code is
     /// non-zero if any failed.
+    ///
+    /// A scene's solve that runs longer than 10 s reports its iteration,
+    /// residual and time every 10 s (INKSIM_HEARTBEAT_S=<seconds> changes
+    /// that).
     Run {
         /// Scene or study file (TOML), e.g. configs/demo.toml, configs/study.toml.
         config: PathBuf,

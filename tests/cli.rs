@@ -511,3 +511,50 @@ fn version_names_the_commit_and_log_lines_carry_their_time() {
     let s = inksim::output::h5::read_summary(&out.join("tiny.h5")).unwrap();
     assert_eq!(s.version, inksim::VERSION);
 }
+
+#[test]
+fn a_long_solve_reports_its_iterations_while_it_runs() {
+    // With the heartbeat every 0 s, every iteration of every solve reports:
+    // the method, an iteration count that grows, the residual against the
+    // tolerance and the time in the solve.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = tiny()
+        .method("gmres")
+        .output(&dir.path().join("out"), "tiny")
+        .write(dir.path());
+    let o = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(["run", cfg.to_str().unwrap()])
+        .env("INKSIM_HEARTBEAT_S", "0")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let beats: Vec<&str> = err
+        .lines()
+        .filter(|l| l.contains("still solving 500 nm, 0° above: gmres iteration"))
+        .collect();
+    assert!(beats.len() >= 3, "{err}");
+    let its: Vec<usize> = beats
+        .iter()
+        .map(|l| {
+            l.split("iteration ")
+                .nth(1)
+                .unwrap()
+                .split(',')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    assert!(
+        its.windows(2).all(|w| w[0] <= w[1]) && its.last() > its.first(),
+        "{its:?}"
+    );
+    assert!(beats
+        .iter()
+        .all(|l| l.contains("(tolerance 1e-7)") && l.ends_with(" s")));
+    // By default (10 s) this quick run stays quiet.
+    let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(ok && !err.contains("still solving"), "{err}");
+}

@@ -1,6 +1,7 @@
 //! The solves of one layer: every (wavelength, incidence, side) on a
 //! permittivity grid through the configured iterative method, or in closed
-//! form on the homogeneous slab; each solve logged to the progress bar.
+//! form on the homogeneous slab; each solve logged to the progress bar, and
+//! a long one reporting its iterations while it runs (`solver::heartbeat`).
 
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
@@ -10,6 +11,7 @@ use crate::optics::farfield::{self, Side, SolveEntry};
 use crate::output::progress::Progress;
 use crate::raster::structure::EpsGrid;
 use crate::raster::{Grid, Raster};
+use crate::solver::heartbeat::{self, Beat};
 use crate::solver::{self, Controls, Problem};
 
 use super::eps::{fraction_eps, mean_eps};
@@ -110,12 +112,32 @@ pub fn solve_layer(
                 eps: grid_eps,
                 eps_binder: eps_b,
             };
-            let sol = solver::solve(&p, scene.solver.method, &ctl).map_err(|source| {
-                PipelineError::Solve {
-                    wavelength_nm: lambda,
-                    polar_deg: inc.polar_deg,
-                    source,
-                }
+            // A long solve reports where it stands (solver::heartbeat).
+            let beat = |b: Beat| {
+                progress.log(&format!(
+                    "[inksim] still solving {lambda} nm, {}° {side}{}: {} iteration {}, \
+                     residual {}{:.1e} (tolerance {:.0e}), {:.0} s",
+                    (inc.polar_deg * 100.0).round() / 100.0,
+                    if realisation > 0 {
+                        format!(" #{realisation}")
+                    } else {
+                        String::new()
+                    },
+                    b.method,
+                    b.iterations,
+                    if b.estimated { "≈ " } else { "" },
+                    b.residual,
+                    ctl.tolerance,
+                    b.elapsed_s
+                ))
+            };
+            let sol = heartbeat::scope(heartbeat_interval(), &beat, || {
+                solver::solve(&p, scene.solver.method, &ctl)
+            })
+            .map_err(|source| PipelineError::Solve {
+                wavelength_nm: lambda,
+                polar_deg: inc.polar_deg,
+                source,
             })?;
             let entry = SolveEntry {
                 wavelength_nm: lambda,
@@ -130,6 +152,16 @@ pub fn solve_layer(
         }
     }
     Ok(entries)
+}
+
+/// How often a long solve reports: `INKSIM_HEARTBEAT_S` seconds when set
+/// to a number ≥ 0, else [`heartbeat::INTERVAL`].
+pub fn heartbeat_interval() -> std::time::Duration {
+    std::env::var("INKSIM_HEARTBEAT_S")
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s >= 0.0 && *s < 1e9)
+        .map_or(heartbeat::INTERVAL, std::time::Duration::from_secs_f64)
 }
 
 /// The solver's iteration controls of a scene.

@@ -54,6 +54,7 @@
 pub mod airy;
 pub mod fft;
 pub mod green;
+pub mod heartbeat;
 pub mod lattice;
 pub mod methods;
 pub mod operator;

@@ -139,6 +139,9 @@ impl BiCgStab {
                     .and(&t)
                     .par_for_each(|r, s, t| *r = S::store(s.load() - omega * t.load()));
                 let rn = norm_sqr(&r).sqrt();
+                // The true residual scales with the preconditioned one
+                // from the restart, where `target` is half of tolerance's.
+                monitor.tick(iterations, 0.5 * ctl.tolerance * rn / target);
                 if !rn.is_finite() || rn <= target || omega.norm() == 0.0 {
                     break;
                 }

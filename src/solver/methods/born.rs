@@ -7,6 +7,7 @@
 
 use super::{run_in_field_storage, Outcome, Solver, Validity};
 use crate::config::{Method, Precision};
+use crate::solver::heartbeat::Beats;
 use crate::solver::storage::{with_storage, Storage};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
@@ -84,8 +85,10 @@ impl Born {
         let mut r = Array3::<S>::default(u.dim());
         let mut best = f64::INFINITY;
         let mut growing = 0;
+        let mut beats = Beats::default();
         for it in 0..=ctl.max_iterations {
             let res = sys.residual(scr, u, &mut r);
+            beats.tick(Method::Born, it, res, false);
             if res <= ctl.tolerance {
                 return Ok(Outcome {
                     method: Method::Born,

@@ -122,6 +122,9 @@ impl Gmres {
                 g[k + 1] = -s * g[k];
                 g[k] = c.conj() * g[k];
                 k_used = k + 1;
+                // The true residual estimated as in the restart (`target`
+                // is half of the tolerance's preconditioned norm).
+                monitor.tick(inner, 0.5 * ctl.tolerance * g[k + 1].norm() / target);
                 if g[k + 1].norm() <= target || hn == 0.0 || inner >= ctl.max_iterations {
                     break;
                 }

@@ -2,6 +2,7 @@
 //! ([`Monitor`]) and the checked start of a Krylov cycle ([`restart`]).
 
 use crate::config::Method;
+use crate::solver::heartbeat::Beats;
 use crate::solver::storage::{norm_sqr, Storage};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
@@ -13,6 +14,7 @@ use ndarray::Array3;
 pub struct Monitor {
     method: Method,
     best: f64,
+    beats: Beats,
 }
 
 impl Monitor {
@@ -20,7 +22,14 @@ impl Monitor {
         Monitor {
             method,
             best: f64::INFINITY,
+            beats: Beats::default(),
         }
+    }
+
+    /// A heartbeat from inside a Krylov cycle: the relative residual
+    /// estimated from the preconditioned one (`heartbeat`).
+    pub fn tick(&mut self, iterations: usize, estimate: f64) {
+        self.beats.tick(self.method, iterations, estimate, true);
     }
 
     /// `Ok(true)`: converged; `Ok(false)`: go on; `Err`: stop with this error.
@@ -31,6 +40,7 @@ impl Monitor {
         ctl: &Controls,
     ) -> Result<bool, SolveError> {
         let method = self.method;
+        self.beats.tick(method, iterations, res, false);
         if !res.is_finite() || res > 1e3 * self.best.max(ctl.tolerance) {
             return Err(SolveError::Diverged {
                 method,

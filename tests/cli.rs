@@ -93,8 +93,8 @@ fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
             "pigment.0.material",
             r#"{ builtin = "red", index = [1.5, 0.0] }"#,
         ),
-        "a material is a table with exactly one of `builtin`, `csv`, `index` (e.g. material = \
-         { builtin = \"red\" }); this one gives more than one",
+        "a material is a table with exactly one of `builtin`, `csv`, `index`, `epsilon` (e.g. \
+         material = { builtin = \"red\" }); this one gives more than one",
     );
     expect_error(
         tiny().raw("pigment.0.material", "{}"),

@@ -778,3 +778,32 @@ fn colour_conditions_and_measurement_geometries() {
         assert!(shown.contains(says), "{shown}");
     }
 }
+
+#[test]
+fn a_material_may_be_given_as_its_complex_permittivity() {
+    // ε = 2.21 + 0.6i is (1.5 + 0.2i)²; a metal-like ε = −8.91 + 1.8i is
+    // (0.3 + 3i)².
+    for (eps, n, k) in [("[2.21, 0.6]", 1.5, 0.2), ("[-8.91, 1.8]", 0.3, 3.0)] {
+        let s =
+            parse(&base().raw("pigment.0.material", &format!("{{ epsilon = {eps} }}"))).unwrap();
+        let idx = s.species[0].material.index_at(550.0).unwrap();
+        assert!(
+            (idx.re - n).abs() < 1e-12 && (idx.im - k).abs() < 1e-12,
+            "{eps}: {idx}"
+        );
+    }
+    // A gain medium, a wrong length and an index beyond the limits are refused.
+    for (eps, want) in [
+        (
+            "[2.0, -0.1]",
+            "must be in [0, 100] for Im ε (a medium that absorbs or is lossless)",
+        ),
+        ("[2.0]", "must be [Re ε, Im ε], got 1 values"),
+        ("[-100.0, 0.0]", "is outside n in (0, 10], k in [0, 10]"),
+    ] {
+        let (key, msg) =
+            invalid(&base().raw("pigment.0.material", &format!("{{ epsilon = {eps} }}")));
+        assert_eq!(key, "pigment[0].material.epsilon", "{msg}");
+        assert!(msg.contains(want), "{eps}: {msg}");
+    }
+}

@@ -4,7 +4,10 @@
 //! Tables are plain CSV: optional `#` comment lines, the header
 //! `wavelength_nm,n,k`, then at least two rows with strictly increasing
 //! wavelengths, `0 < n <= 10` and `0 <= k <= 10`; a UTF-8 byte-order mark
-//! before the header is ignored. Between rows `n` and `k` are linearly
+//! before the header is ignored. A table of the complex permittivity has the
+//! header `wavelength_nm,eps_re,eps_im` (`eps_im >= 0`); each row is turned
+//! into `n + i k = √ε` (the root with `n > 0`, `k >= 0`), held to the same
+//! limits. Between rows `n` and `k` are linearly
 //! interpolated (each separately); outside the table there is no value, so a
 //! caller can never silently extrapolate.
 //!
@@ -48,6 +51,14 @@ const BUILTIN_BLUE_L: &str = include_str!("../../data/pigments/blue-lorentz.csv"
 const BUILTIN_GREEN_L: &str = include_str!("../../data/pigments/green-lorentz.csv");
 
 const HEADER: [&str; 3] = ["wavelength_nm", "n", "k"];
+/// The header of a table of the complex permittivity.
+const HEADER_EPS: [&str; 3] = ["wavelength_nm", "eps_re", "eps_im"];
+
+/// `n + i k = √ε` with `k ≥ 0` (the principal root; `Im ε ≥ 0` assumed).
+pub fn index_of_epsilon(re: f64, im: f64) -> (f64, f64) {
+    let r = Complex64::new(re, im).sqrt();
+    (r.re, r.im)
+}
 
 /// Where a material's table came from.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -195,6 +206,7 @@ impl Material {
             message,
         };
         let mut header_seen = false;
+        let mut header = HEADER;
         let (mut wl, mut n, mut k) = (Vec::new(), Vec::new(), Vec::new());
         // A UTF-8 byte-order mark (spreadsheet exports) is not part of the header.
         let body = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -206,12 +218,19 @@ impl Material {
             }
             let fields: Vec<&str> = line.split(',').map(str::trim).collect();
             if !header_seen {
-                if fields != HEADER {
-                    return Err(line_err(
-                        line_no,
-                        format!("expected header `wavelength_nm,n,k`, got `{line}`"),
-                    ));
-                }
+                header = match fields.as_slice() {
+                    f if f == HEADER => HEADER,
+                    f if f == HEADER_EPS => HEADER_EPS,
+                    _ => {
+                        return Err(line_err(
+                            line_no,
+                            format!(
+                                "expected header `wavelength_nm,n,k` or \
+                                 `wavelength_nm,eps_re,eps_im`, got `{line}`"
+                            ),
+                        ))
+                    }
+                };
                 header_seen = true;
                 continue;
             }
@@ -219,13 +238,14 @@ impl Material {
                 return Err(line_err(
                     line_no,
                     format!(
-                        "expected 3 fields `wavelength_nm,n,k`, got {}",
+                        "expected 3 fields `{}`, got {}",
+                        header.join(","),
                         fields.len()
                     ),
                 ));
             }
             let mut vals = [0.0f64; 3];
-            for (j, (field, col)) in fields.iter().zip(HEADER).enumerate() {
+            for (j, (field, col)) in fields.iter().zip(header).enumerate() {
                 vals[j] = match field.parse::<f64>() {
                     Ok(v) if v.is_finite() => v,
                     _ => {
@@ -236,7 +256,22 @@ impl Material {
                     }
                 };
             }
-            let [w, nn, kk] = vals;
+            let [w, nn, kk] = if header == HEADER_EPS {
+                let [w, re, im] = vals;
+                if im < 0.0 {
+                    return Err(line_err(
+                        line_no,
+                        format!(
+                            "eps_im must be >= 0 (a medium that absorbs or is lossless), got {}",
+                            num(im)
+                        ),
+                    ));
+                }
+                let (nn, kk) = index_of_epsilon(re, im);
+                [w, nn, kk]
+            } else {
+                vals
+            };
             if w <= 0.0 {
                 return Err(line_err(
                     line_no,
@@ -270,7 +305,8 @@ impl Material {
         if !header_seen {
             return Err(MaterialError::Table {
                 origin: origin.to_string(),
-                message: "no header line `wavelength_nm,n,k`".to_string(),
+                message: "no header line `wavelength_nm,n,k` (or `wavelength_nm,eps_re,eps_im`)"
+                    .to_string(),
             });
         }
         if wl.len() < 2 {
@@ -373,6 +409,21 @@ mod tests {
     }
 
     #[test]
+    fn a_permittivity_table_is_its_square_root() {
+        // ε = (n + ik)² = n² − k² + 2nk i: n = 1.5, k = 0.2 and n = 0.3, k = 3
+        // (a metal: Re ε < 0).
+        let text = "wavelength_nm,eps_re,eps_im\n400,2.21,0.6\n700,-8.91,1.8\n";
+        let m = Material::from_csv_text("eps", text).unwrap();
+        let at = |w: f64| m.index_at(w).unwrap();
+        assert!((at(400.0).re - 1.5).abs() < 1e-12 && (at(400.0).im - 0.2).abs() < 1e-12);
+        assert!((at(700.0).re - 0.3).abs() < 1e-12 && (at(700.0).im - 3.0).abs() < 1e-12);
+        // Between rows, n and k are interpolated as for an index table.
+        assert!((at(550.0).re - 0.9).abs() < 1e-12 && (at(550.0).im - 1.6).abs() < 1e-12);
+        // A lossless dielectric has k = 0 exactly.
+        assert_eq!(index_of_epsilon(2.25, 0.0), (1.5, 0.0));
+    }
+
+    #[test]
     fn bad_tables_name_the_line() {
         let cases = [
             ("wavelength,n,k\n400,1,0\n", "line 1"),
@@ -389,6 +440,22 @@ mod tests {
             ("wavelength_nm,n,k\n400,1,inf\n", "line 2: k: `inf`"),
             ("wavelength_nm,n,k\n400,1,0\n", "at least 2 data rows"),
             ("# only comments\n", "no header"),
+            (
+                "wavelength_nm,eps_re,eps_im\n400,2,-0.1\n",
+                "line 2: eps_im must be >= 0",
+            ),
+            (
+                "wavelength_nm,eps_re,eps_im\n400,-200,0\n",
+                "line 2: n must be in (0, 10], got 0",
+            ),
+            (
+                "wavelength_nm,eps_re,eps_im\n400,-200,1\n",
+                "line 2: k must be in [0, 10], got 14.1",
+            ),
+            (
+                "wavelength_nm,eps,im\n400,2,0\n",
+                "or `wavelength_nm,eps_re,eps_im`",
+            ),
         ];
         for (text, want) in cases {
             let err = Material::from_csv_text("bad", text)

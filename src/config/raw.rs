@@ -208,7 +208,8 @@ pub enum RawOrientation {
     Perpendicular,
 }
 
-/// `{ builtin = "red" }`, `{ csv = "path.csv" }` or `{ index = [n, k] }`.
+/// `{ builtin = "red" }`, `{ csv = "path.csv" }`, `{ index = [n, k] }` or
+/// `{ epsilon = [re, im] }`.
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RawMaterial {
@@ -216,6 +217,8 @@ pub enum RawMaterial {
     Csv(String),
     /// Constant `[n, k]` at every wavelength.
     Index(Vec<f64>),
+    /// Constant complex permittivity `[Re ε, Im ε]` at every wavelength.
+    Epsilon(Vec<f64>),
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,5 +1,5 @@
-//! A material key: a builtin name, a constant `[n, k]`, or a CSV table
-//! (resolved next to the config file).
+//! A material key: a builtin name, a constant `[n, k]` or `[Re ε, Im ε]`,
+//! or a CSV table (resolved next to the config file).
 
 use super::Checker;
 use crate::config::materials::BUILTIN_NAMES;
@@ -33,6 +33,41 @@ impl Checker<'_> {
                 );
                 let name = format!("n{}+{}i", nk[0], nk[1]);
                 Material::from_csv_text(&name, &text).map_err(|e| self.invalid(k, e.to_string()))
+            }
+            RawMaterial::Epsilon(e) => {
+                let k = format!("{key}.epsilon");
+                if e.len() != 2 {
+                    return Err(
+                        self.invalid(k, format!("must be [Re ε, Im ε], got {} values", e.len()))
+                    );
+                }
+                self.range(
+                    &k,
+                    e[1],
+                    (0.0..=100.0).contains(&e[1]),
+                    "[0, 100] for Im ε (a medium that absorbs or is lossless)",
+                )?;
+                self.range(
+                    &k,
+                    e[0],
+                    (-100.0..=100.0).contains(&e[0]),
+                    "Re ε in [-100, 100]",
+                )?;
+                let (n, kk) = crate::config::materials::index_of_epsilon(e[0], e[1]);
+                if !(n > 0.0 && kk <= 10.0) {
+                    return Err(self.invalid(
+                        k,
+                        format!("√ε = {n:.3} + {kk:.3}i is outside n in (0, 10], k in [0, 10]"),
+                    ));
+                }
+                let text = format!(
+                    "wavelength_nm,eps_re,eps_im\n1,{re},{im}\n1000000,{re},{im}\n",
+                    re = e[0],
+                    im = e[1]
+                );
+                let name = format!("eps{}+{}i", e[0], e[1]);
+                Material::from_csv_text(&name, &text)
+                    .map_err(|err| self.invalid(k, err.to_string()))
             }
             RawMaterial::Csv(rel) => {
                 if rel.trim().is_empty() {

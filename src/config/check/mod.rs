@@ -145,7 +145,7 @@ const TAGGED: [(&str, &str); 6] = [
 /// none or several of its kinds.
 fn in_config_terms(msg: &str) -> String {
     const MATERIAL: &str = "a material is a table with exactly one of `builtin`, `csv`, \
-                            `index` (e.g. material = { builtin = \"red\" })";
+                            `index`, `epsilon` (e.g. material = { builtin = \"red\" })";
     if msg.contains("wanted exactly 1 element, more than 1 element") {
         return format!("{MATERIAL}; this one gives more than one");
     }

@@ -9,10 +9,14 @@
 //! run) never sees a half-written result: either the old file or the complete
 //! new one. On any error the temporary file is removed.
 //!
-//! - `result`: the writer ([`ResultSet`] → file);
+//! - `result`: the writer ([`ResultSet`] → file), with `geometry` for the
+//!   `/geometry` group;
 //! - `summary`: the reader of identity and per-solve numbers;
-//! - `appearance`: the `/appearance` group, written and read back;
-//! - `attrs`: scalar and string attribute helpers shared by all of them.
+//! - `appearance`: the `/appearance` group's writer, `appearance_read` its
+//!   readers;
+//! - `attrs`: scalar and string attribute helpers shared by all of them;
+//! - `described`: every dataset's `units`, `description` and axis names,
+//!   written with it; `scales`: the HDF5 dimension scales behind the axes.
 //!
 //! # Layout of a result file (format version 1)
 //!
@@ -94,12 +98,17 @@
 //!   `natural_lab` (V × 3 f64), `tile_png` (u8).
 
 mod appearance;
+mod appearance_read;
 mod attrs;
+mod described;
+mod geometry;
 mod result;
+mod scales;
 mod summary;
 
 pub use crate::output::error::IoError;
-pub use appearance::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
+pub use appearance_read::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
+pub(crate) use described::{about, dim, Scales};
 pub use result::{write_result, GeometrySummary, RealisationStop, ResultSet};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 

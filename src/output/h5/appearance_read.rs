@@ -7,7 +7,7 @@ use super::attrs::read_str_attr;
 use super::IoError;
 
 /// The ensemble-mean appearance arrays of a result file (`/appearance`),
-/// for comparing runs (docs/ACCURACY.md). Shapes as in the module docs.
+/// for comparing runs (docs/ACCURACY.md). Shapes as in docs/FORMAT.md.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AppearanceArrays {
     pub wavelengths_nm: Vec<f64>,

@@ -1,5 +1,5 @@
 //! The writer: a [`ResultSet`] checked, then written atomically in the
-//! layout of the module docs (root attributes, `/config`, `/plan`,
+//! layout of docs/FORMAT.md (root attributes, `/config`, `/plan`,
 //! `/geometry`, `/realisations`, `/solves`, `/summary`, `/picture_png`; the
 //! `/geometry` group through the `geometry` module, the `/appearance` group
 //! through the `appearance` module).
@@ -78,7 +78,7 @@ pub struct GeometrySummary<'a> {
     pub statistics: Option<&'a Statistics>,
 }
 
-/// Write a result file atomically (see the module docs for the layout).
+/// Write a result file atomically (layout: docs/FORMAT.md).
 ///
 /// Writes `<path>.tmp` in the same folder (created if missing), closes and
 /// syncs it, then renames it onto `path`. On any error the temporary file is

@@ -1,5 +1,5 @@
 //! `summary.h5`: external links to every variant file and the table of
-//! the variants (layout in the [merge module docs](super)).
+//! the variants (layout: docs/FORMAT.md).
 
 use super::Row;
 use crate::output::atomic;

@@ -1,7 +1,7 @@
 //! The typed half of `summary.h5`: each axis's settings as numbers, and
 //! every variant's measured colours (XYZ, CIELAB, LCh and their standard
 //! errors) per geometry, so the study's numbers can be analysed without
-//! opening the variant files (layout in the [merge module docs](super)).
+//! opening the variant files (layout: docs/FORMAT.md).
 
 use super::Row;
 use crate::config::Measurement;

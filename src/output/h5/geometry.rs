@@ -5,9 +5,28 @@ use ndarray::Array2;
 
 use super::attrs::{vlu, write_scalar_attr};
 use super::described::{about, dim, Scales};
-use super::result::GeometrySummary;
 use crate::geometry::Statistics;
 
+/// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
+/// `radii_nm`, `particle_of_sphere`) share one length, species arrays
+/// (`species_names` and the three fractions) another.
+#[derive(Debug, Clone, Copy)]
+pub struct GeometrySummary<'a> {
+    pub species_names: &'a [String],
+    pub centers_nm: &'a [[f64; 3]],
+    pub radii_nm: &'a [f64],
+    pub particle_of_sphere: &'a [u32],
+    pub species_of_particle: &'a [u32],
+    pub target_fraction: &'a [f64],
+    pub achieved_fraction: &'a [f64],
+    pub raster_fraction: &'a [f64],
+    /// Smallest surface gap between grains (None: no grains).
+    pub min_gap_nm: Option<f64>,
+    /// Full statistics of the fragment (None: no grains).
+    pub statistics: Option<&'a Statistics>,
+}
+
+/// Write `/geometry` (with `/geometry/statistics` when there are grains).
 pub(super) fn write_geometry(
     s: &mut Scales,
     file: &hdf5::File,

@@ -37,7 +37,8 @@ mod summary;
 pub use crate::output::error::IoError;
 pub use appearance_read::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
 pub(crate) use described::{about, dim, Scales};
-pub use result::{write_result, GeometrySummary, RealisationStop, ResultSet};
+pub use geometry::GeometrySummary;
+pub use result::{write_result, RealisationStop, ResultSet};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 
 /// Version of the layout described in docs/FORMAT.md, stored as `format_version`.

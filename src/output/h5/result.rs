@@ -13,9 +13,8 @@ use ndarray::Array2;
 use super::appearance::write_appearance;
 use super::attrs::{vlu, write_scalar_attr, write_str_attr};
 use super::described::{about, dim, Scales};
-use super::geometry::write_geometry;
+use super::geometry::{write_geometry, GeometrySummary};
 use super::{IoError, FORMAT_VERSION};
-use crate::geometry::Statistics;
 use crate::optics::appearance::Appearance;
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::output::atomic::write_atomic_with;
@@ -57,25 +56,6 @@ pub struct RealisationStop {
     /// Largest standard error of ΔE00 to the mean over the measured colours.
     pub de00_se: f64,
     pub target_met: bool,
-}
-
-/// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
-/// `radii_nm`, `particle_of_sphere`) share one length, species arrays
-/// (`species_names` and the three fractions) another.
-#[derive(Debug, Clone, Copy)]
-pub struct GeometrySummary<'a> {
-    pub species_names: &'a [String],
-    pub centers_nm: &'a [[f64; 3]],
-    pub radii_nm: &'a [f64],
-    pub particle_of_sphere: &'a [u32],
-    pub species_of_particle: &'a [u32],
-    pub target_fraction: &'a [f64],
-    pub achieved_fraction: &'a [f64],
-    pub raster_fraction: &'a [f64],
-    /// Smallest surface gap between grains (None: no grains).
-    pub min_gap_nm: Option<f64>,
-    /// Full statistics of the fragment (None: no grains).
-    pub statistics: Option<&'a Statistics>,
 }
 
 /// Write a result file atomically (layout: docs/FORMAT.md).

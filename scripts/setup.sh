@@ -2,8 +2,9 @@
 # Prepare a fresh Debian/Ubuntu machine to build and test inksim.
 #
 # Expects the Rust toolchain (cargo), a C compiler and python3 to be present.
-# Installs what is missing for the HDF5 bindings: the HDF5 C library and
-# headers come from the distribution's packages (Debian/Ubuntu `libhdf5-dev`),
+# Installs what is missing for the HDF5 bindings: the HDF5 C library, its
+# high-level library (libhdf5_hl, for dimension scales) and headers come from
+# the distribution's packages (Debian/Ubuntu `libhdf5-dev`, which has both),
 # found by the build through `pkg-config`; no HDF5 is built from source and
 # no cmake is needed. With --with-browser it also installs Chromium (Debian
 # package `chromium`), which the test of the study's summary page renders it

@@ -1,10 +1,9 @@
 """The result-file layout as Python sees it: dimensions and units of every
 array, in one table.
 
-This mirrors the layout documented in the Rust module docs of
-``src/output/h5/mod.rs`` (result files, format version 1) and
-``src/study/merge.rs`` (``summary.h5``). HDF5 names stay as they are; the
-dimension names are the axes those docs state:
+This mirrors the layout documented in docs/FORMAT.md (result files, format
+version 1, and a study's ``summary.h5``). HDF5 names stay as they are; the
+dimension names are the axes that document states:
 
 =====================  ====================================================
 dimension              meaning (Rust docs' letter)
@@ -23,13 +22,20 @@ dimension              meaning (Rust docs' letter)
 ``species``            pigment species (S)
 ``realisation``        independent random fragments (R)
 ``xyz``, ``lab``, ``rgb``  components: x, y, z / L*, a*, b* / R, G, B
+``tristimulus``, ``lch``  components: X, Y, Z / L*, C*ab, h_ab (measured colours)
+``z_edge``, ``z``, ``r``  z bin edges and bins of the volume profile, distances of g(r)
+``cluster``            clusters of touching grains, largest first
+``byte``               bytes of an encoded file (PNG)
+``variant``            variants of a study, in expansion order (``summary.h5``)
 =====================  ====================================================
 
 Units use UDUNITS-style spellings: ``nm``, ``nm3`` (nm³), ``deg``, ``1``
 (dimensionless: efficiencies, fractions), ``sr-1`` (per steradian), ``s``.
-A ``units`` attribute stored on an HDF5 dataset takes precedence over this
-table (the Rust writer may add them); the table fills in where the file has
-none.
+What the file says takes precedence over this table: inksim stores a
+``units`` and a ``description`` attribute on every dataset and labels its
+dimensions (HDF5 dimension labels, with the coordinates attached as
+dimension scales), under the same dimension names as here. The table fills
+in for files written before inksim stored them, and names the attributes.
 """
 
 from __future__ import annotations

@@ -4,8 +4,9 @@
 the largest arrays are the particle set and the per-solve orders) and closes
 it, so the returned :class:`Result` holds no open HDF5 handle. Each part of
 the file is an :class:`xarray.Dataset` whose variables keep their HDF5 names
-and carry ``units`` and ``long_name`` attributes; dimensions are those of the
-layout documented in ``src/output/h5/mod.rs`` (see :mod:`inksim._layout`).
+and carry ``units`` and ``long_name`` attributes; dimensions are those the
+file labels (HDF5 dimension labels), else those of the layout in
+docs/FORMAT.md (see :mod:`inksim._layout`).
 """
 
 from __future__ import annotations
@@ -50,8 +51,15 @@ def _read(ds: h5py.Dataset) -> np.ndarray:
     return ds[()]
 
 
+# HDF5 dimension-scale bookkeeping (the H5DS API's attributes): the axes
+# are read from them (``_dims``), they are not metadata of the values.
+_SCALE_ATTRS = {"CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST", "DIMENSION_LABELS"}
+
+
 def _meta(key: str, ds: Optional[h5py.Dataset] = None) -> Dict[str, str]:
-    """``units`` (stored attribute first, then the layout table) and ``long_name``."""
+    """``units`` (stored attribute first, then the layout table),
+    ``long_name`` (the table's, else the stored ``description``) and the
+    dataset's other attributes."""
     stored = ds.attrs.get("units") if ds is not None else None
     out: Dict[str, str] = {}
     u = units_of(key, stored)
@@ -60,15 +68,29 @@ def _meta(key: str, ds: Optional[h5py.Dataset] = None) -> Dict[str, str]:
     try:
         out["long_name"] = lookup(key)[2]
     except KeyError:
-        pass
+        if ds is not None and "description" in ds.attrs:
+            out["long_name"] = _py(ds.attrs["description"])
     if ds is not None:
         for k in ds.attrs.keys():
-            if k not in ("units",):
+            if k != "units" and k not in _SCALE_ATTRS:
                 out.setdefault(k, _py(ds.attrs[k]))
     return out
 
 
-def _dims(key: str, shape: tuple) -> tuple:
+def _stored_dims(ds: Optional[h5py.Dataset]) -> Optional[tuple]:
+    """The axis names the file gives (HDF5 dimension labels), when every
+    axis of ``ds`` has one."""
+    if ds is None or ds.ndim == 0:
+        return None
+    labels = tuple(d.label for d in ds.dims)
+    return labels if all(labels) else None
+
+
+def _dims(key: str, shape: tuple, ds: Optional[h5py.Dataset] = None) -> tuple:
+    """Axis names: the file's dimension labels first, then the layout table's."""
+    stored = _stored_dims(ds)
+    if stored is not None and len(stored) == len(shape):
+        return stored
     try:
         dims = lookup(key)[0]
     except KeyError:
@@ -82,7 +104,7 @@ def _dims(key: str, shape: tuple) -> tuple:
 def _var(key: str, ds: h5py.Dataset, dims: Optional[tuple] = None) -> xr.Variable:
     data = _read(ds)
     if dims is None:
-        dims = _dims(key, data.shape)
+        dims = _dims(key, data.shape, ds)
     return xr.Variable(dims, data, attrs=_meta(key, ds))
 
 

@@ -1,331 +1,363 @@
-//! The `/appearance` group: written from an [`Appearance`] (ensemble means
-//! with their standard errors) and read back as [`AppearanceArrays`].
-
-use std::path::Path;
+//! The `/appearance` group, written from an [`Appearance`] (ensemble means
+//! with their standard errors), every dataset with its units, meaning and
+//! axes; read back by `appearance_read`.
 
 use ndarray::Array2;
 
-use super::attrs::{read_str_attr, write_scalar_attr, write_str_attr};
-use super::IoError;
-use crate::optics::appearance::{Appearance, Estimate, MeasuredColour};
-
-/// The ensemble-mean appearance arrays of a result file (`/appearance`),
-/// for comparing runs (docs/ACCURACY.md). Shapes as in the module docs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AppearanceArrays {
-    pub wavelengths_nm: Vec<f64>,
-    pub illumination_deg: Vec<f64>,
-    pub viewing_deg: Vec<f64>,
-    pub above_deg: Vec<f64>,
-    /// (L, A) each.
-    pub reflectance: ndarray::Array2<f64>,
-    pub transmittance: ndarray::Array2<f64>,
-    pub absorption: ndarray::Array2<f64>,
-    /// (L, I, V), present with the tile.
-    pub brdf_total: Option<ndarray::Array3<f64>>,
-    /// (L, V), present with the tile.
-    pub natural: Option<ndarray::Array2<f64>>,
-    /// CIELAB of the tile's cells (V, 1 + I, 3), present with the tile.
-    pub tile_lab: Option<ndarray::Array3<f64>>,
-}
-
-/// Read the `/appearance` arrays of a result file (None when absent).
-pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError> {
-    let hdf = |source| IoError::Hdf5 {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = hdf5::File::open(path).map_err(hdf)?;
-    if !file.link_exists("appearance") {
-        return Ok(None);
-    }
-    let g = file.group("appearance").map_err(hdf)?;
-    let vec = |name: &str| -> Result<Vec<f64>, IoError> {
-        g.dataset(name).and_then(|d| d.read_raw()).map_err(hdf)
-    };
-    let arr2 = |name: &str| -> Result<ndarray::Array2<f64>, IoError> {
-        g.dataset(name).and_then(|d| d.read()).map_err(hdf)
-    };
-    let brdf_total = if g.link_exists("brdf_total") {
-        Some(
-            g.dataset("brdf_total")
-                .and_then(|d| d.read())
-                .map_err(hdf)?,
-        )
-    } else {
-        None
-    };
-    let natural = if g.link_exists("natural") {
-        Some(arr2("natural")?)
-    } else {
-        None
-    };
-    let tile_lab = if g.link_exists("tile_lab") {
-        Some(g.dataset("tile_lab").and_then(|d| d.read()).map_err(hdf)?)
-    } else {
-        None
-    };
-    Ok(Some(AppearanceArrays {
-        tile_lab,
-        wavelengths_nm: vec("wavelengths_nm")?,
-        illumination_deg: vec("illumination_deg")?,
-        viewing_deg: vec("viewing_deg")?,
-        above_deg: vec("above_deg")?,
-        reflectance: arr2("reflectance")?,
-        transmittance: arr2("transmittance")?,
-        absorption: arr2("absorption")?,
-        brdf_total,
-        natural,
-    }))
-}
+use super::attrs::{write_scalar_attr, write_str_attr};
+use super::described::{about, dim, standard_error, About, Scales};
+use crate::optics::appearance::{Appearance, Colours, Estimate, MeasuredColour};
 
 fn write_estimate<D: ndarray::Dimension>(
+    s: &Scales,
     g: &hdf5::Group,
     name: &str,
     e: &Estimate<D>,
+    a: About,
 ) -> hdf5::Result<()> {
-    g.new_dataset_builder()
-        .with_data(e.mean.view())
-        .create(name)?;
+    s.write(g, name, e.mean.view(), a)?;
     if let Some(se) = &e.se {
-        g.new_dataset_builder()
-            .with_data(se.view())
-            .create(format!("{name}_se").as_str())?;
+        let description = standard_error(a.description);
+        let a = About {
+            description: &description,
+            ..a
+        };
+        s.write(g, &format!("{name}_se"), se.view(), a)?;
     }
     Ok(())
 }
+
+const LA: &[&str] = &[dim::WAVELENGTH, dim::ABOVE];
+const LIV: &[&str] = &[dim::WAVELENGTH, dim::ILLUMINATION, dim::VIEWING];
+const LINN: &[&str] = &[dim::WAVELENGTH, dim::ILLUMINATION, dim::SY, dim::SX];
+const TILE: &[&str] = &[dim::VIEWING, dim::TILE_COLUMN];
 
 pub(super) fn write_appearance(
     file: &hdf5::File,
     a: &Appearance,
     tile_png: Option<&[u8]>,
+    s: &mut Scales,
 ) -> hdf5::Result<()> {
     let g = file.create_group("appearance")?;
     let sp = &a.spec;
     let below = sp.below.as_ref().map(|h| h.polar_deg()).unwrap_or_default();
-    for (name, v) in [
-        ("wavelengths_nm", &sp.wavelengths_nm),
-        ("above_deg", &sp.above_deg),
-        ("illumination_deg", &sp.illumination_deg),
-        ("viewing_deg", &sp.viewing_deg),
-        ("below_deg", &below),
+    for (name, v, units, dims, description) in [
+        (
+            "wavelengths_nm",
+            &sp.wavelengths_nm,
+            "nm",
+            dim::WAVELENGTH,
+            "vacuum wavelengths solved; wavelength",
+        ),
+        (
+            "above_deg",
+            &sp.above_deg,
+            "deg",
+            dim::ABOVE,
+            "polar angles of incidence solved from above (the ink side); \
+             above",
+        ),
+        (
+            "illumination_deg",
+            &sp.illumination_deg,
+            "deg",
+            dim::ILLUMINATION,
+            "illumination polar angles of the BRDF and the tile; \
+             illumination",
+        ),
+        (
+            "viewing_deg",
+            &sp.viewing_deg,
+            "deg",
+            dim::VIEWING,
+            "viewing polar angles in the plane of incidence; viewing",
+        ),
+        (
+            "below_deg",
+            &below,
+            "deg",
+            dim::BELOW,
+            "polar angles of the quadrature nodes solved from below (the layer flipped; \
+             empty without them); below",
+        ),
     ] {
-        g.new_dataset_builder().with_data(&v[..]).create(name)?;
+        s.coordinate(&g, name, v, about(units, description, &[dims]))?;
     }
     write_scalar_attr(&g, "azimuth_deg", sp.azimuth_deg)?;
     write_scalar_attr(&g, "table_cell", sp.table.cell)?;
     write_scalar_attr(&g, "realisations", sp.realisations as u64)?;
-    write_estimate(&g, "reflectance", &a.reflectance)?;
-    write_estimate(&g, "transmittance", &a.transmittance)?;
-    write_estimate(&g, "absorption", &a.absorption)?;
-    for (name, v) in [
-        ("specular_coherent", &a.specular_coherent),
-        ("specular_incoherent", &a.specular_incoherent),
-        ("direct_coherent", &a.direct_coherent),
-        ("direct_incoherent", &a.direct_incoherent),
+    for (name, e, what) in [
+        (
+            "reflectance",
+            &a.reflectance,
+            "total reflectance, all orders",
+        ),
+        (
+            "transmittance",
+            &a.transmittance,
+            "total transmittance, all orders",
+        ),
+        ("absorption", &a.absorption, "absorbed fraction"),
     ] {
-        g.new_dataset_builder().with_data(v.view()).create(name)?;
+        let description = format!("{what}, ensemble mean; wavelength × above");
+        write_estimate(s, &g, name, e, about("1", &description, LA))?;
     }
-    write_estimate(&g, "brdf_table", &a.brdf_table)?;
+    for (name, v, description) in [
+        (
+            "specular_coherent",
+            &a.specular_coherent,
+            "coherent specular reflectance |⟨r00⟩|²; wavelength × above",
+        ),
+        (
+            "specular_incoherent",
+            &a.specular_incoherent,
+            "incoherent specular reflectance ⟨|r00|²⟩ − |⟨r00⟩|²; wavelength × above",
+        ),
+        (
+            "direct_coherent",
+            &a.direct_coherent,
+            "coherent direct transmittance |⟨t00⟩|²; wavelength × above",
+        ),
+        (
+            "direct_incoherent",
+            &a.direct_incoherent,
+            "incoherent direct transmittance ⟨|t00|²⟩ − |⟨t00⟩|²; wavelength × above",
+        ),
+    ] {
+        s.write(&g, name, v.view(), about("1", description, LA))?;
+    }
+    let table = |what: &str| {
+        format!(
+            "{what} power density per projected solid angle on the table nodes \
+             s = sin θ (cos φ, sin φ) = (i − N/2, j − N/2)·table_cell (rows j along s_y); \
+             the {} is bilinear(table) / bilinear(table_coverage); \
+             wavelength × illumination × sy × sx",
+            if what == "reflected" { "BRDF" } else { "BTDF" }
+        )
+    };
+    write_estimate(
+        s,
+        &g,
+        "brdf_table",
+        &a.brdf_table,
+        about("sr-1", &table("reflected"), LINN),
+    )?;
     let nt = sp.table.n();
     let coverage = ndarray::Array2::from_shape_fn((nt, nt), |(j, i)| {
         crate::optics::farfield::table::node_coverage(sp.table, i, j)
     });
-    described(
+    let description = "share of each table node's bilinear kernel above the horizon; the \
+                       BRDF/BTDF is bilinear(table) / bilinear(table_coverage); sy × sx";
+    s.write(
         &g,
         "table_coverage",
         coverage.view(),
-        "1",
-        "share of each table node's bilinear kernel above the horizon; the BRDF/BTDF is \
-         bilinear(table) / bilinear(table_coverage)",
+        about("1", description, &[dim::SY, dim::SX]),
     )?;
-    write_estimate(&g, "brdf_diffuse", &a.brdf_diffuse)?;
+    let description = "diffuse BRDF of the layer alone in the plane of incidence, specular \
+                       side; wavelength × illumination × viewing";
+    write_estimate(
+        s,
+        &g,
+        "brdf_diffuse",
+        &a.brdf_diffuse,
+        about("sr-1", description, LIV),
+    )?;
     if let Some(t) = &a.btdf_table {
-        write_estimate(&g, "btdf_table", t)?;
+        write_estimate(
+            s,
+            &g,
+            "btdf_table",
+            t,
+            about("sr-1", &table("transmitted"), LINN),
+        )?;
     }
     if let Some(t) = &a.btdf_diffuse {
-        write_estimate(&g, "btdf_diffuse", t)?;
+        let description = "diffuse BTDF of the layer alone in the plane of incidence, forward \
+                           side; wavelength × illumination × viewing";
+        write_estimate(s, &g, "btdf_diffuse", t, about("sr-1", description, LIV))?;
     }
     if let Some(p) = &a.paper {
         write_scalar_attr(&g, "paper_albedo", p.albedo)?;
-        write_estimate(&g, "r_dd_up", &p.r_dd_up)?;
-        write_estimate(&g, "t_d", &p.t_d)?;
+        let description =
+            "albedo of the layer for diffuse light from below (the paper's side); wavelength";
+        write_estimate(
+            s,
+            &g,
+            "r_dd_up",
+            &p.r_dd_up,
+            about("1", description, &[dim::WAVELENGTH]),
+        )?;
+        let description = "diffuse transmittance of the layer; wavelength";
+        write_estimate(
+            s,
+            &g,
+            "t_d",
+            &p.t_d,
+            about("1", description, &[dim::WAVELENGTH]),
+        )?;
     }
     if let Some(t) = &a.brdf_total {
-        g.new_dataset_builder()
-            .with_data(t.view())
-            .create("brdf_total")?;
+        let description = "diffuse BRDF of the layer on its substrate in the plane of incidence; \
+                           wavelength × illumination × viewing";
+        s.write(&g, "brdf_total", t.view(), about("sr-1", description, LIV))?;
     }
     if let Some(n) = &a.natural {
-        g.new_dataset_builder()
-            .with_data(n.view())
-            .create("natural")?;
+        let description = "radiance factor under a uniform white sky; wavelength × viewing";
+        s.write(
+            &g,
+            "natural",
+            n.view(),
+            about("1", description, &[dim::WAVELENGTH, dim::VIEWING]),
+        )?;
     }
     if let Some(c) = &a.colours {
-        g.new_dataset_builder()
-            .with_data(c.tile_srgb8.view())
-            .create("tile_srgb8")?;
-        g.new_dataset_builder()
-            .with_data(c.tile_lab.view())
-            .create("tile_lab")?;
-        let rgb = Array2::from_shape_fn((c.natural_srgb8.len(), 3), |(i, j)| c.natural_srgb8[i][j]);
-        g.new_dataset_builder()
-            .with_data(&rgb)
-            .create("natural_srgb8")?;
-        let lab = Array2::from_shape_fn((c.natural_lab.len(), 3), |(i, j)| c.natural_lab[i][j]);
-        g.new_dataset_builder()
-            .with_data(&lab)
-            .create("natural_lab")?;
+        write_colours(s, &g, c)?;
     }
     if let Some((ill, obs)) = a.colour_conditions {
         write_str_attr(&g, "illuminant", ill.name())?;
         write_str_attr(&g, "observer", obs.name())?;
         write_scalar_attr(&g, "observer_deg", obs.degrees())?;
     }
-    if let Some(s) = a.colours.as_ref().and_then(|c| c.spread.as_ref()) {
-        let what = "of the tile's L*, a*, b* (viewing, 1 + illumination, 3)";
-        described(
-            &g,
-            "tile_lab_se",
-            s.lab_se.view(),
-            "1",
-            &format!("standard error {what}"),
-        )?;
-        let what = "of each tile colour in ΔE00 (viewing, 1 + illumination)";
-        described(
-            &g,
-            "tile_de00_se",
-            s.de00_se.view(),
-            "1",
-            &format!("standard error {what}"),
-        )?;
-        let what = "CIELAB of every realisation (realisation, viewing, 1 + illumination, 3)";
-        described(
-            &g,
-            "tile_lab_realisations",
-            s.realisation_lab.view(),
-            "1",
-            what,
-        )?;
-    }
     if !a.measured.is_empty() {
         let mg = g.create_group("measured")?;
         for m in &a.measured {
-            write_measured(&mg, m)?;
+            write_measured(s, &mg, m)?;
         }
     }
     if let Some(png) = tile_png {
-        g.new_dataset_builder().with_data(png).create("tile_png")?;
+        let description = "the tile picture as a PNG file (encoded bytes, no units); byte";
+        s.write(&g, "tile_png", png, about("", description, &[dim::BYTE]))?;
+    }
+    Ok(())
+}
+
+/// The tile's and the white sky's colours, with their spread.
+fn write_colours(s: &Scales, g: &hdf5::Group, c: &Colours) -> hdf5::Result<()> {
+    let cells = "the tile's cells (column 0 under the uniform white sky, then one per \
+                 illumination angle)";
+    let description = format!("sRGB 8-bit code values of {cells}; viewing × tile column × R, G, B");
+    let dims = [dim::VIEWING, dim::TILE_COLUMN, dim::RGB];
+    s.write(
+        g,
+        "tile_srgb8",
+        c.tile_srgb8.view(),
+        about("1", &description, &dims),
+    )?;
+    let description =
+        format!("CIELAB L*, a*, b* (D65 white) of {cells}; viewing × tile column × L*, a*, b*");
+    let dims = [dim::VIEWING, dim::TILE_COLUMN, dim::LAB];
+    s.write(
+        g,
+        "tile_lab",
+        c.tile_lab.view(),
+        about("1", &description, &dims),
+    )?;
+    let rgb = Array2::from_shape_fn((c.natural_srgb8.len(), 3), |(i, j)| c.natural_srgb8[i][j]);
+    let description = "sRGB 8-bit code values under a uniform white sky; viewing × R, G, B";
+    s.write(
+        g,
+        "natural_srgb8",
+        &rgb,
+        about("1", description, &[dim::VIEWING, dim::RGB]),
+    )?;
+    let lab = Array2::from_shape_fn((c.natural_lab.len(), 3), |(i, j)| c.natural_lab[i][j]);
+    let description =
+        "CIELAB L*, a*, b* (D65 white) under a uniform white sky; viewing × L*, a*, b*";
+    s.write(
+        g,
+        "natural_lab",
+        &lab,
+        about("1", description, &[dim::VIEWING, dim::LAB]),
+    )?;
+    if let Some(sp) = &c.spread {
+        let description =
+            "standard error of the tile's L*, a*, b*; viewing × tile column × L*, a*, b*";
+        let dims = [dim::VIEWING, dim::TILE_COLUMN, dim::LAB];
+        s.write(
+            g,
+            "tile_lab_se",
+            sp.lab_se.view(),
+            about("1", description, &dims),
+        )?;
+        let description = "standard error of each tile colour in ΔE00; viewing × tile column";
+        s.write(
+            g,
+            "tile_de00_se",
+            sp.de00_se.view(),
+            about("1", description, TILE),
+        )?;
+        let description =
+            "CIELAB of every realisation's tile; realisation × viewing × tile column × L*, a*, b*";
+        let dims = [dim::REALISATION, dim::VIEWING, dim::TILE_COLUMN, dim::LAB];
+        s.write(
+            g,
+            "tile_lab_realisations",
+            sp.realisation_lab.view(),
+            about("1", description, &dims),
+        )?;
     }
     Ok(())
 }
 
 /// `/appearance/measured/<slug>`: one measurement geometry's colour.
-fn write_measured(parent: &hdf5::Group, m: &MeasuredColour) -> hdf5::Result<()> {
+fn write_measured(s: &mut Scales, parent: &hdf5::Group, m: &MeasuredColour) -> hdf5::Result<()> {
     let g = parent.create_group(m.geometry.slug())?;
     write_str_attr(&g, "geometry", m.geometry.name())?;
-    write_estimate(&g, "reflectance_factor", &m.reflectance)?;
-    let vector = |name: &str, data: &[f64], units: &str, desc: &str| {
-        described(&g, name, ndarray::aview1(data), units, desc)
-    };
-    vector(
+    let description = "reflectance factor in this geometry at the solved wavelengths; wavelength";
+    write_estimate(
+        s,
+        &g,
+        "reflectance_factor",
+        &m.reflectance,
+        about("1", description, &[dim::WAVELENGTH]),
+    )?;
+    let description =
+        "wavelengths of the spectrum the colour is integrated from; spectrum wavelength";
+    s.coordinate(
+        &g,
         "spectrum_wavelengths_nm",
         &m.spectrum_wavelengths_nm,
-        "nm",
-        "wavelengths of the spectrum colour is integrated from",
+        about("nm", description, &[dim::SPECTRUM_WAVELENGTH]),
     )?;
-    vector(
+    // One coordinate per geometry: the next geometry's replaces it.
+    let description = "reflectance factor the colour is integrated from (through the spectral \
+                       proxy where there is one); spectrum wavelength";
+    s.write(
+        &g,
         "spectrum",
-        &m.spectrum,
-        "1",
-        "reflectance factor colour is integrated from (through the spectral proxy where there is one)",
+        &m.spectrum[..],
+        about("1", description, &[dim::SPECTRUM_WAVELENGTH]),
     )?;
-    vector("xyz", &m.xyz, "1", "CIE XYZ, white Y = 100")?;
-    vector("lab", &m.lab, "1", "CIELAB L*, a*, b*")?;
-    vector("lch", &m.lch, "1, 1, deg", "CIE LCh(ab): L*, C*ab, h_ab")?;
+    s.forget(dim::SPECTRUM_WAVELENGTH);
+    let vector = |name: &str, data: &[f64], units: &str, description: &str, d: &str| {
+        s.write(&g, name, data, about(units, description, &[d]))
+    };
+    vector(
+        "xyz",
+        &m.xyz,
+        "1",
+        "CIE XYZ, white Y = 100; X, Y, Z",
+        dim::TRISTIMULUS,
+    )?;
+    vector("lab", &m.lab, "1", "CIELAB L*, a*, b*", dim::LAB)?;
+    vector(
+        "lch",
+        &m.lch,
+        "1, 1, deg",
+        "CIE LCh(ab): L*, C*ab, h_ab",
+        dim::LCH,
+    )?;
     if let (Some(se), Some(de)) = (m.lab_se, m.de00_se) {
-        vector("lab_se", &se, "1", "standard errors of L*, a*, b*")?;
         vector(
-            "de00_se",
-            &[de],
+            "lab_se",
+            &se,
             "1",
-            "standard error of the colour in ΔE00",
+            "standard errors of L*, a*, b*",
+            dim::LAB,
         )?;
+        let description = "standard error of the colour in ΔE00 (one value)";
+        vector("de00_se", &[de], "1", description, dim::VALUE)?;
     }
     Ok(())
-}
-
-/// A dataset with `units` and `description` attributes.
-fn described<D: ndarray::Dimension>(
-    g: &hdf5::Group,
-    name: &str,
-    data: ndarray::ArrayView<'_, f64, D>,
-    units: &str,
-    description: &str,
-) -> hdf5::Result<()> {
-    let d = g.new_dataset_builder().with_data(data).create(name)?;
-    write_str_attr(&d, "units", units)?;
-    write_str_attr(&d, "description", description)
-}
-
-/// One measurement geometry's colour as read back from a result file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MeasuredRecord {
-    /// The geometry's name (`45/0`, `d/8 SCI`, `d/8 SCE`).
-    pub geometry: String,
-    pub lab: [f64; 3],
-    /// CIE XYZ (Y of the perfect diffuser = 100).
-    pub xyz: [f64; 3],
-    /// Standard errors of L*, a*, b* and of ΔE00 (two or more realisations).
-    pub lab_se: Option<[f64; 3]>,
-    pub de00_se: Option<f64>,
-}
-
-/// The measured colours of a result file (`/appearance/measured`) and the
-/// illuminant and observer (degrees) they were computed for; `None` when the
-/// file has none.
-pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String, u32)>, IoError> {
-    let hdf = |source| IoError::Hdf5 {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = hdf5::File::open(path).map_err(hdf)?;
-    if !file.link_exists("appearance/measured") {
-        return Ok(None);
-    }
-    let g = file.group("appearance").map_err(hdf)?;
-    let illuminant = read_str_attr(&g, "illuminant").map_err(hdf)?;
-    let observer: u32 = g
-        .attr("observer_deg")
-        .and_then(|a| a.read_scalar())
-        .map_err(hdf)?;
-    let three = |d: &hdf5::Group, name: &str| -> Result<Option<[f64; 3]>, IoError> {
-        if !d.link_exists(name) {
-            return Ok(None);
-        }
-        let v: Vec<f64> = d.dataset(name).and_then(|x| x.read_raw()).map_err(hdf)?;
-        Ok(Some([v[0], v[1], v[2]]))
-    };
-    let mg = g.group("measured").map_err(hdf)?;
-    let mut out = Vec::new();
-    for name in mg.member_names().map_err(hdf)? {
-        let d = mg.group(&name).map_err(hdf)?;
-        let de00_se = if d.link_exists("de00_se") {
-            let v: Vec<f64> = d
-                .dataset("de00_se")
-                .and_then(|x| x.read_raw())
-                .map_err(hdf)?;
-            v.first().copied()
-        } else {
-            None
-        };
-        out.push(MeasuredRecord {
-            geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
-            lab: three(&d, "lab")?.unwrap_or([f64::NAN; 3]),
-            xyz: three(&d, "xyz")?.unwrap_or([f64::NAN; 3]),
-            lab_se: three(&d, "lab_se")?,
-            de00_se,
-        });
-    }
-    Ok(Some((out, illuminant, observer)))
 }

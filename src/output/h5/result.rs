@@ -1,7 +1,8 @@
 //! The writer: a [`ResultSet`] checked, then written atomically in the
-//! layout of the module docs (root attributes, `/config`, `/plan`,
+//! layout of docs/FORMAT.md (root attributes, `/config`, `/plan`,
 //! `/geometry`, `/realisations`, `/solves`, `/summary`, `/picture_png`; the
-//! `/appearance` group through the `appearance` module).
+//! `/geometry` group through the `geometry` module, the `/appearance` group
+//! through the `appearance` module).
 
 use std::path::Path;
 
@@ -11,8 +12,9 @@ use ndarray::Array2;
 
 use super::appearance::write_appearance;
 use super::attrs::{vlu, write_scalar_attr, write_str_attr};
+use super::described::{about, dim, Scales};
+use super::geometry::{write_geometry, GeometrySummary};
 use super::{IoError, FORMAT_VERSION};
-use crate::geometry::Statistics;
 use crate::optics::appearance::Appearance;
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::output::atomic::write_atomic_with;
@@ -56,26 +58,7 @@ pub struct RealisationStop {
     pub target_met: bool,
 }
 
-/// Statistics of the generated fragment. Sphere arrays (`centers_nm`,
-/// `radii_nm`, `particle_of_sphere`) share one length, species arrays
-/// (`species_names` and the three fractions) another.
-#[derive(Debug, Clone, Copy)]
-pub struct GeometrySummary<'a> {
-    pub species_names: &'a [String],
-    pub centers_nm: &'a [[f64; 3]],
-    pub radii_nm: &'a [f64],
-    pub particle_of_sphere: &'a [u32],
-    pub species_of_particle: &'a [u32],
-    pub target_fraction: &'a [f64],
-    pub achieved_fraction: &'a [f64],
-    pub raster_fraction: &'a [f64],
-    /// Smallest surface gap between grains (None: no grains).
-    pub min_gap_nm: Option<f64>,
-    /// Full statistics of the fragment (None: no grains).
-    pub statistics: Option<&'a Statistics>,
-}
-
-/// Write a result file atomically (see the module docs for the layout).
+/// Write a result file atomically (layout: docs/FORMAT.md).
 ///
 /// Writes `<path>.tmp` in the same folder (created if missing), closes and
 /// syncs it, then renames it onto `path`. On any error the temporary file is
@@ -217,62 +200,44 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
         .with_data(&set.size_nm[..])
         .create("size_nm")?;
 
-    file.new_dataset::<VarLenUnicode>()
-        .shape(())
-        .create("config")?
-        .write_scalar(&vlu(set.config_text)?)?;
-    file.new_dataset::<VarLenUnicode>()
-        .shape(())
-        .create("plan")?
-        .write_scalar(&vlu(set.plan)?)?;
+    let mut scales = Scales::default();
+    let s = &mut scales;
+    for (name, text, description) in [
+        (
+            "config",
+            set.config_text,
+            "the scene's exact TOML text (text, no units)",
+        ),
+        (
+            "plan",
+            set.plan,
+            "the run's plan, one line per decision (text, no units)",
+        ),
+    ] {
+        let d = file.new_dataset::<VarLenUnicode>().shape(()).create(name)?;
+        d.write_scalar(&vlu(text)?)?;
+        s.describe(&d, about("", description, &[]))?;
+    }
 
-    let g = &set.geometry;
-    let geo = file.create_group("geometry")?;
-    let centers = Array2::from_shape_fn((g.centers_nm.len(), 3), |(i, j)| g.centers_nm[i][j]);
-    geo.new_dataset_builder()
-        .with_data(&centers)
-        .create("centers_nm")?;
-    geo.new_dataset_builder()
-        .with_data(g.radii_nm)
-        .create("radii_nm")?;
-    geo.new_dataset_builder()
-        .with_data(g.particle_of_sphere)
-        .create("particle_of_sphere")?;
-    geo.new_dataset_builder()
-        .with_data(g.species_of_particle)
-        .create("species_of_particle")?;
-    let names = g
-        .species_names
-        .iter()
-        .map(|s| vlu(s))
-        .collect::<hdf5::Result<Vec<_>>>()?;
-    geo.new_dataset_builder()
-        .with_data(&names[..])
-        .create("species_names")?;
-    geo.new_dataset_builder()
-        .with_data(g.target_fraction)
-        .create("target_fraction")?;
-    geo.new_dataset_builder()
-        .with_data(g.achieved_fraction)
-        .create("achieved_fraction")?;
-    geo.new_dataset_builder()
-        .with_data(g.raster_fraction)
-        .create("raster_fraction")?;
-    if let Some(gap) = g.min_gap_nm {
-        write_scalar_attr(&geo, "min_gap_nm", gap)?;
-    }
-    if let Some(st) = g.statistics {
-        write_statistics(&geo.create_group("statistics")?, st)?;
-    }
+    write_geometry(s, file, &set.geometry)?;
     let real = file.create_group("realisations")?;
     let seeds: Vec<u64> = set.realisations.iter().map(|r| r.0).collect();
     let pvc: Vec<f64> = set.realisations.iter().map(|r| r.1).collect();
-    real.new_dataset_builder()
-        .with_data(&seeds[..])
-        .create("seed")?;
-    real.new_dataset_builder()
-        .with_data(&pvc[..])
-        .create("achieved_pvc")?;
+    let description = "seed of each random fragment (realisation); realisation";
+    let realisation = &[dim::REALISATION][..];
+    s.write(
+        &real,
+        "seed",
+        &seeds[..],
+        about("1", description, realisation),
+    )?;
+    let description = "pigment volume concentration each fragment achieved; realisation";
+    s.write(
+        &real,
+        "achieved_pvc",
+        &pvc[..],
+        about("1", description, realisation),
+    )?;
     if let Some(stop) = set.realisation_stop {
         write_scalar_attr(&real, "target_de00_se", stop.target_de00)?;
         write_scalar_attr(&real, "achieved_de00_se", stop.de00_se)?;
@@ -290,8 +255,8 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     let solves = file.create_group("solves")?;
     let mut rows = Vec::with_capacity(set.entries.len());
     for (i, e) in set.entries.iter().enumerate() {
-        let s = solves.create_group(&format!("{i:04}"))?;
-        write_entry(&s, e)?;
+        let solve = solves.create_group(&format!("{i:04}"))?;
+        write_entry(s, &solve, e)?;
         let eff = &e.efficiencies;
         rows.push(SummaryRow {
             wavelength_nm: e.wavelength_nm,
@@ -310,14 +275,14 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
             realisation: e.realisation as u64,
         });
     }
-    let summary = file
-        .new_dataset_builder()
-        .with_data(&rows[..])
-        .create("summary")?;
-    write_str_attr(
-        &summary,
-        "description",
-        "one row per solve, in solve order; select side == 0 for what a viewer sees",
+    let description = "one row per solve, in solve order; select side == 0 for what a viewer \
+                       sees; units and meaning per field in the attributes <field>_units and \
+                       <field>_description (a table of mixed units: no units of its own); solve";
+    let summary = s.write(
+        file,
+        "summary",
+        &rows[..],
+        about("", description, &[dim::SOLVE]),
     )?;
     for (field, units, description) in SUMMARY_FIELDS {
         write_str_attr(&summary, &format!("{field}_units"), units)?;
@@ -325,54 +290,21 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     }
 
     if let Some(png) = set.picture_png {
-        file.new_dataset_builder()
-            .with_data(png)
-            .create("picture_png")?;
+        let description = "the rendered picture as a PNG file (encoded bytes, no units); byte";
+        s.write(
+            file,
+            "picture_png",
+            png,
+            about("", description, &[dim::BYTE]),
+        )?;
     }
     if let Some(app) = set.appearance {
-        write_appearance(file, app, set.tile_png)?;
+        write_appearance(file, app, set.tile_png, s)?;
     }
     file.flush()
 }
 
-fn write_statistics(g: &hdf5::Group, st: &Statistics) -> hdf5::Result<()> {
-    for (name, v) in [
-        ("pvc_total", st.pvc_total),
-        ("min_gap_nm", st.min_gap_nm),
-        ("worst_overlap_nm", st.worst_overlap_nm),
-        ("mean_diameter_nm", st.mean_diameter_nm),
-        ("protrusion_nm", st.protrusion_nm),
-        ("bottom_excess_nm", st.bottom_excess_nm),
-        ("rdf_slab_nm", st.rdf_slab_nm),
-        ("contact_gap_nm", st.contact_gap_nm),
-    ] {
-        write_scalar_attr(g, name, v)?;
-    }
-    if let Some(s) = st.order_parameter {
-        write_scalar_attr(g, "order_parameter", s)?;
-    }
-    let count: Vec<u64> = st.count.iter().map(|&c| c as u64).collect();
-    let clusters: Vec<u64> = st.cluster_sizes.iter().map(|&c| c as u64).collect();
-    g.new_dataset_builder()
-        .with_data(&count[..])
-        .create("count")?;
-    g.new_dataset_builder()
-        .with_data(&clusters[..])
-        .create("cluster_sizes")?;
-    for (name, v) in [
-        ("volume_nm3", &st.volume_nm3),
-        ("pvc", &st.pvc),
-        ("profile_z_nm", &st.profile_z_nm),
-        ("profile_fraction", &st.profile_fraction),
-        ("rdf_r_nm", &st.rdf_r_nm),
-        ("rdf", &st.rdf),
-    ] {
-        g.new_dataset_builder().with_data(&v[..]).create(name)?;
-    }
-    Ok(())
-}
-
-fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
+fn write_entry(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
     let eff = &e.efficiencies;
     let rec = &e.record;
     for (name, v) in [
@@ -409,20 +341,49 @@ fn write_entry(g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
             eff.orders[i].n
         }
     });
-    let orders_mn = g.new_dataset_builder().with_data(&mn).create("orders_mn")?;
-    write_str_attr(&orders_mn, "description", ORDER_CONVENTION)?;
+    let description =
+        format!("indices of the propagating orders; order × (m, n). {ORDER_CONVENTION}");
+    s.write(
+        g,
+        "orders_mn",
+        &mn,
+        about("1", &description, &[dim::ORDER, dim::MN]),
+    )?;
     let column = |f: fn(&crate::optics::farfield::Order) -> f64| {
         eff.orders.iter().map(f).collect::<Vec<_>>()
     };
-    for (name, values) in [
-        ("orders_theta_deg", column(|o| o.theta_deg)),
-        ("orders_phi_deg", column(|o| o.phi_deg)),
-        ("orders_reflectance", column(|o| o.reflectance)),
-        ("orders_transmittance", column(|o| o.transmittance)),
+    for (name, values, units, description) in [
+        (
+            "orders_theta_deg",
+            column(|o| o.theta_deg),
+            "deg",
+            "polar angle each order leaves at; order",
+        ),
+        (
+            "orders_phi_deg",
+            column(|o| o.phi_deg),
+            "deg",
+            "azimuth each order leaves at; order",
+        ),
+        (
+            "orders_reflectance",
+            column(|o| o.reflectance),
+            "1",
+            "share of the incident power reflected into each order; order",
+        ),
+        (
+            "orders_transmittance",
+            column(|o| o.transmittance),
+            "1",
+            "share of the incident power transmitted into each order; order",
+        ),
     ] {
-        g.new_dataset_builder()
-            .with_data(&values[..])
-            .create(name)?;
+        s.write(
+            g,
+            name,
+            &values[..],
+            about(units, description, &[dim::ORDER]),
+        )?;
     }
     Ok(())
 }

@@ -6,20 +6,10 @@
 //! them.
 //!
 //! Written into the study folder, each atomically:
-//! - `summary.h5`: group `/variants` with one HDF5 *external link* per
-//!   variant (`/variants/<name>` → `variants/<name>.h5:/`, a path relative
-//!   to the summary file, so the folder can be moved), and a table of the
-//!   variants as parallel 1-D datasets in expansion order: `name`, `id`
-//!   (UTF-8), `seed` (u64), `mean_reflectance`, `mean_transmittance`,
-//!   `mean_absorption` (f64, means over the solves), `natural_srgb8` (n × 3
-//!   u8, sRGB under natural light at the first viewing angle; `has_colour`
-//!   (u8) says whether the result had an `/appearance` group) and
-//!   `labels/<axis>` (UTF-8, empty where a variant has no label on that axis);
-//!   `values/<axis>/<key>` (f64, NaN off the axis) for every key an axis sets
-//!   to a number; `colour/<geometry>/{xyz, lab, lch, lab_se}` (n × 3) and
-//!   `de00_se` (n) per measurement geometry (`45_0`, `d8_sci`, `d8_sce`; NaN
-//!   where a variant has none), attributes `illuminant`, `observer_deg` on
-//!   `colour`. Root attributes `study`, `profile`, `sweep_file`.
+//! - `summary.h5`: one HDF5 external link per variant (`/variants/<name>`)
+//!   and the table of the variants (names, seeds, means, colours, axis
+//!   labels and values), every dataset with `units`, `description` and
+//!   labelled axes; layout for users in docs/FORMAT.md.
 //! - `grids/<grid>[__<axis>-<label>…].png`: for each declared grid (or the
 //!   default: first axis as rows, second as columns), one picture per
 //!   combination of the labels of the remaining axes not fixed by `where`;

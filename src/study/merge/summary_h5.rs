@@ -1,8 +1,9 @@
 //! `summary.h5`: external links to every variant file and the table of
-//! the variants (layout in the [merge module docs](super)).
+//! the variants (layout: docs/FORMAT.md).
 
 use super::Row;
 use crate::output::atomic;
+use crate::output::h5::{about, dim, Scales};
 use crate::study::sweep::{Expansion, Study};
 use crate::study::StudyError;
 use hdf5::types::VarLenUnicode;
@@ -48,32 +49,44 @@ pub(super) fn write_summary_h5(
         let strings = |xs: Vec<String>| -> Result<Vec<VarLenUnicode>, StudyError> {
             xs.iter().map(|s| vlu(path, s)).collect()
         };
+        let mut scales = Scales::default();
+        let variant = &[dim::VARIANT][..];
         let names = strings(rows.iter().map(|r| r.v.name.clone()).collect())?;
-        f.new_dataset_builder()
-            .with_data(&names)
-            .create("name")
+        let description = "variant names (labels, no units), in expansion order; variant";
+        scales
+            .coordinate(&f, "name", &names, about("", description, variant))
             .map_err(h)?;
         let ids = strings(rows.iter().map(|r| r.v.id.clone()).collect())?;
-        f.new_dataset_builder()
-            .with_data(&ids)
-            .create("id")
+        let description = "variant ids: the first 8 hex digits of the SHA-256 of the name \
+                           (labels, no units); variant";
+        scales
+            .write(&f, "id", &ids[..], about("", description, variant))
             .map_err(h)?;
         let seeds: Vec<u64> = rows.iter().map(|r| r.v.seed).collect();
-        f.new_dataset_builder()
-            .with_data(&seeds)
-            .create("seed")
+        let description = "seed of each variant's scene; variant";
+        scales
+            .write(&f, "seed", &seeds[..], about("1", description, variant))
             .map_err(h)?;
-        for (n, xs) in [
+        for (n, xs, what) in [
             (
                 "mean_reflectance",
                 rows.iter().map(|r| r.r).collect::<Vec<f64>>(),
+                "total reflectance",
             ),
-            ("mean_transmittance", rows.iter().map(|r| r.t).collect()),
-            ("mean_absorption", rows.iter().map(|r| r.a).collect()),
+            (
+                "mean_transmittance",
+                rows.iter().map(|r| r.t).collect(),
+                "total transmittance",
+            ),
+            (
+                "mean_absorption",
+                rows.iter().map(|r| r.a).collect(),
+                "absorbed fraction",
+            ),
         ] {
-            f.new_dataset_builder()
-                .with_data(&xs)
-                .create(n)
+            let description = format!("{what}, mean over the variant's solves from above; variant");
+            scales
+                .write(&f, n, &xs[..], about("1", &description, variant))
                 .map_err(h)?;
         }
         let mut rgb = ndarray::Array2::<u8>::zeros((rows.len(), 3));
@@ -88,13 +101,20 @@ pub(super) fn write_summary_h5(
                 has[i] = 1;
             }
         }
-        f.new_dataset_builder()
-            .with_data(&rgb)
-            .create("natural_srgb8")
+        let description = "sRGB 8-bit code values under a uniform white sky at the first \
+                           viewing angle (0 where has_colour is 0); variant × R, G, B";
+        scales
+            .write(
+                &f,
+                "natural_srgb8",
+                &rgb,
+                about("1", description, &[dim::VARIANT, dim::RGB]),
+            )
             .map_err(h)?;
-        f.new_dataset_builder()
-            .with_data(&has)
-            .create("has_colour")
+        let description = "1 where the variant's result has colours (an /appearance group \
+                           with the tile), else 0; variant";
+        scales
+            .write(&f, "has_colour", &has[..], about("1", description, variant))
             .map_err(h)?;
         let lg = f.create_group("labels").map_err(h)?;
         for a in &study.axes {
@@ -103,13 +123,18 @@ pub(super) fn write_summary_h5(
                     .map(|r| r.v.label(&a.name).unwrap_or("").to_string())
                     .collect(),
             )?;
-            lg.new_dataset_builder()
-                .with_data(&ls)
-                .create(a.name.as_str())
+            let description = format!(
+                "label of each variant on axis `{}` (\"\": not on this axis; labels, no units); variant",
+                a.name
+            );
+            scales
+                .write(&lg, &a.name, &ls[..], about("", &description, variant))
                 .map_err(h)?;
         }
-        super::summary_values::write_axis_values(&f, study, rows).map_err(h)?;
-        super::summary_values::write_colours(&f, rows)?;
+        super::summary_values::write_axis_values(&f, study, rows, &scales).map_err(h)?;
+        super::summary_values::write_colours(&f, rows, &scales)?;
+        // The scales hold datasets open; the file closes with the last handle.
+        drop(scales);
         f.close().map_err(h)?;
         Ok(())
     })

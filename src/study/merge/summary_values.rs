@@ -1,12 +1,12 @@
 //! The typed half of `summary.h5`: each axis's settings as numbers, and
 //! every variant's measured colours (XYZ, CIELAB, LCh and their standard
 //! errors) per geometry, so the study's numbers can be analysed without
-//! opening the variant files (layout in the [merge module docs](super)).
+//! opening the variant files (layout: docs/FORMAT.md).
 
 use super::Row;
 use crate::config::Measurement;
 use crate::optics::colour;
-use crate::output::h5::{self, MeasuredRecord};
+use crate::output::h5::{self, about, dim, MeasuredRecord, Scales};
 use crate::study::run;
 use crate::study::sweep::Study;
 use crate::study::StudyError;
@@ -19,7 +19,12 @@ use toml::Value;
 /// or float) in all of its values, that number per variant (NaN for a
 /// variant without a label on the axis). Keys set to anything else (tables,
 /// strings) are described by the axis's labels (`labels/<axis>`).
-pub(super) fn write_axis_values(f: &hdf5::File, study: &Study, rows: &[Row]) -> hdf5::Result<()> {
+pub(super) fn write_axis_values(
+    f: &hdf5::File,
+    study: &Study,
+    rows: &[Row],
+    scales: &Scales,
+) -> hdf5::Result<()> {
     let g = f.create_group("values")?;
     for axis in &study.axes {
         // key → label → number, kept only when every value sets it to one.
@@ -52,20 +57,26 @@ pub(super) fn write_axis_values(f: &hdf5::File, study: &Study, rows: &[Row]) -> 
                         .unwrap_or(f64::NAN)
                 })
                 .collect();
-            let d = ag.new_dataset_builder().with_data(&col).create(key)?;
-            let text: VarLenUnicode = format!(
-                "the value of `{key}` that axis `{}` sets, per variant (NaN: not on this axis)",
+            let description = format!(
+                "the value of `{key}` that axis `{}` sets, per variant (NaN: not on this \
+                 axis); variant",
                 axis.name
-            )
-            .parse()
-            .expect("no NUL");
-            d.new_attr::<VarLenUnicode>()
-                .shape(())
-                .create("description")?
-                .write_scalar(&text)?;
+            );
+            let a = about(units_of_key(key), &description, &[dim::VARIANT]);
+            scales.write(&ag, key, &col, a)?;
         }
     }
     Ok(())
+}
+
+/// Units of a scene key's number: scene keys name them by suffix (`_nm`,
+/// `_nm3`, `_deg`); a key without one is a plain number.
+fn units_of_key(key: &str) -> &'static str {
+    let last = key.rsplit('.').next().unwrap_or(key);
+    [("_nm", "nm"), ("_nm3", "nm3"), ("_deg", "deg")]
+        .into_iter()
+        .find(|(suffix, _)| last.ends_with(suffix))
+        .map_or("1", |(_, units)| units)
 }
 
 /// `colour/<geometry>/{xyz, lab, lch, lab_se, de00_se}` (n × 3, n): each
@@ -73,7 +84,11 @@ pub(super) fn write_axis_values(f: &hdf5::File, study: &Study, rows: &[Row]) -> 
 /// error where it has one realisation of a random layer; 0 for a layer with
 /// nothing random), with the illuminant and observer as
 /// attributes of `colour`.
-pub(super) fn write_colours(f: &hdf5::File, rows: &[Row]) -> Result<(), StudyError> {
+pub(super) fn write_colours(
+    f: &hdf5::File,
+    rows: &[Row],
+    scales: &Scales,
+) -> Result<(), StudyError> {
     let n = rows.len();
     let mut per_variant: Vec<Vec<MeasuredRecord>> = Vec::with_capacity(n);
     let mut conditions: Option<(String, u32)> = None;
@@ -116,45 +131,50 @@ pub(super) fn write_colours(f: &hdf5::File, rows: &[Row]) -> Result<(), StudyErr
             Array2::from_shape_fn((n, 3), |(i, c)| found[i].as_ref().map_or(nan3, pick)[c])
         };
         let mg = g.create_group(m.slug()).map_err(h)?;
-        let sets: [(&str, Array2<f64>, &str); 4] = [
+        let sets: [(&str, Array2<f64>, &str, &str, &str); 4] = [
             (
                 "xyz",
                 three(&|x| x.xyz),
-                "CIE XYZ, Y of the perfect diffuser = 100",
+                "1",
+                "CIE XYZ, Y of the perfect diffuser = 100; variant × X, Y, Z",
+                dim::TRISTIMULUS,
             ),
-            ("lab", three(&|x| x.lab), "CIELAB L*, a*, b*"),
+            (
+                "lab",
+                three(&|x| x.lab),
+                "1",
+                "CIELAB L*, a*, b*; variant × L*, a*, b*",
+                dim::LAB,
+            ),
             (
                 "lch",
                 three(&|x| colour::lab_to_lch(x.lab)),
-                "L*, C*ab, hab (degrees)",
+                "1, 1, deg",
+                "L*, C*ab, hab (degrees); variant × L*, C*ab, hab",
+                dim::LCH,
             ),
             (
                 "lab_se",
                 three(&|x| x.lab_se.unwrap_or(nan3)),
-                "standard errors of L*, a*, b* over the realisations (0: nothing random in the layer; NaN: one realisation of a random layer)",
+                "1",
+                "standard errors of L*, a*, b* over the realisations (0: nothing random in the \
+                 layer; NaN: one realisation of a random layer); variant × L*, a*, b*",
+                dim::LAB,
             ),
         ];
-        for (name, data, description) in sets {
-            let d = mg
-                .new_dataset_builder()
-                .with_data(&data)
-                .create(name)
-                .map_err(h)?;
-            let text: VarLenUnicode = description.parse().expect("no NUL");
-            d.new_attr::<VarLenUnicode>()
-                .shape(())
-                .create("description")
-                .and_then(|a| a.write_scalar(&text))
-                .map_err(h)?;
+        for (name, data, units, description, d) in sets {
+            let dims = [dim::VARIANT, d];
+            let a = about(units, description, &dims);
+            scales.write(&mg, name, &data, a).map_err(h)?;
         }
         let de: Array1<f64> = found
             .iter()
             .map(|x| x.as_ref().and_then(|x| x.de00_se).unwrap_or(f64::NAN))
             .collect();
-        mg.new_dataset_builder()
-            .with_data(&de)
-            .create("de00_se")
-            .map_err(h)?;
+        let description = "standard error of each variant's colour in ΔE00 over the \
+                           realisations (NaN: none); variant";
+        let a = about("1", description, &[dim::VARIANT]);
+        scales.write(&mg, "de00_se", &de, a).map_err(h)?;
     }
     Ok(())
 }

@@ -18,6 +18,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use crate::output::error::IoError;
+use crate::output::temp_name::is_temp_suffix;
+pub use crate::output::temp_name::output_of;
 
 /// Temporary files this process is writing now.
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -56,39 +58,6 @@ pub fn stale_temporaries(target: &Path) -> Vec<PathBuf> {
                 .is_some_and(|rest| is_temp_suffix(&rest))
         })
         .collect()
-}
-
-/// The output a temporary file is written for (`<name>` of
-/// `<name>.<pid>-<n>.tmp` or `<name>.tmp`); any other path is itself.
-pub fn output_of(path: &Path) -> PathBuf {
-    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
-        return path.to_path_buf();
-    };
-    // The suffix starts at one of the name's dots.
-    for (i, _) in name.match_indices('.') {
-        if i > 0 && is_temp_suffix(&name[i..]) {
-            return path.with_file_name(&name[..i]);
-        }
-    }
-    path.to_path_buf()
-}
-
-/// `.tmp` or `.<digits>-<digits>.tmp`.
-fn is_temp_suffix(rest: &str) -> bool {
-    let Some(mid) = rest.strip_suffix(".tmp") else {
-        return false;
-    };
-    if mid.is_empty() {
-        return true;
-    }
-    let Some(mid) = mid.strip_prefix('.') else {
-        return false;
-    };
-    let Some((pid, n)) = mid.split_once('-') else {
-        return false;
-    };
-    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    digits(pid) && digits(n)
 }
 
 fn folder_of(target: &Path) -> PathBuf {

@@ -34,7 +34,9 @@ const DISK_FULL: &str = "the disk is full (no space left on device); the file's 
 /// The output a path names: a temporary file being written
 /// (`<name>.<pid>-<n>.tmp`) is shown as the output it was to become.
 fn shown(path: &std::path::Path) -> String {
-    crate::output::atomic::output_of(path).display().to_string()
+    crate::output::temp_name::output_of(path)
+        .display()
+        .to_string()
 }
 
 fn io_message(e: &std::io::Error) -> String {

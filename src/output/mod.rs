@@ -22,3 +22,4 @@ pub mod merl;
 pub mod progress;
 pub mod render;
 pub mod space;
+mod temp_name;

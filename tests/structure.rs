@@ -73,7 +73,7 @@ fn boxes_are_exact_and_curved_bodies_keep_their_volume() {
         };
         let r = rasterize_primitives(
             &[Primitive {
-                body,
+                body: body.clone(),
                 material: material(),
             }],
             &g,
@@ -415,4 +415,108 @@ fn bodies_thinner_than_a_cell_are_named_and_the_error_table_is_not_applied() {
         text.contains("not estimated for an explicit structure") && !text.contains("lateral cell"),
         "{text}"
     );
+}
+
+/// A layered structure (`kind = "layers"`) in the scene of `bodies_scene`:
+/// material 1 is n = 2 + 0.1i, material 2 the builtin blue.
+fn layers_scene(dir: &Path, slices: &str) -> SceneToml {
+    bodies_scene(dir, 10.0, &[buried_slab()])
+        .without("structure")
+        .raw(
+            "structure",
+            &format!(
+                "{{ kind = \"layers\", materials = [{{ index = [2.0, 0.1] }}, \
+                 {{ builtin = \"blue\" }}], layer = [{slices}] }}"
+            ),
+        )
+}
+
+#[test]
+fn a_layered_structure_is_the_boxes_its_maps_draw() {
+    let dir = tempfile::tempdir().unwrap();
+    // A map of one code over the whole fragment is the slab it fills.
+    let slab = layers_scene(dir.path(), r#"{ z_nm = [300.0, 500.0], map = ["1"] }"#);
+    let a = slab.run(dir.path());
+    let b = slab_scene(dir.path(), 10.0).run(dir.path());
+    for (x, y) in a.entries.iter().zip(&b.entries) {
+        let (x, y) = (&x.efficiencies, &y.efficiencies);
+        assert!((x.total_reflectance - y.total_reflectance).abs() < 1e-12);
+        assert!((x.total_transmittance - y.total_transmittance).abs() < 1e-12);
+    }
+    // A staircased post over two slices, on a 4 × 4 map of the 200 nm
+    // fragment (50 nm pixels, the grid's cells), and a blue strip: the
+    // raster is that of the boxes drawn as primitives, cell for cell.
+    let post = layers_scene(
+        dir.path(),
+        r#"{ z_nm = [100.0, 200.0], map = ["0000", "0110", "0110", "0000"] },
+           { z_nm = [200.0, 400.0], map = ["1111", "1 1 1 1", "2222", "0000"] }"#,
+    );
+    let scene = post.scene(dir.path());
+    let g = pipeline::grid_of(&scene);
+    let layered = match scene.structure.as_ref().unwrap() {
+        inksim::config::Structure::Primitives(ps) => rasterize_primitives(ps, &g),
+        _ => unreachable!(),
+    };
+    assert_eq!(layered.fractions.len(), 2, "one body per material");
+    let bx = |lo: [f64; 3], hi: [f64; 3], m: Material| Primitive {
+        body: Body::Box {
+            min_nm: lo,
+            max_nm: hi,
+        },
+        material: m,
+    };
+    let explicit = rasterize_primitives(
+        &[
+            bx([50.0, 50.0, 100.0], [150.0, 150.0, 200.0], material()),
+            bx([0.0, 0.0, 200.0], [200.0, 100.0, 400.0], material()),
+            bx([0.0, 100.0, 200.0], [200.0, 150.0, 400.0], material()),
+        ],
+        &g,
+    );
+    let ones = &explicit.fractions[0] + &explicit.fractions[1];
+    for (k, (x, y)) in layered.fractions[0].iter().zip(ones.iter()).enumerate() {
+        assert!((x - y).abs() < 1e-12, "voxel {k}: {x} vs {y}");
+    }
+    for (x, y) in layered.fractions[1]
+        .iter()
+        .zip(explicit.fractions[2].iter())
+    {
+        assert!((x - y).abs() < 1e-12);
+    }
+    assert!((layered.fractions[1].sum() * 50.0 * 50.0 * 10.0 - 200.0 * 50.0 * 200.0).abs() < 1e-6);
+}
+
+#[test]
+fn a_layered_structure_with_a_bad_map_is_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    for (slices, want) in [
+        (
+            r#"{ z_nm = [0.0, 100.0], map = ["01", "011"] }"#,
+            "structure.layer[0].map[1]`: has 3 columns, the first row 2",
+        ),
+        (
+            r#"{ z_nm = [0.0, 100.0], map = ["0x"] }"#,
+            "`x` is not a material code: 0 (the binder) or 1–2",
+        ),
+        (
+            r#"{ z_nm = [0.0, 100.0], map = ["03"] }"#,
+            "`3` is not a material code",
+        ),
+        (
+            r#"{ z_nm = [0.0, 300.0], map = ["1"] }, { z_nm = [200.0, 400.0], map = ["1"] }"#,
+            "structure.layer[1].z_nm`: starts at 200 nm, above the end of the slice before (300 nm)",
+        ),
+        (
+            r#"{ z_nm = [0.0, 2000.0], map = ["1"] }"#,
+            "must be [z0, z1] with 0 <= z0 < z1 <= 1000",
+        ),
+        (r#"{ z_nm = [0.0, 100.0], map = ["00"] }"#, "every map is all binder"),
+    ] {
+        let text = layers_scene(dir.path(), slices).toml();
+        let err = inksim::config::parse_scene(Path::new("s.toml"), &text)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(want), "{slices}: {err}");
+        assert!(!err.contains('\n'), "{err}");
+    }
 }

@@ -308,8 +308,13 @@ pub struct OutputSpec {
 
 /// A body of an explicit structure (nm; z = 0 is the top of the layer,
 /// periodic in x and y).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Body {
+    /// Disjoint axis-aligned boxes `[min_nm, max_nm]`, one body: the cells
+    /// of one material in a layered structure (`kind = "layers"`).
+    Boxes {
+        boxes: Vec<[[f64; 3]; 2]>,
+    },
     /// The full fragment between two depths.
     Slab {
         z_nm: [f64; 2],

@@ -81,6 +81,22 @@ pub enum RawStructure {
     },
     /// A complex ε grid from an HDF5 file.
     Hdf5 { file: String },
+    /// Slices in z, each a map of material codes over the fragment.
+    Layers {
+        materials: Vec<RawMaterial>,
+        #[serde(default)]
+        layer: Vec<RawSlice>,
+    },
+}
+
+/// `[[structure.layer]]`: the slice `z_nm = [z0, z1]` and its map, rows
+/// along y (the first at y = 0), one character per column along x: `0` the
+/// binder, `k` (1–9) the k-th of `structure.materials`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSlice {
+    pub z_nm: Vec<f64>,
+    pub map: Vec<String>,
 }
 
 #[derive(Debug, Deserialize)]

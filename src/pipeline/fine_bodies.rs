@@ -5,9 +5,16 @@
 
 use crate::config::{Body, Scene, Structure};
 
-/// Extent of a body along x, y and z (nm); a slab spans the fragment.
+/// Extent of a body along x, y and z (nm); a slab spans the fragment; for
+/// a layered structure's boxes, the narrowest box on each axis.
 fn extent(body: &Body, fragment: [f64; 2]) -> [f64; 3] {
     match *body {
+        Body::Boxes { ref boxes } => [0, 1, 2].map(|a| {
+            boxes
+                .iter()
+                .map(|b| (b[1][a] - b[0][a]).abs())
+                .fold(f64::INFINITY, f64::min)
+        }),
         Body::Slab { z_nm } => [fragment[0], fragment[1], (z_nm[1] - z_nm[0]).abs()],
         Body::Box { min_nm, max_nm } => [0, 1, 2].map(|a| (max_nm[a] - min_nm[a]).abs()),
         Body::Sphere { radius_nm, .. } => [2.0 * radius_nm; 3],
@@ -32,6 +39,7 @@ fn kind(body: &Body) -> &'static str {
         Body::Box { .. } => "box",
         Body::Sphere { .. } => "sphere",
         Body::Cylinder { .. } => "cylinder",
+        Body::Boxes { .. } => "layers: the cells of one material",
     }
 }
 

@@ -76,7 +76,7 @@ fn inside(body: &Body, p: [f64; 3], size: [f64; 3]) -> bool {
             let radial2: f64 = (0..3).filter(|&a| a != axis).map(|a| d[a] * d[a]).sum();
             d[axis].abs() <= len / 2.0 && radial2 <= r * r
         }
-        _ => false,
+        Body::Slab { .. } | Body::Box { .. } | Body::Boxes { .. } => false,
     }
 }
 
@@ -105,20 +105,35 @@ fn bounds(body: &Body) -> ([f64; 3], [f64; 3]) {
         }
         Body::Slab { z_nm } => ([f64::MIN, f64::MIN, z_nm[0]], [f64::MAX, f64::MAX, z_nm[1]]),
         Body::Box { min_nm, max_nm } => (min_nm, max_nm),
+        // Rasterised box by box (`body_fractions`).
+        Body::Boxes { .. } => ([f64::MIN, f64::MIN, 0.0], [f64::MAX, f64::MAX, 0.0]),
     }
+}
+
+/// Volume fraction of voxel `[lo, hi)` inside the box `[min_nm, max_nm]`.
+fn box_fraction(
+    min_nm: [f64; 3],
+    max_nm: [f64; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
+    size: [f64; 3],
+) -> f64 {
+    let vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    periodic_overlap(lo[0], hi[0], min_nm[0], max_nm[0], size[0])
+        * periodic_overlap(lo[1], hi[1], min_nm[1], max_nm[1], size[1])
+        * overlap(lo[2], hi[2], min_nm[2], max_nm[2])
+        / vol
 }
 
 /// Volume fraction of voxel `[lo, hi)` inside `body`.
 fn fraction(body: &Body, lo: [f64; 3], hi: [f64; 3], size: [f64; 3]) -> f64 {
-    let vol = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
     match *body {
         Body::Slab { z_nm } => overlap(lo[2], hi[2], z_nm[0], z_nm[1]) / (hi[2] - lo[2]),
-        Body::Box { min_nm, max_nm } => {
-            periodic_overlap(lo[0], hi[0], min_nm[0], max_nm[0], size[0])
-                * periodic_overlap(lo[1], hi[1], min_nm[1], max_nm[1], size[1])
-                * overlap(lo[2], hi[2], min_nm[2], max_nm[2])
-                / vol
-        }
+        Body::Box { min_nm, max_nm } => box_fraction(min_nm, max_nm, lo, hi, size),
+        Body::Boxes { ref boxes } => boxes
+            .iter()
+            .map(|b| box_fraction(b[0], b[1], lo, hi, size))
+            .sum(),
         _ => {
             let corners: Vec<bool> = (0..8)
                 .map(|k| {
@@ -153,6 +168,46 @@ fn fraction(body: &Body, lo: [f64; 3], hi: [f64; 3], size: [f64; 3]) -> f64 {
     }
 }
 
+/// Add the volume fractions of `body` to `f` over the voxels its bounds
+/// touch (cells `d`).
+fn body_fractions(body: &Body, grid: &Grid, d: [f64; 3], f: &mut Array3<f64>) {
+    let (nx, ny, nz) = (grid.nx, grid.ny, grid.nz);
+    let size = grid.size_nm;
+    let (blo, bhi) = bounds(body);
+    let range = |a: usize, n: usize| -> Vec<usize> {
+        let l = size[a];
+        if a < 2 && (bhi[a] - blo[a] >= l || blo[a] <= f64::MIN / 2.0) {
+            return (0..n).collect();
+        }
+        let i0 = (blo[a] / d[a]).floor() as i64;
+        let i1 = (bhi[a] / d[a]).ceil() as i64;
+        let mut v: Vec<usize> = (i0..i1)
+            .filter_map(|i| {
+                if a < 2 {
+                    Some(i.rem_euclid(n as i64) as usize)
+                } else if i >= 0 && (i as usize) < n {
+                    Some(i as usize)
+                } else {
+                    None
+                }
+            })
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let (xs, ys, zs) = (range(0, nx), range(1, ny), range(2, nz));
+    for &iz in &zs {
+        for &iy in &ys {
+            for &ix in &xs {
+                let lo = [ix as f64 * d[0], iy as f64 * d[1], iz as f64 * d[2]];
+                let hi = [lo[0] + d[0], lo[1] + d[1], lo[2] + d[2]];
+                f[[iz, iy, ix]] += fraction(body, lo, hi, size);
+            }
+        }
+    }
+}
+
 /// Rasterise primitives on `grid`: one fraction array per primitive.
 pub fn rasterize_primitives(primitives: &[Primitive], grid: &Grid) -> Raster {
     let (nx, ny, nz) = (grid.nx, grid.ny, grid.nz);
@@ -164,43 +219,31 @@ pub fn rasterize_primitives(primitives: &[Primitive], grid: &Grid) -> Raster {
     ];
     let mut fractions: Vec<Array3<f64>> = Vec::with_capacity(primitives.len());
     for p in primitives {
-        let (blo, bhi) = bounds(&p.body);
-        let range = |a: usize, n: usize| -> Vec<usize> {
-            let l = size[a];
-            if a < 2 && (bhi[a] - blo[a] >= l || blo[a] <= f64::MIN / 2.0) {
-                return (0..n).collect();
+        let f = match &p.body {
+            // Each box over its own voxels: the boxes are disjoint, so
+            // their fractions add.
+            Body::Boxes { boxes } => {
+                let mut f = Array3::zeros((nz, ny, nx));
+                for b in boxes {
+                    let one = Body::Box {
+                        min_nm: b[0],
+                        max_nm: b[1],
+                    };
+                    body_fractions(&one, grid, d, &mut f);
+                }
+                f
             }
-            let i0 = (blo[a] / d[a]).floor() as i64;
-            let i1 = (bhi[a] / d[a]).ceil() as i64;
-            let mut v: Vec<usize> = (i0..i1)
-                .filter_map(|i| {
-                    if a < 2 {
-                        Some(i.rem_euclid(n as i64) as usize)
-                    } else if i >= 0 && (i as usize) < n {
-                        Some(i as usize)
-                    } else {
-                        None
-                    }
-                })
-                .collect();
-            v.sort_unstable();
-            v.dedup();
-            v
+            body => {
+                let mut f = Array3::zeros((nz, ny, nx));
+                body_fractions(body, grid, d, &mut f);
+                f
+            }
         };
-        let (xs, ys, zs) = (range(0, nx), range(1, ny), range(2, nz));
-        let mut f = Array3::zeros((nz, ny, nx));
-        for &iz in &zs {
-            for &iy in &ys {
-                for &ix in &xs {
-                    let lo = [ix as f64 * d[0], iy as f64 * d[1], iz as f64 * d[2]];
-                    let hi = [lo[0] + d[0], lo[1] + d[1], lo[2] + d[2]];
-                    let v = fraction(&p.body, lo, hi, size);
-                    if v > 0.0 {
-                        f[[iz, iy, ix]] = v;
-                        for prev in fractions.iter_mut() {
-                            prev[[iz, iy, ix]] *= 1.0 - v;
-                        }
-                    }
+        // A later body replaces earlier ones where it lies.
+        for ((iz, iy, ix), &v) in f.indexed_iter() {
+            if v > 0.0 {
+                for prev in fractions.iter_mut() {
+                    prev[[iz, iy, ix]] *= 1.0 - v.min(1.0);
                 }
             }
         }

@@ -135,7 +135,8 @@ const TAGGED: [(&str, &str); 6] = [
     ),
     (
         "RawStructure",
-        "a structure: kind = \"primitives\" with [[structure.primitive]] tables, or \
+        "a structure: kind = \"primitives\" with [[structure.primitive]] tables, \
+         kind = \"layers\" with materials and [[structure.layer]] tables, or \
          kind = \"hdf5\" with file",
     ),
 ];

@@ -507,9 +507,10 @@ fn preview_shows_the_lights_mirror_image_only_where_the_layer_reflects() {
 #[test]
 fn merl_export_stays_bounded_at_grazing_angles() {
     // The BRDF is the table's density over its coverage, finite up to the
-    // horizon: no bin at grazing angles may exceed the largest value seen
-    // at moderate angles by more than the BRDF's own variation (a division
-    // by cos θo put spikes of 100/sr and more there).
+    // horizon: every one of the 90 × 90 × 180 bins is finite and ≥ 0, and
+    // no bin at grazing angles exceeds the largest value seen at moderate
+    // angles by more than the BRDF's own variation (a division by cos θo
+    // put spikes of 100/sr and more there).
     use inksim::output::merl;
     let dir = tempfile::tempdir().unwrap();
     grains_scene(dir.path(), 2)
@@ -518,14 +519,17 @@ fn merl_export_stays_bounded_at_grazing_angles() {
         .run(dir.path());
     let bytes = std::fs::read(dir.path().join("grains.binary")).unwrap();
     let (mut moderate, mut grazing) = (0.0f64, 0.0f64);
-    for ih in (0..90).step_by(3) {
-        for id in (0..90).step_by(3) {
-            for ip in (0..180).step_by(9) {
+    let mut bins = 0usize;
+    for ih in 0..90 {
+        for id in 0..90 {
+            for ip in 0..180 {
+                bins += 1;
                 let (ti, to, _) = merl::bin_angles(ih, id, ip);
+                let v = merl::lookup(&bytes, ih, id, ip).unwrap();
                 if ti >= 90.0 || to >= 90.0 {
+                    assert_eq!(v, [0.0; 3], "below the horizon: ({ih}, {id}, {ip})");
                     continue;
                 }
-                let v = merl::lookup(&bytes, ih, id, ip).unwrap();
                 let m = v.iter().cloned().fold(0.0, f64::max);
                 assert!(m.is_finite() && m >= 0.0);
                 if ti.max(to) <= 60.0 {
@@ -536,6 +540,7 @@ fn merl_export_stays_bounded_at_grazing_angles() {
             }
         }
     }
+    assert_eq!(bins, 90 * 90 * 180);
     assert!(moderate > 0.0 && grazing > 0.0);
     assert!(
         grazing < 1.5 * moderate,

@@ -2,27 +2,12 @@
 //! files, one row per solve, per spectrum point and per colour.
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::Command;
 
 mod common;
+use common::cli::inksim_in;
 use common::scene::{PigmentToml, SceneToml};
 use common::study::StudyToml;
 use inksim::output::h5::{read_appearance, read_measured, read_summary};
-
-fn inksim_in(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
-        .args(args)
-        .current_dir(dir)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("SLURM_ARRAY_TASK_COUNT")
-        .output()
-        .expect("run inksim");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
 
 /// A CSV table as rows of column → field (no field of ours is quoted).
 fn table(path: &Path) -> Vec<HashMap<String, String>> {

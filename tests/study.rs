@@ -11,6 +11,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
+use common::cli::inksim_in;
 use common::keys::floats;
 use common::scene::{PigmentToml, SceneToml};
 use common::study::StudyToml;
@@ -50,21 +51,6 @@ fn sweep_of(base: &SceneToml) -> StudyToml {
 
 fn sweep() -> StudyToml {
     sweep_of(&base())
-}
-
-fn inksim_in(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
-        .args(args)
-        .current_dir(dir)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("SLURM_ARRAY_TASK_COUNT")
-        .output()
-        .expect("run inksim");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

@@ -59,6 +59,44 @@ impl Csv {
     }
 }
 
+/// The columns of a colour, after those that say which colour it is.
+pub const COLOUR_COLUMNS: [&str; 14] = [
+    "illuminant",
+    "observer_deg",
+    "L_star",
+    "a_star",
+    "b_star",
+    "C_star_ab",
+    "h_deg",
+    "L_star_se",
+    "a_star_se",
+    "b_star_se",
+    "de00_se",
+    "X",
+    "Y",
+    "Z",
+];
+
+/// The fields of [`COLOUR_COLUMNS`]: conditions, CIELAB and LCh, their
+/// standard errors and XYZ (empty where absent).
+pub fn colour_fields(
+    illuminant: &str,
+    observer_deg: &str,
+    lab: [f64; 3],
+    lab_se: Option<[f64; 3]>,
+    de00_se: Option<f64>,
+    xyz: Option<[f64; 3]>,
+) -> Vec<String> {
+    let lch = lab_to_lch(lab);
+    let mut f = vec![illuminant.to_string(), observer_deg.to_string()];
+    f.extend(lab.iter().map(|&v| num(v)));
+    f.extend([num(lch[1]), num(lch[2])]);
+    f.extend((0..3).map(|c| opt(lab_se.map(|s| s[c]))));
+    f.push(opt(de00_se));
+    f.extend((0..3).map(|c| opt(xyz.map(|x| x[c]))));
+    f
+}
+
 /// A number as CSV: its shortest round-trip form (in exponent form when
 /// very small or large), empty for NaN.
 pub fn num(x: f64) -> String {
@@ -156,25 +194,9 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
     let Some(tile) = &a.tile_lab else {
         return Ok(tables);
     };
-    let mut colours = Csv::new(&[
-        "geometry",
-        "viewing_deg",
-        "illumination_deg",
-        "illuminant",
-        "observer_deg",
-        "L_star",
-        "a_star",
-        "b_star",
-        "C_star_ab",
-        "h_deg",
-        "L_star_se",
-        "a_star_se",
-        "b_star_se",
-        "de00_se",
-        "X",
-        "Y",
-        "Z",
-    ]);
+    let mut header = vec!["geometry", "viewing_deg", "illumination_deg"];
+    header.extend(COLOUR_COLUMNS);
+    let mut colours = Csv::new(&header);
     let (ill, obs) = extra.conditions.clone().unwrap_or_default();
     let lab_row = |geometry: &str,
                    view: String,
@@ -183,13 +205,8 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
                    lab_se: Option<[f64; 3]>,
                    de00_se: Option<f64>,
                    xyz: Option<[f64; 3]>| {
-        let lch = lab_to_lch(lab);
-        let mut f = vec![geometry.to_string(), view, illum, ill.clone(), obs.clone()];
-        f.extend(lab.iter().map(|&v| num(v)));
-        f.extend([num(lch[1]), num(lch[2])]);
-        f.extend((0..3).map(|c| opt(lab_se.map(|s| s[c]))));
-        f.push(opt(de00_se));
-        f.extend((0..3).map(|c| opt(xyz.map(|x| x[c]))));
+        let mut f = vec![geometry.to_string(), view, illum];
+        f.extend(colour_fields(&ill, &obs, lab, lab_se, de00_se, xyz));
         f
     };
     if let Some((records, _, _)) = read_measured(path)? {

@@ -14,31 +14,15 @@
 use super::run::{self, State};
 use super::sweep::{Expansion, Study};
 use super::StudyError;
-use crate::optics::colour::lab_to_lch;
-use crate::output::export::{num, Csv};
+use crate::output::export::{colour_fields, Csv, COLOUR_COLUMNS};
 use crate::output::h5;
 
 /// The table's text and the names of the variants not finished.
 pub fn colours_csv(study: &Study, exp: &Expansion) -> Result<(String, Vec<String>), StudyError> {
     let mut header: Vec<&str> = vec!["variant"];
     header.extend(study.axes.iter().map(|a| a.name.as_str()));
-    header.extend([
-        "geometry",
-        "illuminant",
-        "observer_deg",
-        "L_star",
-        "a_star",
-        "b_star",
-        "C_star_ab",
-        "h_deg",
-        "L_star_se",
-        "a_star_se",
-        "b_star_se",
-        "de00_se",
-        "X",
-        "Y",
-        "Z",
-    ]);
+    header.push("geometry");
+    header.extend(COLOUR_COLUMNS);
     let mut csv = Csv::new(&header);
     let mut missing = Vec::new();
     for v in &exp.variants {
@@ -57,13 +41,15 @@ pub fn colours_csv(study: &Study, exp: &Expansion) -> Result<(String, Vec<String
                     .iter()
                     .map(|a| v.label(&a.name).unwrap_or("").to_string()),
             );
-            let lch = lab_to_lch(r.lab);
-            f.extend([r.geometry.clone(), illuminant.clone(), observer.to_string()]);
-            f.extend(r.lab.iter().map(|&x| num(x)));
-            f.extend([num(lch[1]), num(lch[2])]);
-            f.extend((0..3).map(|c| r.lab_se.map_or(String::new(), |s| num(s[c]))));
-            f.push(r.de00_se.map_or(String::new(), num));
-            f.extend(r.xyz.iter().map(|&x| num(x)));
+            f.push(r.geometry.clone());
+            f.extend(colour_fields(
+                &illuminant,
+                &observer.to_string(),
+                r.lab,
+                r.lab_se,
+                r.de00_se,
+                Some(r.xyz),
+            ));
             csv.row(f);
         }
     }

@@ -1,9 +1,11 @@
-//! Set-up shared by the tests: closed-form slab references, a packed layer
+//! Set-up shared by the tests: the program run as a user runs it,
+//! closed-form slab references, a packed layer
 //! of one pigment, runs on a thread pool of a given size, and builders of
 //! scene and study files (a test names only what it varies).
 #![allow(dead_code)]
 
 pub mod airy;
+pub mod cli;
 pub mod keys;
 pub mod layers;
 pub mod scene;

@@ -406,7 +406,7 @@ pub struct Appearance {
     pub baseline: Option<Baseline>,
 }
 
-/// A classical colour model computed from the same scene (METHOD §7).
+/// A classical colour model computed from the same scene (METHOD §6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Baseline {
     /// Kubelka–Munk two-flux reflectance on the paper with Saunderson's

@@ -1,5 +1,5 @@
 //! Optics — the classical baseline beside the wave solution: Kubelka–Munk
-//! with Saunderson's correction (METHOD §, "Kubelka–Munk baseline").
+//! with Saunderson's correction (METHOD §6, "Kubelka–Munk baseline").
 //!
 //! The industry's two-flux picture of the same scene, for showing where
 //! radiative transfer and the wave solution part:
@@ -35,6 +35,10 @@
 //!    CIEDE2000 to the wave solution's colour in the same geometry.
 //!
 //! The binder's own absorption and the layer's relief are not in the model.
+//! Nor is the wave scene's boundary under the layer: there the binder ends
+//! in vacuum above the paper (METHOD §1), here the paper is in optical
+//! contact with the binder, as Saunderson's correction assumes — the main
+//! reason the two colours differ for a weak layer (METHOD §6).
 
 pub mod km;
 pub mod sphere;

@@ -116,20 +116,27 @@ fn str_attr(d: &hdf5::Dataset, name: &str) -> String {
 /// (n_b = 1.558) on paper of albedo 0.9, read at 45°/0°; beside it the same
 /// layer with invisible spheres (n = n_b), the clear binder.
 ///
-/// Measured (3 solved wavelengths, 20 nm cells, 1 µm fragment, one
-/// realisation): the wave solution's absorbed fraction at normal incidence
-/// is μa X (μa of the KM baseline) within 4 % at every solved wavelength, so
-/// the single scatterer is the wave layer's; the colours do NOT agree:
-/// ΔE00(KM, wave) = 6.2 with the pigment and 5.8 for the clear binder. The
-/// gap is the two models' layer–paper boundary, not the pigment: the wave
-/// scene has vacuum under the binder (air / binder / air / paper, light from
-/// the paper re-enters the binder refracted into the escape cone), while
-/// Saunderson's correction puts the paper in optical contact with the binder
-/// (light reflected by the paper at any angle is trapped under the surface,
-/// r_i ≈ 0.60, and sees the paper again). That trapping also lengthens the
-/// light's path through the absorbing layer, as does K = 2 μa (diffuse light
-/// inside, against the near-normal directed light of 45°/0°): the pigment
-/// lowers L* by 2.9 in the baseline and by 0.85 in the wave solution.
+/// Measured (5 solved wavelengths 400–700 nm, 20 nm cells, 1 µm fragment,
+/// one realisation):
+/// - the wave solution's absorbed fraction at normal incidence is μa X (μa
+///   of the baseline) to within 0.946–1.088: the single scatterer is the
+///   wave layer's. The rest is the film's Fabry–Perot standing wave: with
+///   r² = 0.047 at each surface the mean intensity inside a weakly absorbing
+///   film lies between (1 − r⁴)/(1 + r²)² = 0.91 and (1 − r⁴)/(1 − r²)² = 1.10
+///   of the single pass, hence the tolerance 0.12;
+/// - the colours do NOT agree: ΔE00(KM, wave) = 5.43 with the pigment and
+///   4.09 for the clear binder already. The clear binder's gap is the two
+///   models' layer–paper boundary: the wave scene has vacuum under the
+///   binder (air / binder / air / paper: light from the paper re-enters the
+///   binder refracted into the escape cone, L* 94.3), Saunderson's
+///   correction puts the paper in optical contact with the binder (light
+///   the paper reflects at any angle is trapped under the surface, r_i ≈
+///   0.60, L* 88.2); the coherent film's fringes (45°/0° factor 0.6–1.2
+///   across 5 nm steps) add a little chroma to the wave colour;
+/// - the trapping also lengthens the light's path through the absorbing
+///   layer, as does K = 2 μa (diffuse light inside, against the directed
+///   light of 45°/0°): the pigment lowers L* by 2.88 in the baseline and by
+///   0.85 in the wave solution, which makes the other 1.3 of ΔE00.
 #[test]
 fn dilute_weak_spheres_beside_the_wave_solution() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,7 +147,7 @@ fn dilute_weak_spheres_beside_the_wave_solution() {
             .thickness_nm(4000.0)
             .fragment_nm(1000.0)
             .cell_nm(20.0)
-            .wavelengths_nm(&[450.0, 550.0, 650.0])
+            .wavelengths_nm(&[400.0, 475.0, 550.0, 625.0, 700.0])
             .polar_deg(&[0.0, 45.0])
             .paper(0.9)
             .measurements(&["45/0"])
@@ -184,13 +191,13 @@ fn dilute_weak_spheres_beside_the_wave_solution() {
                 let expect = baseline::coefficients(&input, l).mu_a * 4000.0;
                 let ratio = e.efficiencies.absorption / expect;
                 assert!(
-                    (ratio - 1.0).abs() < 0.08,
+                    (ratio - 1.0).abs() < 0.12,
                     "{} nm: {ratio}",
                     e.wavelength_nm
                 );
                 seen += 1;
             }
-            assert_eq!(seen, 3);
+            assert_eq!(seen, 5);
         }
 
         // The result file holds the same, described.
@@ -217,9 +224,9 @@ fn dilute_weak_spheres_beside_the_wave_solution() {
         let r: Vec<f64> = g.dataset("reflectance_factor").unwrap().read_raw().unwrap();
         assert_eq!(r, km.reflectance_factor);
     }
-    // The boundary, not the pigment, makes the gap (measured 6.23 and 5.82).
-    assert!(de.iter().all(|&d| (4.0..8.0).contains(&d)), "{de:?}");
-    assert!((de[0] - de[1]).abs() < 1.0, "{de:?}");
+    // Measured 5.43 (pigment) and 4.09 (clear binder): see above.
+    assert!((4.0..7.0).contains(&de[0]), "{de:?}");
+    assert!((3.0..5.5).contains(&de[1]), "{de:?}");
     // Trapping and diffuse paths: the pigment darkens the baseline more
     // (measured ΔL* 2.88 against 0.85, a ratio of 3.4).
     let drop_wave = lightness[1].0 - lightness[0].0;
@@ -235,4 +242,28 @@ fn rep_scene(
     dir: &std::path::Path,
 ) -> inksim::config::Scene {
     base(pigment(1.6, 0.01, 0.01, 60.0)).scene(dir)
+}
+
+#[test]
+fn a_dissolved_pigment_is_beers_law() {
+    // No grains, no scattering: S = 0 and R = R_g e^{−2KX}, K = 2 f k₀ Im ε / n_b.
+    let dir = tempfile::tempdir().unwrap();
+    let nb = 1.558;
+    let scene = with_baseline(SceneToml::grains())
+        .binder_index(nb)
+        .pigment(pigment(1.7, 0.05, 0.2, 200.0).molecular())
+        .thickness_nm(2000.0)
+        .paper(0.9)
+        .scene(dir.path());
+    let input = pipeline::baseline_input(&scene).unwrap().unwrap();
+    let body = baseline::body_reflectance(&input);
+    for (l, &wl) in input.wavelengths_nm.iter().enumerate() {
+        let c = baseline::coefficients(&input, l);
+        assert_eq!(c.s, 0.0);
+        let eps = num_complex::Complex64::new(1.7, 0.05).powi(2);
+        let k = 2.0 * 0.2 * 2.0 * std::f64::consts::PI / wl * eps.im / nb;
+        assert!((c.k - k).abs() < 1e-12 * k, "{wl} nm: {c:?}");
+        let expect = 0.9 * (-2.0 * k * 2000.0).exp();
+        assert!((body[l] - expect).abs() < 1e-12, "{wl} nm");
+    }
 }

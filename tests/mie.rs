@@ -1,5 +1,6 @@
 //! A dilute lattice of small spheres against the single-scattering limit of
-//! the scalar sphere series (METHOD §7).
+//! the scalar sphere series (METHOD §7), the partial waves of
+//! `optics::baseline::sphere`.
 //!
 //! One sphere (radius a, permittivity ε_s) per period L × L in vacuum (the
 //! "binder" has n = 1, so the slab background is plain vacuum). Scalar
@@ -18,83 +19,13 @@
 
 use inksim::config::Method;
 use inksim::geometry::{Geometry, Particle, Sphere};
+use inksim::optics::baseline::sphere::{amplitude, coefficients};
 use inksim::optics::farfield::efficiencies;
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
-
-/// Spherical Bessel j_0..=j_lmax of a complex argument by Miller's downward
-/// recurrence, normalised by j_0 = sin z / z.
-fn bessel_j(z: C64, lmax: usize) -> Vec<C64> {
-    let start = lmax + 30 + z.norm() as usize;
-    let mut j = vec![C64::new(0.0, 0.0); start + 2];
-    j[start + 1] = C64::new(0.0, 0.0);
-    j[start] = C64::new(1e-30, 0.0);
-    for l in (1..=start).rev() {
-        j[l - 1] = (2 * l + 1) as f64 / z * j[l] - j[l + 1];
-    }
-    let scale = (z.sin() / z) / j[0];
-    j.truncate(lmax + 1);
-    j.iter().map(|v| v * scale).collect()
-}
-
-/// Spherical Hankel h_l^(1) of a real argument by upward recurrence (stable).
-fn hankel(x: f64, lmax: usize) -> Vec<C64> {
-    let i = C64::i();
-    let mut h = vec![-i * (i * x).exp() / x];
-    h.push((i * x).exp() * (-i / (x * x) - 1.0 / x));
-    for l in 1..lmax {
-        let next = (2 * l + 1) as f64 / x * h[l] - h[l - 1];
-        h.push(next);
-    }
-    h.truncate(lmax + 1);
-    h
-}
-
-/// f_l'(z) = f_{l−1}(z) − (l+1)/z f_l(z) for l ≥ 1; f_0' = −f_1.
-fn derivative(f: &[C64], z: C64) -> Vec<C64> {
-    (0..f.len() - 1)
-        .map(|l| {
-            if l == 0 {
-                -f[1]
-            } else {
-                f[l - 1] - (l + 1) as f64 / z * f[l]
-            }
-        })
-        .collect()
-}
-
-/// Partial-wave coefficients c_l, l = 0..lmax.
-fn coefficients(k: f64, eps_s: C64, a: f64, lmax: usize) -> Vec<C64> {
-    let ks = eps_s.sqrt() * k;
-    let x = C64::new(k * a, 0.0);
-    let xs = ks * a;
-    let j = bessel_j(x, lmax + 1);
-    let js = bessel_j(xs, lmax + 1);
-    let h = hankel(k * a, lmax + 1);
-    let (dj, djs, dh) = (derivative(&j, x), derivative(&js, xs), derivative(&h, x));
-    (0..=lmax)
-        .map(|l| {
-            let num = k * dj[l] * js[l] - ks * j[l] * djs[l];
-            let den = k * dh[l] * js[l] - ks * h[l] * djs[l];
-            -num / den
-        })
-        .collect()
-}
-
-fn amplitude(c: &[C64], k: f64, cos_t: f64) -> C64 {
-    let (mut p0, mut p1) = (1.0, cos_t);
-    let mut f = c[0] * p0;
-    for (l, cl) in c.iter().enumerate().skip(1) {
-        f += cl * (2 * l + 1) as f64 * p1;
-        let p2 = ((2 * l + 1) as f64 * cos_t * p1 - l as f64 * p0) / (l + 1) as f64;
-        p0 = p1;
-        p1 = p2;
-    }
-    f / (C64::i() * k)
-}
 
 #[test]
 fn lossless_sphere_obeys_the_optical_theorem() {

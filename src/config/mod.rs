@@ -401,6 +401,26 @@ pub struct Appearance {
     /// Measurement geometries reported with the tile (default all three:
     /// 45°/0°, d/8° SCI and SCE); each adds its angles to the solves from above.
     pub measurements: Vec<Measurement>,
+    /// A classical model's colour to report beside the wave solution's
+    /// (`baseline = "kubelka-munk"`); None: none.
+    pub baseline: Option<Baseline>,
+}
+
+/// A classical colour model computed from the same scene (METHOD §6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Baseline {
+    /// Kubelka–Munk two-flux reflectance on the paper with Saunderson's
+    /// surface correction, from the scalar sphere's cross sections.
+    KubelkaMunk,
+}
+
+impl Baseline {
+    /// The name in a scene file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Baseline::KubelkaMunk => "kubelka-munk",
+        }
+    }
 }
 
 /// `realisations = { target_de00, max, min }`: realisations are added (at

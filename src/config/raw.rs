@@ -333,6 +333,7 @@ pub struct RawAppearance {
     pub illuminant: Option<String>,
     pub observer_deg: Option<i64>,
     pub measurements: Option<Vec<String>>,
+    pub baseline: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

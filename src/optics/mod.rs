@@ -8,11 +8,14 @@
 //! - [`effective_medium`]: the homogeneous slab of the volume-averaged ε
 //!   and the estimated error of replacing grains by it;
 //! - [`appearance`]: ensemble means with standard errors, natural light and
-//!   the colours of a result.
+//!   the colours of a result;
+//! - [`baseline`]: the classical two-flux colour of the same scene
+//!   (Kubelka–Munk with Saunderson's correction) beside the wave solution's.
 //!
 //! Imports only from `config`, `geometry`, `raster` and `solver`.
 
 pub mod appearance;
+pub mod baseline;
 pub mod colour;
 pub mod effective_medium;
 pub mod farfield;

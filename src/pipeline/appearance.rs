@@ -48,16 +48,7 @@ fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
     if wl.len() < 2 || matches!(scene.substrate, Substrate::None) || scene.structure.is_some() {
         return None;
     }
-    let (lo, hi) = (wl[0], wl[wl.len() - 1]);
-    let mut fine: Vec<f64> = wl.clone();
-    let mut x = (lo / PROXY_STEP_NM).ceil() * PROXY_STEP_NM;
-    while x < hi {
-        if !fine.contains(&x) {
-            fine.push(x);
-        }
-        x += PROXY_STEP_NM;
-    }
-    fine.sort_by(f64::total_cmp);
+    let fine = fine_grid(wl);
     let eps = fine
         .iter()
         .map(|&l| mean_eps(scene, l).ok())
@@ -67,4 +58,23 @@ fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
         eps,
         thickness_nm: scene.layer.thickness_nm,
     })
+}
+
+/// The colour grid: every `PROXY_STEP_NM` over the band of `wl`, plus every
+/// wavelength of `wl`, increasing.
+pub fn fine_grid(wl: &[f64]) -> Vec<f64> {
+    let mut fine: Vec<f64> = wl.to_vec();
+    if wl.is_empty() {
+        return fine;
+    }
+    let (lo, hi) = (wl[0], wl[wl.len() - 1]);
+    let mut x = (lo / PROXY_STEP_NM).ceil() * PROXY_STEP_NM;
+    while x < hi {
+        if !fine.contains(&x) {
+            fine.push(x);
+        }
+        x += PROXY_STEP_NM;
+    }
+    fine.sort_by(f64::total_cmp);
+    fine
 }

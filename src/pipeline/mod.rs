@@ -19,6 +19,8 @@
 //! - `solve`: the solves of one layer (iterative, or the closed-form slab);
 //! - `eps`: the permittivities of the scene's materials at a wavelength;
 //! - `appearance`: what the appearance stage is given;
+//! - `baseline`: the classical (Kubelka–Munk) colour beside the wave one,
+//!   when the scene asks for it;
 //! - `result`: the result file assembled from a run's parts;
 //! - `run`: a run end to end ([`run`]), and the geometry-only run
 //!   ([`run_geometry`]);
@@ -30,6 +32,7 @@
 
 pub mod accuracy;
 mod appearance;
+mod baseline;
 pub mod disk;
 mod eps;
 mod fine_bodies;
@@ -54,6 +57,7 @@ use crate::raster::structure;
 use crate::solver;
 
 pub use appearance::{appearance_spec, PROXY_STEP_NM};
+pub use baseline::{add_baseline, baseline_input};
 pub use eps::fraction_eps;
 pub use grains::{build_geometry, build_geometry_seeded, grid_of, Packer, RSA_MAX_PVC};
 pub use plan::{plan_text, planned_solves, realisation_seed, RunPlan};

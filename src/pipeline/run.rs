@@ -187,11 +187,9 @@ fn assemble_products(
         products.brdf || products.btdf || products.tile || products.merl || products.preview;
     let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
     let appearance = if wants_appearance {
-        Some(appearance::assemble(
-            &appearance_spec(scene, plan),
-            entries,
-            &obs,
-        )?)
+        let mut a = appearance::assemble(&appearance_spec(scene, plan), entries, &obs)?;
+        super::baseline::add_baseline(scene, &mut a, &obs)?;
+        Some(a)
     } else {
         None
     };

@@ -1,12 +1,12 @@
 //! `[appearance]` (products, viewing angles, BRDF cell, quadrature, colour
-//! conditions and measurement geometries) and
+//! conditions, measurement geometries and the classical baseline) and
 //! `[substrate]` (none, or paper of an albedo).
 
 use super::Checker;
 use crate::config::raw::{RawAppearance, RawProduct, RawSubstrate};
 use crate::config::{
-    Appearance, ConfigError, Illuminant, Incidence, Measurement, Products, StandardObserver,
-    Substrate,
+    Appearance, Baseline, ConfigError, Illuminant, Incidence, Measurement, Products,
+    StandardObserver, Substrate,
 };
 
 /// Paper albedo of the reference study (METHOD §8).
@@ -106,6 +106,16 @@ impl Checker<'_> {
                 out
             }
         };
+        let baseline = match raw.and_then(|a| a.baseline.as_deref()) {
+            None => None,
+            Some("kubelka-munk") => Some(Baseline::KubelkaMunk),
+            Some(name) => {
+                return Err(self.invalid(
+                    "appearance.baseline",
+                    format!("unknown baseline \"{name}\"; allowed: \"kubelka-munk\""),
+                ))
+            }
+        };
         Ok(Appearance {
             viewing_deg,
             products,
@@ -114,6 +124,7 @@ impl Checker<'_> {
             illuminant,
             observer,
             measurements,
+            baseline,
         })
     }
 

@@ -5,7 +5,7 @@ use super::Checker;
 use crate::config::raw::{RawConfig, RawOutput, RawRealisations};
 use crate::config::{
     ConfigError, GrainShape, Material, OutputSpec, Provenance, RealisationTarget, Scene, Structure,
-    Surface,
+    Substrate, Surface,
 };
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
@@ -71,6 +71,20 @@ impl Checker<'_> {
             ));
         }
         let substrate = self.substrate(raw.substrate.as_ref())?;
+        if appearance.baseline.is_some() {
+            let why = if structure.is_some() {
+                Some("the baseline is computed from the pigments' grains: an explicit structure has none")
+            } else if matches!(substrate, Substrate::None) {
+                Some("the baseline is a layer on paper: give substrate = { kind = \"paper\" }")
+            } else if !appearance.products.tile {
+                Some("the baseline is reported beside the measured colours: add \"tile\" to appearance.outputs")
+            } else {
+                None
+            };
+            if let Some(why) = why {
+                return Err(self.invalid("appearance.baseline", why));
+            }
+        }
         if layer.surface != Surface::Flat {
             let molecular =
                 !species.is_empty() && species.iter().all(|s| s.shape == GrainShape::Molecular);

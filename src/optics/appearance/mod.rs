@@ -31,6 +31,7 @@ pub use colours::{ColourSpread, Colours};
 pub use measure::{MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
+use crate::optics::baseline::BaselineColour;
 use crate::optics::colour::{ColourError, Illuminant, Observer, StandardObserver};
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
@@ -117,6 +118,9 @@ pub struct Appearance {
     pub colours: Option<Colours>,
     /// Colour in each of `spec.measurements`, in that order.
     pub measured: Vec<MeasuredColour>,
+    /// The classical baseline's colour in each measurement geometry, when
+    /// the scene asked for one (filled in by the pipeline).
+    pub baseline: Vec<BaselineColour>,
     /// The CIE illuminant and observer every colour was computed for (None
     /// for an observer built from custom tables).
     pub colour_conditions: Option<(Illuminant, StandardObserver)>,
@@ -386,6 +390,7 @@ pub fn assemble(
         natural,
         colours,
         measured,
+        baseline: Vec::new(),
         colour_conditions: observer.conditions(),
     })
 }

@@ -7,6 +7,7 @@ use ndarray::Array2;
 use super::attrs::{write_scalar_attr, write_str_attr};
 use super::described::{about, dim, standard_error, About, Scales};
 use crate::optics::appearance::{Appearance, Colours, Estimate, MeasuredColour};
+use crate::optics::baseline::BaselineColour;
 
 fn write_estimate<D: ndarray::Dimension>(
     s: &Scales,
@@ -225,6 +226,13 @@ pub(super) fn write_appearance(
             write_measured(s, &mg, m)?;
         }
     }
+    if !a.baseline.is_empty() {
+        let bg = g.create_group("baseline")?;
+        write_str_attr(&bg, "model", "kubelka-munk")?;
+        for b in &a.baseline {
+            write_baseline(s, &bg, b)?;
+        }
+    }
     if let Some(png) = tile_png {
         let description = "the tile picture as a PNG file (encoded bytes, no units); byte";
         s.write(&g, "tile_png", png, about("", description, &[dim::BYTE]))?;
@@ -358,6 +366,44 @@ fn write_measured(s: &mut Scales, parent: &hdf5::Group, m: &MeasuredColour) -> h
         )?;
         let description = "standard error of the colour in ΔE00 (one value)";
         vector("de00_se", &[de], "1", description, dim::VALUE)?;
+    }
+    Ok(())
+}
+
+/// `/appearance/baseline/<slug>`: the Kubelka–Munk colour in one measurement
+/// geometry.
+fn write_baseline(s: &mut Scales, parent: &hdf5::Group, b: &BaselineColour) -> hdf5::Result<()> {
+    let g = parent.create_group(b.geometry.slug())?;
+    write_str_attr(&g, "geometry", b.geometry.name())?;
+    let description =
+        "wavelengths of the Kubelka–Munk spectrum (the spectral proxy's grid); spectrum wavelength";
+    s.coordinate(
+        &g,
+        "spectrum_wavelengths_nm",
+        &b.spectrum_wavelengths_nm,
+        about("nm", description, &[dim::SPECTRUM_WAVELENGTH]),
+    )?;
+    let description = "Kubelka–Munk reflectance factor in this geometry (Saunderson's surface \
+                       correction included); spectrum wavelength";
+    s.write(
+        &g,
+        "reflectance_factor",
+        &b.reflectance_factor[..],
+        about("1", description, &[dim::SPECTRUM_WAVELENGTH]),
+    )?;
+    // One coordinate per geometry: the next geometry's replaces it.
+    s.forget(dim::SPECTRUM_WAVELENGTH);
+    let description = "CIELAB L*, a*, b* of the Kubelka–Munk spectrum";
+    s.write(&g, "lab", &b.lab[..], about("1", description, &[dim::LAB]))?;
+    if let Some(de) = b.de00_to_wave {
+        let description = "CIEDE2000 from the Kubelka–Munk colour to the wave solution's colour \
+                           in the same geometry (/appearance/measured); one value";
+        s.write(
+            &g,
+            "de00_to_wave",
+            &[de][..],
+            about("1", description, &[dim::VALUE]),
+        )?;
     }
     Ok(())
 }

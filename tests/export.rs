@@ -7,7 +7,7 @@ mod common;
 use common::cli::inksim_in;
 use common::scene::{PigmentToml, SceneToml};
 use common::study::StudyToml;
-use inksim::output::h5::{read_appearance, read_measured, read_summary};
+use inksim::output::h5::{read_appearance, read_baseline, read_measured, read_summary};
 
 /// A CSV table as rows of column → field (no field of ours is quoted).
 fn table(path: &Path) -> Vec<HashMap<String, String>> {
@@ -154,7 +154,8 @@ fn a_study_exports_every_finished_variants_colours_with_its_labels() {
     let base = scene()
         .realisations(1)
         .pigment(PigmentToml::builtin("red").named("p").diameter_nm(150.0))
-        .outputs(&["tile"]);
+        .outputs(&["tile"])
+        .set("appearance.baseline", "kubelka-munk");
     let study = StudyToml::new("t", 5, "out", &base).axis("pvc", "pigment.0.pvc", "[0.1, 0.2]");
     std::fs::write(dir.path().join("study.toml"), study.toml()).unwrap();
     let (ok, _, err) = inksim_in(dir.path(), &["run", "study.toml"]);
@@ -176,6 +177,13 @@ fn a_study_exports_every_finished_variants_colours_with_its_labels() {
         rows[0]["de00_se"].is_empty(),
         "one realisation: no standard error"
     );
+    // The Kubelka–Munk baseline beside the wave colour, geometry by geometry.
+    let km = read_baseline(&dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
+    for r in rows.iter().filter(|r| &r["variant"] == name) {
+        let b = km.iter().find(|b| b.geometry == r["geometry"]).unwrap();
+        assert_eq!(num(r, "km_b_star"), b.lab[2]);
+        assert_eq!(num(r, "km_de00_to_wave"), b.de00_to_wave.unwrap());
+    }
 
     // A variant not finished has no rows, and the user is told.
     std::fs::remove_file(dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
@@ -185,4 +193,35 @@ fn a_study_exports_every_finished_variants_colours_with_its_labels() {
         "{err}"
     );
     assert_eq!(table(&dir.path().join(&path)).len(), 3);
+}
+
+#[test]
+fn the_kubelka_munk_baseline_is_exported_beside_the_wave_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = scene()
+        .realisations(1)
+        .set("appearance.baseline", "kubelka-munk")
+        .output(&out, "km")
+        .write(dir.path());
+    assert!(inksim_in(dir.path(), &["run", cfg.to_str().unwrap()]).0);
+    let (ok, stdout, err) = inksim_in(dir.path(), &["export", "out/km.h5"]);
+    assert!(
+        ok && stdout.contains("baseline: out/km-baseline.csv"),
+        "{stdout}{err}"
+    );
+    let rows = table(&out.join("km-baseline.csv"));
+    let stored = read_baseline(&out.join("km.h5")).unwrap();
+    let (measured, _, _) = read_measured(&out.join("km.h5")).unwrap().unwrap();
+    assert_eq!(rows.len(), measured.len());
+    for (r, b) in rows.iter().zip(&stored) {
+        assert_eq!(r["model"], "kubelka-munk");
+        assert_eq!(r["geometry"], b.geometry);
+        assert_eq!(num(r, "L_star"), b.lab[0]);
+        assert_eq!(num(r, "de00_to_wave"), b.de00_to_wave.unwrap());
+        // The stored difference is to the wave colour of the same geometry.
+        let wave = measured.iter().find(|m| m.geometry == b.geometry).unwrap();
+        let de = inksim::optics::colour::delta_e2000(b.lab, wave.lab);
+        assert!((de - b.de00_to_wave.unwrap()).abs() < 1e-12);
+    }
 }

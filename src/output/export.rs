@@ -18,7 +18,11 @@
 //!   `illuminant`, `observer_deg`, CIELAB `L_star`, `a_star`, `b_star`,
 //!   `C_star_ab`, `h_deg`, their standard errors `L_star_se`, `a_star_se`,
 //!   `b_star_se` and `de00_se` (empty for one realisation), and CIE `X`,
-//!   `Y`, `Z` (Y of the perfect diffuser = 100; measurement geometries only).
+//!   `Y`, `Z` (Y of the perfect diffuser = 100; measurement geometries only);
+//! - `<name>-baseline.csv` (with `appearance.baseline`): per measurement
+//!   geometry the baseline's `model`, `geometry`, `illuminant`,
+//!   `observer_deg`, `L_star`, `a_star`, `b_star`, `C_star_ab`, `h_deg` and
+//!   `de00_to_wave`, its CIEDE2000 to the wave colour of that geometry.
 //!
 //! Numbers are written in the shortest form that reads back to the same
 //! f64; a text field with a comma or a quote is quoted.
@@ -27,7 +31,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::IoError;
-use super::h5::{read_appearance, read_measured, read_summary};
+use super::h5::{read_appearance, read_baseline, read_measured, read_summary};
 use crate::optics::colour::lab_to_lch;
 use crate::optics::farfield::Side;
 
@@ -241,6 +245,24 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
         }
     }
     tables.push(("colours", colours.into_text()));
+    let baseline = read_baseline(path)?;
+    if !baseline.is_empty() {
+        let mut header = vec!["model", "geometry"];
+        header.extend(&COLOUR_COLUMNS[..7]);
+        header.push("de00_to_wave");
+        let mut km = Csv::new(&header);
+        for b in baseline {
+            let mut f = vec![b.model.clone(), b.geometry.clone()];
+            f.extend(
+                colour_fields(&ill, &obs, b.lab, None, None, None)
+                    .into_iter()
+                    .take(7),
+            );
+            f.push(opt(b.de00_to_wave));
+            km.row(f);
+        }
+        tables.push(("baseline", km.into_text()));
+    }
     Ok(tables)
 }
 

@@ -137,3 +137,51 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
     }
     Ok(Some((out, illuminant, observer)))
 }
+
+/// One measurement geometry's Kubelka–Munk colour as read back from a
+/// result file (`/appearance/baseline`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BaselineRecord {
+    /// The baseline's model (`kubelka-munk`).
+    pub model: String,
+    /// The geometry's name (`45/0`, `d/8 SCI`, `d/8 SCE`).
+    pub geometry: String,
+    pub lab: [f64; 3],
+    /// CIEDE2000 to the wave solution's colour in the same geometry.
+    pub de00_to_wave: Option<f64>,
+}
+
+/// The baseline colours of a result file; empty when it has none.
+pub fn read_baseline(path: &Path) -> Result<Vec<BaselineRecord>, IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    if !file.link_exists("appearance/baseline") {
+        return Ok(Vec::new());
+    }
+    let g = file.group("appearance/baseline").map_err(hdf)?;
+    let model = read_str_attr(&g, "model").map_err(hdf)?;
+    let mut out = Vec::new();
+    for name in g.member_names().map_err(hdf)? {
+        let d = g.group(&name).map_err(hdf)?;
+        let lab: Vec<f64> = d.dataset("lab").and_then(|x| x.read_raw()).map_err(hdf)?;
+        let de00_to_wave = if d.link_exists("de00_to_wave") {
+            let v: Vec<f64> = d
+                .dataset("de00_to_wave")
+                .and_then(|x| x.read_raw())
+                .map_err(hdf)?;
+            v.first().copied()
+        } else {
+            None
+        };
+        out.push(BaselineRecord {
+            model: model.clone(),
+            geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
+            lab: [lab[0], lab[1], lab[2]],
+            de00_to_wave,
+        });
+    }
+    Ok(out)
+}

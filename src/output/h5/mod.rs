@@ -35,7 +35,9 @@ mod scales;
 mod summary;
 
 pub use crate::output::error::IoError;
-pub use appearance_read::{read_appearance, read_measured, AppearanceArrays, MeasuredRecord};
+pub use appearance_read::{
+    read_appearance, read_baseline, read_measured, AppearanceArrays, BaselineRecord, MeasuredRecord,
+};
 pub(crate) use described::{about, dim, Scales};
 pub use geometry::GeometrySummary;
 pub use result::{write_result, RealisationStop, ResultSet};

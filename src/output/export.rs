@@ -31,7 +31,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::IoError;
-use super::h5::{read_appearance, read_baseline, read_measured, read_summary};
+use super::h5::{read_appearance, read_baseline, read_measured, read_optional, read_summary};
 use crate::optics::colour::lab_to_lch;
 use crate::optics::farfield::Side;
 
@@ -287,24 +287,7 @@ impl Extra {
         let g = hdf5::File::open(path)
             .and_then(|f| f.group("appearance"))
             .map_err(hdf)?;
-        let two = |name: &str| -> Result<Option<ndarray::Array2<f64>>, IoError> {
-            if !g.link_exists(name) {
-                return Ok(None);
-            }
-            g.dataset(name)
-                .and_then(|d| d.read())
-                .map(Some)
-                .map_err(hdf)
-        };
-        let tile_lab_se = if g.link_exists("tile_lab_se") {
-            Some(
-                g.dataset("tile_lab_se")
-                    .and_then(|d| d.read())
-                    .map_err(hdf)?,
-            )
-        } else {
-            None
-        };
+        let two = |name: &str| read_optional::<f64, ndarray::Ix2>(&g, name).map_err(hdf);
         let conditions = match (g.attr("illuminant"), g.attr("observer_deg")) {
             (Ok(i), Ok(o)) => {
                 let ill: hdf5::types::VarLenUnicode = i.read_scalar().map_err(hdf)?;
@@ -317,7 +300,7 @@ impl Extra {
             reflectance_se: two("reflectance_se")?,
             transmittance_se: two("transmittance_se")?,
             absorption_se: two("absorption_se")?,
-            tile_lab_se,
+            tile_lab_se: read_optional(&g, "tile_lab_se").map_err(hdf)?,
             tile_de00_se: two("tile_de00_se")?,
             conditions,
         })

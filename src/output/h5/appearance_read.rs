@@ -6,6 +6,31 @@ use std::path::Path;
 use super::attrs::read_str_attr;
 use super::IoError;
 
+/// Dataset `name` of `g` read whole, `None` where `g` has no such link
+/// (the optional datasets of docs/FORMAT.md).
+pub fn read_optional<T: hdf5::H5Type, D: ndarray::Dimension>(
+    g: &hdf5::Group,
+    name: &str,
+) -> hdf5::Result<Option<ndarray::Array<T, D>>> {
+    if !g.link_exists(name) {
+        return Ok(None);
+    }
+    g.dataset(name)?.read().map(Some)
+}
+
+/// The first `N` values of an optional 1-D dataset (a colour's three
+/// components, a single value), refused when it holds fewer.
+fn optional_values<const N: usize>(g: &hdf5::Group, name: &str) -> hdf5::Result<Option<[f64; N]>> {
+    match read_optional::<f64, ndarray::Ix1>(g, name)? {
+        None => Ok(None),
+        Some(v) if v.len() >= N => Ok(Some(std::array::from_fn(|i| v[i]))),
+        Some(v) => Err(hdf5::Error::from(format!(
+            "{name}: {} values, expected {N}",
+            v.len()
+        ))),
+    }
+}
+
 /// The ensemble-mean appearance arrays of a result file (`/appearance`),
 /// for comparing runs (docs/ACCURACY.md). Shapes as in docs/FORMAT.md.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,27 +68,8 @@ pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError>
     let arr2 = |name: &str| -> Result<ndarray::Array2<f64>, IoError> {
         g.dataset(name).and_then(|d| d.read()).map_err(hdf)
     };
-    let brdf_total = if g.link_exists("brdf_total") {
-        Some(
-            g.dataset("brdf_total")
-                .and_then(|d| d.read())
-                .map_err(hdf)?,
-        )
-    } else {
-        None
-    };
-    let natural = if g.link_exists("natural") {
-        Some(arr2("natural")?)
-    } else {
-        None
-    };
-    let tile_lab = if g.link_exists("tile_lab") {
-        Some(g.dataset("tile_lab").and_then(|d| d.read()).map_err(hdf)?)
-    } else {
-        None
-    };
     Ok(Some(AppearanceArrays {
-        tile_lab,
+        tile_lab: read_optional(&g, "tile_lab").map_err(hdf)?,
         wavelengths_nm: vec("wavelengths_nm")?,
         illumination_deg: vec("illumination_deg")?,
         viewing_deg: vec("viewing_deg")?,
@@ -71,8 +77,8 @@ pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError>
         reflectance: arr2("reflectance")?,
         transmittance: arr2("transmittance")?,
         absorption: arr2("absorption")?,
-        brdf_total,
-        natural,
+        brdf_total: read_optional(&g, "brdf_total").map_err(hdf)?,
+        natural: read_optional(&g, "natural").map_err(hdf)?,
     }))
 }
 
@@ -107,32 +113,19 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
         .attr("observer_deg")
         .and_then(|a| a.read_scalar())
         .map_err(hdf)?;
-    let three = |d: &hdf5::Group, name: &str| -> Result<Option<[f64; 3]>, IoError> {
-        if !d.link_exists(name) {
-            return Ok(None);
-        }
-        let v: Vec<f64> = d.dataset(name).and_then(|x| x.read_raw()).map_err(hdf)?;
-        Ok(Some([v[0], v[1], v[2]]))
-    };
     let mg = g.group("measured").map_err(hdf)?;
     let mut out = Vec::new();
     for name in mg.member_names().map_err(hdf)? {
         let d = mg.group(&name).map_err(hdf)?;
-        let de00_se = if d.link_exists("de00_se") {
-            let v: Vec<f64> = d
-                .dataset("de00_se")
-                .and_then(|x| x.read_raw())
-                .map_err(hdf)?;
-            v.first().copied()
-        } else {
-            None
-        };
+        let three = |name: &str| optional_values::<3>(&d, name).map_err(hdf);
         out.push(MeasuredRecord {
             geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
-            lab: three(&d, "lab")?.unwrap_or([f64::NAN; 3]),
-            xyz: three(&d, "xyz")?.unwrap_or([f64::NAN; 3]),
-            lab_se: three(&d, "lab_se")?,
-            de00_se,
+            lab: three("lab")?.unwrap_or([f64::NAN; 3]),
+            xyz: three("xyz")?.unwrap_or([f64::NAN; 3]),
+            lab_se: three("lab_se")?,
+            de00_se: optional_values::<1>(&d, "de00_se")
+                .map_err(hdf)?
+                .map(|[v]| v),
         });
     }
     Ok(Some((out, illuminant, observer)))
@@ -166,21 +159,16 @@ pub fn read_baseline(path: &Path) -> Result<Vec<BaselineRecord>, IoError> {
     let mut out = Vec::new();
     for name in g.member_names().map_err(hdf)? {
         let d = g.group(&name).map_err(hdf)?;
-        let lab: Vec<f64> = d.dataset("lab").and_then(|x| x.read_raw()).map_err(hdf)?;
-        let de00_to_wave = if d.link_exists("de00_to_wave") {
-            let v: Vec<f64> = d
-                .dataset("de00_to_wave")
-                .and_then(|x| x.read_raw())
-                .map_err(hdf)?;
-            v.first().copied()
-        } else {
-            None
-        };
+        let lab = optional_values::<3>(&d, "lab")
+            .and_then(|v| v.ok_or_else(|| hdf5::Error::from(format!("{name}: no lab"))))
+            .map_err(hdf)?;
         out.push(BaselineRecord {
             model: model.clone(),
             geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
-            lab: [lab[0], lab[1], lab[2]],
-            de00_to_wave,
+            lab,
+            de00_to_wave: optional_values::<1>(&d, "de00_to_wave")
+                .map_err(hdf)?
+                .map(|[v]| v),
         });
     }
     Ok(out)

@@ -36,7 +36,8 @@ mod summary;
 
 pub use crate::output::error::IoError;
 pub use appearance_read::{
-    read_appearance, read_baseline, read_measured, AppearanceArrays, BaselineRecord, MeasuredRecord,
+    read_appearance, read_baseline, read_measured, read_optional, AppearanceArrays, BaselineRecord,
+    MeasuredRecord,
 };
 pub(crate) use described::{about, dim, Scales};
 pub use geometry::GeometrySummary;

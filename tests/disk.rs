@@ -49,7 +49,7 @@ fn the_disk_estimate_holds_what_a_run_writes() {
             .realisations(realisations)
             .output(&out, "tiny");
         let scene = toml.scene(dir.path());
-        let estimate = disk::estimate_bytes(&scene);
+        let estimate = disk::estimate_bytes(&scene, &inksim::pipeline::RunPlan::of(&scene));
         toml.run(dir.path());
         let written = bytes_in(&out) as f64;
         assert!(
@@ -94,12 +94,11 @@ fn a_run_the_disk_cannot_hold_is_refused_before_any_solve() {
         .outputs(&["brdf", "tile"])
         .output(&out, "tiny")
         .write(dir.path());
-    let need = disk::estimate_bytes(
-        &tiny()
-            .outputs(&["brdf", "tile"])
-            .output(&out, "tiny")
-            .scene(dir.path()),
-    );
+    let scene = tiny()
+        .outputs(&["brdf", "tile"])
+        .output(&out, "tiny")
+        .scene(dir.path());
+    let need = disk::estimate_bytes(&scene, &inksim::pipeline::RunPlan::of(&scene));
     assert!(
         need > 256e3,
         "the test needs a result larger than the file system"

@@ -86,15 +86,12 @@ pub fn geometry(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> 
 /// `inksim check SCENE`: validate and print what a run would compute.
 pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     let scene = config.scene()?;
+    let run_plan = inksim::pipeline::RunPlan::of(&scene);
+    let disk_bytes = inksim::pipeline::disk::estimate_bytes(&scene, &run_plan);
     inksim::pipeline::memory::fits(&scene, memory)
         .and_then(|()| inksim::pipeline::check_output_files(&scene))
         .and_then(|()| inksim::pipeline::check_inputs(&scene))
-        .and_then(|()| {
-            inksim::pipeline::disk::preflight(
-                &scene.output.dir,
-                inksim::pipeline::disk::estimate_bytes(&scene),
-            )
-        })
+        .and_then(|()| inksim::pipeline::disk::preflight(&scene.output.dir, disk_bytes))
         .with_context(|| config.display().to_string())?;
     let g = scene.grid;
     println!("{}: valid", config.display());
@@ -108,7 +105,6 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
         g.nz,
         g.nx * g.ny * g.nz
     );
-    let run_plan = inksim::pipeline::RunPlan::of(&scene);
     println!(
         "{} solves ({} wavelengths × {} realisations × {} incidences), method {:?}, \
          tolerance {:.0e}",
@@ -141,7 +137,7 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     println!(
         "would write {} (about {} in all)",
         files.join(", "),
-        human_bytes(inksim::pipeline::disk::estimate_bytes(&scene))
+        human_bytes(disk_bytes)
     );
     Ok(())
 }

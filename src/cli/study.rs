@@ -45,7 +45,12 @@ pub fn run(
         .variants
         .iter()
         .filter(|v| shard.contains(v.index) && srun::state(v) != State::Done)
-        .map(|v| inksim::pipeline::disk::estimate_bytes(&v.scene))
+        .map(|v| {
+            inksim::pipeline::disk::estimate_bytes(
+                &v.scene,
+                &inksim::pipeline::RunPlan::of(&v.scene),
+            )
+        })
         .sum();
     inksim::pipeline::disk::preflight(&exp.study_dir, need)
         .with_context(|| config.display().to_string())?;
@@ -131,7 +136,12 @@ pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
         let need: f64 = exp
             .variants
             .iter()
-            .map(|v| inksim::pipeline::disk::estimate_bytes(&v.scene))
+            .map(|v| {
+                inksim::pipeline::disk::estimate_bytes(
+                    &v.scene,
+                    &inksim::pipeline::RunPlan::of(&v.scene),
+                )
+            })
             .sum();
         inksim::pipeline::disk::preflight(&exp.study_dir, need).with_context(|| {
             format!(

@@ -39,9 +39,8 @@ pub const SPHERE_BYTES: f64 = 48.0;
 /// The MERL export.
 pub const MERL_BYTES: f64 = 12.0 + 90.0 * 90.0 * 180.0 * 3.0 * 8.0;
 
-/// Estimated bytes a run of `scene` writes (module docs).
-pub fn estimate_bytes(scene: &Scene) -> f64 {
-    let plan = RunPlan::of(scene);
+/// Estimated bytes a run of `scene` following `plan` writes (module docs).
+pub fn estimate_bytes(scene: &Scene, plan: &RunPlan) -> f64 {
     let files = output_files(scene);
     let pngs = files
         .iter()

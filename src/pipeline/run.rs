@@ -67,8 +67,8 @@ pub fn run_with(
     check_output_files(scene)?;
     check_output_dir(&scene.output.dir)?;
     memory::preflight(scene, limit)?;
-    super::disk::preflight(&scene.output.dir, super::disk::estimate_bytes(scene))?;
     let mut plan = RunPlan::of(scene);
+    super::disk::preflight(&scene.output.dir, super::disk::estimate_bytes(scene, &plan))?;
     let total = plan.solves(scene) as u64;
     let progress = if quiet {
         Progress::hidden(total, &scene.output.name)

@@ -7,22 +7,6 @@ use std::process::Command;
 mod common;
 use common::scene::SceneToml;
 
-/// Red spheres, 15 % PVC of 150 nm, in a 400 nm layer: 20 × 20 × 20 cells,
-/// two wavelengths, two angles.
-fn tiny() -> SceneToml {
-    SceneToml::grains()
-        .seed(3)
-        .thickness_nm(400.0)
-        .fragment_nm(500.0)
-        .pvc(0.15)
-        .diameter_nm(150.0)
-        .z_cell_nm(20.0)
-        .wavelengths_nm(&[500.0, 600.0])
-        .polar_deg(&[0.0, 40.0])
-        .tolerance(1e-7)
-        .output_name("tiny")
-}
-
 fn inksim(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
         .args(args)
@@ -68,28 +52,28 @@ fn expect_error(scene: SceneToml, needle: &str) {
 
 #[test]
 fn unknown_key_is_named() {
-    expect_error(tiny().set("colour", 1), "colour");
+    expect_error(SceneToml::tiny().set("colour", 1), "colour");
 }
 
 #[test]
 fn negative_thickness_is_named() {
-    expect_error(tiny().thickness_nm(-5.0), "layer.thickness_nm");
+    expect_error(SceneToml::tiny().thickness_nm(-5.0), "layer.thickness_nm");
 }
 
 #[test]
 fn pvc_beyond_packer_is_named() {
-    expect_error(tiny().pvc(0.6), "0.55");
+    expect_error(SceneToml::tiny().pvc(0.6), "0.55");
 }
 
 #[test]
 fn wavelength_outside_pigment_data_is_named() {
-    expect_error(tiny().wavelengths_nm(&[500.0, 900.0]), "900");
+    expect_error(SceneToml::tiny().wavelengths_nm(&[500.0, 900.0]), "900");
 }
 
 #[test]
 fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
     expect_error(
-        tiny().raw(
+        SceneToml::tiny().raw(
             "pigment.0.material",
             r#"{ builtin = "red", index = [1.5, 0.0] }"#,
         ),
@@ -97,23 +81,23 @@ fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
          material = { builtin = \"red\" }); this one gives more than one",
     );
     expect_error(
-        tiny().raw("pigment.0.material", "{}"),
+        SceneToml::tiny().raw("pigment.0.material", "{}"),
         "this one gives none",
     );
     expect_error(
-        tiny().raw("pigment.0.shape", r#""rice""#),
+        SceneToml::tiny().raw("pigment.0.shape", r#""rice""#),
         "expected a grain shape: { kind = \"sphere\" }",
     );
     expect_error(
-        tiny().raw("pigment.0.shape", r#""rice""#),
+        SceneToml::tiny().raw("pigment.0.shape", r#""rice""#),
         r#"got string "rice""#,
     );
     expect_error(
-        tiny().raw("pigment.0.shape", "{ aspect = 3.0 }"),
+        SceneToml::tiny().raw("pigment.0.shape", "{ aspect = 3.0 }"),
         "`shape` is missing `kind`: expected a grain shape",
     );
     expect_error(
-        tiny().raw("layer.surface", r#""rough""#),
+        SceneToml::tiny().raw("layer.surface", r#""rough""#),
         "expected a surface: { kind = \"flat\" }",
     );
 }
@@ -122,25 +106,28 @@ fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
 fn limits_and_numbers_read_as_written() {
     // The grain limit is the packer's, not (0, 1).
     expect_error(
-        tiny().pvc(1.0),
+        SceneToml::tiny().pvc(1.0),
         "key `pigment[0].pvc`: must be in (0, 0.55] (the most the packer reaches), got 1",
     );
     // Huge and tiny numbers in exponent form, not 301 digits.
-    expect_error(tiny().diameter_nm(1e300), "got 1e300");
-    expect_error(tiny().tolerance(1e-300), "1e-300");
+    expect_error(SceneToml::tiny().diameter_nm(1e300), "got 1e300");
+    expect_error(SceneToml::tiny().tolerance(1e-300), "1e-300");
     // Grains so small the layer would hold more than a packer can place.
     expect_error(
-        tiny().diameter_nm(1e-9),
+        SceneToml::tiny().diameter_nm(1e-9),
         "1e-9 nm grains at PVC 0.15 make about 2.9e34 grains in this layer, more than the \
          2000000 a layer may hold",
     );
-    expect_error(tiny().diameter_nm(2.0), "make about 3580986 grains");
+    expect_error(
+        SceneToml::tiny().diameter_nm(2.0),
+        "make about 3580986 grains",
+    );
 }
 
 #[test]
 fn unwritable_output_folder_is_named() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let blocker = dir.path().join("file");
     std::fs::write(&blocker, b"x").unwrap();
     let out = blocker.join("sub");
@@ -167,7 +154,7 @@ fn missing_config_file_is_named() {
 #[test]
 fn run_writes_results_identical_for_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let mut summaries = vec![];
     for threads in ["1", "2"] {
         let out = dir.path().join(format!("t{threads}"));
@@ -223,7 +210,7 @@ fn run_writes_results_identical_for_one_and_two_threads() {
 #[test]
 fn grain_longer_than_half_the_fragment_is_named_once() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = tiny().diameter_nm(200.0).raw(
+    let scene = SceneToml::tiny().diameter_nm(200.0).raw(
         "pigment.0.shape",
         "{ kind = \"rice\", aspect = 3.0, spheres = 3 }",
     );
@@ -245,7 +232,7 @@ fn grain_longer_than_half_the_fragment_is_named_once() {
 #[test]
 fn dense_rice_layer_uses_dynamics_and_runs() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = tiny()
+    let scene = SceneToml::tiny()
         .pvc(0.45)
         .diameter_nm(80.0)
         .raw("pigment.0.shape", "{ kind = \"rice\" }")
@@ -272,7 +259,7 @@ fn dense_rice_layer_uses_dynamics_and_runs() {
 #[test]
 fn sparse_spheres_use_random_addition() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let (ok, out, err) = inksim(&["check", cfg.to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(out.contains("geometry: rsa"), "{out}");
@@ -281,7 +268,7 @@ fn sparse_spheres_use_random_addition() {
 #[test]
 fn geometry_command_writes_particles_and_picture() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let out = dir.path().join("geo");
     let (ok, stdout, err) = inksim(&[
         "geometry",
@@ -311,7 +298,10 @@ fn geometry_command_writes_particles_and_picture() {
 /// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (197 + 8) B
 /// + 25 MB = 68.8 GB by the memory model.
 fn huge_scene() -> SceneToml {
-    tiny().fragment_nm(4096.0).cell_nm(1.0).z_cell_nm(20.0)
+    SceneToml::tiny()
+        .fragment_nm(4096.0)
+        .cell_nm(1.0)
+        .z_cell_nm(20.0)
 }
 
 /// One line, no panic, naming the grid, the estimate, the limit and what
@@ -352,7 +342,7 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert_memory_line(&err);
     assert!(t.elapsed().as_secs_f64() < 10.0, "no work before the check");
     assert!(!out.join("tiny.h5").exists());
-    let small = tiny().write(dir.path());
+    let small = SceneToml::tiny().write(dir.path());
     let (ok, out, _) = inksim(&["check", small.to_str().unwrap(), "--max-memory", "1G"]);
     assert!(ok, "20 × 20 × 20 fits in 1 GB: {out}");
     assert!(
@@ -376,7 +366,7 @@ fn a_missing_file_is_not_found_whatever_the_flags() {
 #[test]
 fn plan_on_a_scene_says_it_is_not_a_study() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let (ok, _, err) = inksim(&["plan", cfg.to_str().unwrap()]);
     assert!(
         !ok && err.contains("scene.toml: not a study (no [study] table)"),
@@ -387,7 +377,7 @@ fn plan_on_a_scene_says_it_is_not_a_study() {
 #[test]
 fn a_huge_thread_count_is_capped_with_a_message() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny().write(dir.path());
+    let cfg = SceneToml::tiny().write(dir.path());
     let (ok, _, err) = inksim(&["--threads", "100000", "check", cfg.to_str().unwrap()]);
     assert!(ok && err.contains("--threads 100000 capped at"), "{err}");
 }
@@ -397,7 +387,7 @@ fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir_all(out.join("tiny.h5")).unwrap();
-    let cfg = tiny().output(&out, "tiny").write(dir.path());
+    let cfg = SceneToml::tiny().output(&out, "tiny").write(dir.path());
     for cmd in ["check", "run"] {
         let (ok, _, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
         assert!(!ok, "{cmd}");
@@ -415,7 +405,7 @@ fn a_folder_where_the_result_goes_fails_check_and_run_before_any_solve() {
 fn a_second_run_of_the_same_result_refuses_while_the_first_holds_it() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let cfg = tiny().output(&out, "tiny").write(dir.path());
+    let cfg = SceneToml::tiny().output(&out, "tiny").write(dir.path());
     // Another run holds the result's lock (as `inksim run` does while it works).
     let held = inksim::output::lock::OutputLock::try_acquire(&out.join("tiny.h5"))
         .unwrap()
@@ -450,7 +440,9 @@ fn a_config_is_read_once_so_standard_input_works() {
     use std::io::Write;
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
-    let text = tiny().output(&dir.path().join("out"), "tiny").toml();
+    let text = SceneToml::tiny()
+        .output(&dir.path().join("out"), "tiny")
+        .toml();
     let mut child = Command::new(env!("CARGO_BIN_EXE_inksim"))
         .args(["check", "/dev/stdin"])
         .stdin(Stdio::piped())
@@ -496,7 +488,7 @@ fn version_names_the_commit_and_log_lines_carry_their_time() {
     );
     // Off a terminal every progress line of a run starts with its UTC time.
     let dir = tempfile::tempdir().unwrap();
-    let (ok, err, _, out) = run_scene(dir.path(), &tiny());
+    let (ok, err, _, out) = run_scene(dir.path(), &SceneToml::tiny());
     assert!(ok, "{err}");
     let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
     assert!(lines.len() > 3, "{err}");
@@ -518,7 +510,7 @@ fn a_long_solve_reports_its_iterations_while_it_runs() {
     // the method, an iteration count that grows, the residual against the
     // tolerance and the time in the solve.
     let dir = tempfile::tempdir().unwrap();
-    let cfg = tiny()
+    let cfg = SceneToml::tiny()
         .method("gmres")
         .output(&dir.path().join("out"), "tiny")
         .write(dir.path());

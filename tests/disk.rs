@@ -8,21 +8,9 @@ mod common;
 use common::scene::SceneToml;
 use inksim::pipeline::disk;
 
-/// Red spheres, 15 % PVC of 150 nm, in a 400 nm layer on paper.
+/// The shared tiny scene, on paper.
 fn tiny() -> SceneToml {
-    SceneToml::grains()
-        .seed(3)
-        .thickness_nm(400.0)
-        .fragment_nm(500.0)
-        .pvc(0.15)
-        .diameter_nm(150.0)
-        .z_cell_nm(20.0)
-        .wavelengths_nm(&[500.0, 600.0])
-        .polar_deg(&[0.0, 40.0])
-        .tolerance(1e-7)
-        .quadrature_points(3)
-        .paper(0.8)
-        .output_name("tiny")
+    SceneToml::tiny().quadrature_points(3).paper(0.8)
 }
 
 fn bytes_in(dir: &Path) -> u64 {

@@ -46,6 +46,22 @@ impl SceneToml {
         Self::grains().pigment(PigmentToml::builtin("red").pvc(0.2).molecular())
     }
 
+    /// Red spheres, 15 % PVC of 150 nm, in a 400 nm layer: 20 × 20 × 20
+    /// cells, two wavelengths, two angles; results named `tiny`.
+    pub fn tiny() -> Self {
+        Self::grains()
+            .seed(3)
+            .thickness_nm(400.0)
+            .fragment_nm(500.0)
+            .pvc(0.15)
+            .diameter_nm(150.0)
+            .z_cell_nm(20.0)
+            .wavelengths_nm(&[500.0, 600.0])
+            .polar_deg(&[0.0, 40.0])
+            .tolerance(1e-7)
+            .output_name("tiny")
+    }
+
     /// The layer of [`grains`](Self::grains) given as explicit bodies in
     /// the binder instead of pigments.
     pub fn structure(bodies: &[PrimitiveToml]) -> Self {

@@ -81,7 +81,7 @@ fn knobs() -> Vec<(&'static str, Vec<Value>)> {
         ("solver.tolerance", f(&[1e-2, 1e-3, 1e-4, 1e-6, 1e-9])),
         (
             "illumination.wavelength_range_nm.step",
-            f(&[100.0, 50.0, 30.0, 10.0]),
+            f(&[100.0, 50.0, 30.0, 20.0, 15.0, 10.0]),
         ),
         ("appearance.quadrature_points", i(&[2, 4, 6, 12])),
         ("realisations", i(&[1, 2, 4, 8])),

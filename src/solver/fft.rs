@@ -64,29 +64,13 @@ impl Fft2 {
     /// Unnormalised forward transform of every slice: `real (nz,ny,nx)` → `spec (nz,nx,ny)`.
     /// `real` is used as working space and left transformed along x.
     pub fn forward(&self, real: &mut Array3<C64>, spec: &mut Array3<C64>, scr: &mut FftScratch) {
-        self.forward_from(|_, _| {}, real, spec, scr);
-    }
-
-    /// [`forward`](Self::forward) of the slices `fill(k, slice)` writes into
-    /// `real`'s slice `k` (whatever it held) just before that slice is
-    /// transformed, while it is in cache: a pointwise product feeding the
-    /// transform costs no pass of its own over the field.
-    pub fn forward_from(
-        &self,
-        fill: impl Fn(usize, &mut [C64]) + Sync,
-        real: &mut Array3<C64>,
-        spec: &mut Array3<C64>,
-        scr: &mut FftScratch,
-    ) {
         let (nx, ny) = (self.nx, self.ny);
         let r = real.as_slice_mut().expect("contiguous field");
         let s = spec.as_slice_mut().expect("contiguous spectrum");
         r.par_chunks_mut(nx * ny)
             .zip(s.par_chunks_mut(nx * ny))
             .zip(scr.bufs.par_iter_mut())
-            .enumerate()
-            .for_each(|(k, ((rs, ss), buf))| {
-                fill(k, rs);
+            .for_each(|((rs, ss), buf)| {
                 self.fx.process_with_scratch(rs, buf);
                 transpose(rs, ss, ny, nx);
                 self.fy.process_with_scratch(ss, buf);
@@ -102,40 +86,11 @@ impl Fft2 {
         s.par_chunks_mut(nx * ny)
             .zip(r.par_chunks_mut(nx * ny))
             .zip(scr.bufs.par_iter_mut())
-            .for_each(|((ss, rs), buf)| self.inverse_slice(ss, rs, buf));
-    }
-
-    /// [`inverse`](Self::inverse), then `then(k, slice, out_k)` on each
-    /// transformed slice `k` while it is in cache, with `out_k` slice `k` of
-    /// `out` (`out` holds nz slices of nx·ny values, (nz, ny, nx)): what
-    /// consumes the transform's result costs no pass of its own.
-    pub fn inverse_then<T: Send>(
-        &self,
-        spec: &mut Array3<C64>,
-        real: &mut Array3<C64>,
-        scr: &mut FftScratch,
-        out: &mut [T],
-        then: impl Fn(usize, &[C64], &mut [T]) + Sync,
-    ) {
-        let (nx, ny) = (self.nx, self.ny);
-        let r = real.as_slice_mut().expect("contiguous field");
-        let s = spec.as_slice_mut().expect("contiguous spectrum");
-        assert_eq!(out.len(), r.len(), "one output value per voxel");
-        s.par_chunks_mut(nx * ny)
-            .zip(r.par_chunks_mut(nx * ny))
-            .zip(scr.bufs.par_iter_mut())
-            .zip(out.par_chunks_mut(nx * ny))
-            .enumerate()
-            .for_each(|(k, (((ss, rs), buf), o))| {
-                self.inverse_slice(ss, rs, buf);
-                then(k, rs, o);
+            .for_each(|((ss, rs), buf)| {
+                self.iy.process_with_scratch(ss, buf);
+                transpose(ss, rs, nx, ny);
+                self.ix.process_with_scratch(rs, buf);
             });
-    }
-
-    fn inverse_slice(&self, ss: &mut [C64], rs: &mut [C64], buf: &mut [C64]) {
-        self.iy.process_with_scratch(ss, buf);
-        transpose(ss, rs, self.nx, self.ny);
-        self.ix.process_with_scratch(rs, buf);
     }
 }
 

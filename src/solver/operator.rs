@@ -221,37 +221,9 @@ impl Operator {
         field: &mut Array3<C64>,
         ws: &mut Workspace,
     ) {
-        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
-        self.shifted_spectral(table, ws);
-        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
-    }
-
-    /// `G_s` applied to the source `source(k, slice)` writes per z-slice,
-    /// the result handed slice by slice to `then(k, slice, out_k)` (see
-    /// [`Fft2::forward_from`] and [`Fft2::inverse_then`]); `field` is
-    /// working space. The same arithmetic as filling `field`, applying
-    /// [`apply_shifted_green`](Self::apply_shifted_green) and reading it
-    /// back, without the two extra passes over the field.
-    pub fn apply_shifted_green_with<T: Send>(
-        &self,
-        table: &ShiftTable,
-        field: &mut Array3<C64>,
-        ws: &mut Workspace,
-        source: impl Fn(usize, &mut [C64]) + Sync,
-        out: &mut [T],
-        then: impl Fn(usize, &[C64], &mut [T]) + Sync,
-    ) {
-        self.fft
-            .forward_from(source, field, &mut ws.spec, &mut ws.fft);
-        self.shifted_spectral(table, ws);
-        self.fft
-            .inverse_then(&mut ws.spec, field, &mut ws.fft, out, then);
-    }
-
-    /// The spectral part of `G_s`: per harmonic, in place on `ws.spec`.
-    fn shifted_spectral(&self, table: &ShiftTable, ws: &mut Workspace) {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let norm = 1.0 / (nx * ny) as f64;
+        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         // Near-grazing harmonics: dense path on their saved columns.
         let mut dense = std::mem::take(&mut ws.special_in);
         dense.clear();
@@ -274,6 +246,7 @@ impl Operator {
             }
         }
         ws.special_in = dense;
+        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 
     /// Boundary values `w(0)`, `w(H)` of `w = G_b(x + c G_s x)` per harmonic
@@ -479,58 +452,6 @@ mod tests {
             for (g, w) in got.iter().zip(want.iter()) {
                 assert!((g - w).norm() < 1e-11 * scale, "{what}: {g} vs {w}");
             }
-        }
-    }
-
-    /// The fused application (source formed per slice as the FFT reads it,
-    /// result consumed per slice as the inverse FFT hands it back) gives the
-    /// same bits as forming the source, applying `G_s` and reading it back.
-    #[test]
-    fn fused_application_matches_three_passes_bit_for_bit() {
-        let (nx, ny, nz) = (12, 9, 16);
-        let lat = Problem::lattice([nx, ny, nz], [600.0, 450.0, 800.0], 500.0, 20.0, 10.0);
-        let eps_b = 1.558f64.powi(2);
-        let c = lat.k0 * lat.k0 * C64::new(0.4, 0.3);
-        let table = ShiftTable::new(&lat, eps_b, c);
-        let x = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
-            C64::new((i * j) as f64 * 0.01 - 0.2, (k as f64 * 0.3).cos())
-        });
-        let v = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
-            C64::new(0.5 + ((i + k) % 3) as f64 * 0.2, (j % 2) as f64 * 0.1)
-        });
-        let op = Operator::new(lat);
-        let mut ws = op.workspace();
-        // Three passes.
-        let mut field = Array3::from_shape_fn(x.dim(), |i| v[i] * x[i]);
-        op.apply_shifted_green(&table, &mut field, &mut ws);
-        let want = Array3::from_shape_fn(x.dim(), |i| x[i] - field[i]);
-        // Fused.
-        let plane = nx * ny;
-        let (xs, vs) = (x.as_slice().unwrap(), v.as_slice().unwrap());
-        let mut got = Array3::from_elem(x.dim(), C64::new(f64::NAN, 0.0));
-        let mut scratch = Array3::from_elem(x.dim(), C64::new(f64::NAN, 0.0));
-        op.apply_shifted_green_with(
-            &table,
-            &mut scratch,
-            &mut ws,
-            |k, slice| {
-                for (i, t) in slice.iter_mut().enumerate() {
-                    *t = vs[k * plane + i] * xs[k * plane + i];
-                }
-            },
-            got.as_slice_mut().unwrap(),
-            |k, slice, o| {
-                for (i, (o, t)) in o.iter_mut().zip(slice).enumerate() {
-                    *o = xs[k * plane + i] - t;
-                }
-            },
-        );
-        assert!(
-            want.iter().any(|w| (w - xs[0]).norm() > 1e-3),
-            "G_s did something"
-        );
-        for (g, w) in got.iter().zip(want.iter()) {
-            assert_eq!(g, w);
         }
     }
 }

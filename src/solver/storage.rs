@@ -133,30 +133,6 @@ pub fn dot<S: Storage>(a: &Array3<S>, b: &Array3<S>) -> C64 {
     parts.iter().sum()
 }
 
-/// `(⟨a, b⟩, ‖a‖²)` in one pass over both fields, each summed exactly as
-/// [`dot`] and [`norm_sqr`] sum it (the same bits, thread-count independent).
-pub fn dot_and_norm_sqr<S: Storage>(a: &Array3<S>, b: &Array3<S>) -> (C64, f64) {
-    let parts: Vec<(C64, f64)> = a
-        .outer_iter()
-        .into_par_iter()
-        .zip(b.outer_iter().into_par_iter())
-        .map(|(sa, sb)| {
-            let (mut d, mut n) = (C64::new(0.0, 0.0), 0.0);
-            for (x, y) in sa.iter().zip(sb.iter()) {
-                let x = x.load();
-                d += x.conj() * y.load();
-                n += x.norm_sqr();
-            }
-            (d, n)
-        })
-        .collect();
-    parts
-        .iter()
-        .fold((C64::new(0.0, 0.0), 0.0), |(d, n), (pd, pn)| {
-            (d + pd, n + pn)
-        })
-}
-
 /// ‖a‖² in f64 (thread-count independent).
 pub fn norm_sqr<S: Storage>(a: &Array3<S>) -> f64 {
     sum_slices(a, |x: &S, _: &S| x.load().norm_sqr(), a)
@@ -184,17 +160,5 @@ mod tests {
         }
         assert_eq!(norm_sqr(&a), 4e8 + 252.0);
         assert_eq!(dot(&a, &a), C64::new(4e8 + 252.0, 0.0));
-    }
-
-    #[test]
-    fn fused_reduction_gives_the_bits_of_the_separate_ones() {
-        let a = Array3::from_shape_fn((5, 7, 3), |(k, j, i)| {
-            C64::new((k * 7 + j) as f64 / 3.0, (i as f64 + 0.1).ln())
-        });
-        let b = a.mapv(|v| v * C64::new(0.3, -1.7) + 1e-3);
-        let (d, n) = dot_and_norm_sqr(&a, &b);
-        assert_eq!(d, dot(&a, &b));
-        assert_eq!(n, norm_sqr(&a));
-        assert!(n > 0.0 && d.norm() > 0.0);
     }
 }

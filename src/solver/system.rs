@@ -345,33 +345,13 @@ impl<'a> System<'a> {
         x: &Array3<S>,
         out: &mut Array3<S>,
     ) {
-        // `(V − c) x` is formed slice by slice as the FFT reads it, and
-        // `x − G_s(…)` as the inverse FFT hands each slice back: the same
-        // arithmetic as `load_scaled` and a pass over `out`, without those
-        // two passes over the field.
-        let (k2, eb, c) = (self.k2, self.eps_binder, self.shift.c);
-        let plane = self.op.lat.nx * self.op.lat.ny;
-        let xs = x.as_slice().expect("contiguous field");
-        let es = self.eps.as_slice().expect("contiguous permittivity");
-        let source = |k: usize, slice: &mut [C64]| {
-            let range = k * plane..(k + 1) * plane;
-            for ((t, x), e) in slice.iter_mut().zip(&xs[range.clone()]).zip(&es[range]) {
-                *t = (k2 * (e - eb) - c) * x.load();
-            }
-        };
-        let then = |k: usize, slice: &[C64], o: &mut [S]| {
-            for ((o, x), t) in o.iter_mut().zip(&xs[k * plane..]).zip(slice) {
-                *o = S::store(x.load() - t);
-            }
-        };
-        self.op.apply_shifted_green_with(
-            &self.shift.table,
-            &mut scr.field,
-            &mut scr.op,
-            source,
-            out.as_slice_mut().expect("contiguous field"),
-            then,
-        );
+        self.load_scaled(scr, x, self.shift.c);
+        self.op
+            .apply_shifted_green(&self.shift.table, &mut scr.field, &mut scr.op);
+        Zip::from(&mut *out)
+            .and(x)
+            .and(&scr.field)
+            .par_for_each(|o, x, t| *o = S::store(x.load() - t));
     }
 
     /// `x ← γ x`, γ = 1 + i(ε − ε_r)/ε_s: the CBS preconditioner of the

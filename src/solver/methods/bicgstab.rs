@@ -8,12 +8,11 @@
 
 use super::{restart, run_in_field_storage, Monitor, Outcome, Restart, Solver, Validity};
 use crate::config::{Method, Precision};
-use crate::solver::storage::{dot, dot_and_norm_sqr, norm_sqr, Storage};
+use crate::solver::storage::{dot, norm_sqr, Storage};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
-use rayon::prelude::*;
 
 /// BiCGStab settings.
 #[derive(Debug, Clone, Copy)]
@@ -126,13 +125,20 @@ impl BiCgStab {
                     .par_for_each(|s, r, v| *s = S::store(r.load() - alpha * v.load()));
                 Self::op(sys, scr, &s, &mut t);
                 applications += 2;
-                let (ts, tt) = dot_and_norm_sqr(&t, &s);
+                let tt = norm_sqr(&t);
                 omega = if tt > 0.0 {
-                    ts / tt
+                    dot(&t, &s) / tt
                 } else {
                     C64::new(0.0, 0.0)
                 };
-                let rn = step(u, &mut r, &p, &s, &t, alpha, omega).sqrt();
+                Zip::from(&mut *u).and(&p).and(&s).par_for_each(|u, p, s| {
+                    *u = S::store(u.load() + alpha * p.load() + omega * s.load())
+                });
+                Zip::from(&mut r)
+                    .and(&s)
+                    .and(&t)
+                    .par_for_each(|r, s, t| *r = S::store(s.load() - omega * t.load()));
+                let rn = norm_sqr(&r).sqrt();
                 // The true residual scales with the preconditioned one
                 // from the restart, where `target` is half of tolerance's.
                 monitor.tick(iterations, 0.5 * ctl.tolerance * rn / target);
@@ -142,43 +148,6 @@ impl BiCgStab {
             }
         }
     }
-}
-
-/// `u ← u + α p + ω s` and `r ← s − ω t` in one pass; returns ‖r‖² of the
-/// stored `r`, summed per z-slice as [`norm_sqr`] sums it.
-fn step<S: Storage>(
-    u: &mut Array3<S>,
-    r: &mut Array3<S>,
-    p: &Array3<S>,
-    s: &Array3<S>,
-    t: &Array3<S>,
-    alpha: C64,
-    omega: C64,
-) -> f64 {
-    let parts: Vec<f64> = u
-        .outer_iter_mut()
-        .into_par_iter()
-        .zip(r.outer_iter_mut().into_par_iter())
-        .zip(p.outer_iter().into_par_iter())
-        .zip(s.outer_iter().into_par_iter())
-        .zip(t.outer_iter().into_par_iter())
-        .map(|((((mut u, mut r), p), s), t)| {
-            let mut n = 0.0;
-            Zip::from(&mut u)
-                .and(&mut r)
-                .and(&p)
-                .and(&s)
-                .and(&t)
-                .for_each(|u, r, p, s, t| {
-                    let s = s.load();
-                    *u = S::store(u.load() + alpha * p.load() + omega * s);
-                    *r = S::store(s - omega * t.load());
-                    n += r.load().norm_sqr();
-                });
-            n
-        })
-        .collect();
-    parts.iter().sum()
 }
 
 /// Complex entries uniform in a square, from a fixed seed, scaled to norm

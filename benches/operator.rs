@@ -4,8 +4,9 @@
 //! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
 //! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
 //!
-//! `cargo bench --bench operator` (256 × 256 × 64 and 512 × 512 × 96; the
-//! larger grid needs about 3 GB). Each is measured twice: wall time
+//! `cargo bench --bench operator` (60 × 60 × 50, the standard profile's
+//! grid (1.4 µm fragments, 20 nm z cells), 256 × 256 × 64 and 512 × 512 × 96;
+//! the largest needs about 3 GB). Each is measured twice: wall time
 //! (`operator`) and the CPU time of all the process's threads together
 //! (`operator_cpu`, Linux), which other processes competing for the cores
 //! disturb much less.
@@ -28,14 +29,12 @@ fn field(nz: usize, ny: usize, nx: usize) -> Array3<C64> {
 fn bench<M: Measurement>(c: &mut Criterion<M>, name: &str) {
     let mut g = c.benchmark_group(name);
     g.sample_size(10);
-    for &(n, nz) in &[(256usize, 64usize), (512, 96)] {
-        let lat = Problem::lattice(
-            [n, n, nz],
-            [2560.0 * n as f64 / 256.0, 2560.0 * n as f64 / 256.0, 1000.0],
-            500.0,
-            30.0,
-            0.0,
-        );
+    for &(n, nz, period) in &[
+        (60usize, 50usize, 1400.0),
+        (256, 64, 2560.0),
+        (512, 96, 5120.0),
+    ] {
+        let lat = Problem::lattice([n, n, nz], [period, period, 1000.0], 500.0, 30.0, 0.0);
         let op = Operator::new(lat);
         let table = GreenTable::new(&lat, C64::new(1.558f64.powi(2), 0.0));
         let mut ws = op.workspace();

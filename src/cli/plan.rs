@@ -121,7 +121,8 @@ pub fn plan(
     }
     let jobs = srun::default_jobs(nthreads, peak, n, limit);
     println!(
-        "total ({} variants{}): {s_sum} solves, est. {} of compute on this machine; peak memory \
+        "total ({} variants{}): {s_sum} solves, est. {} of compute on this machine (its CPU time \
+         over {nthreads} threads: the wall time while the cores are kept busy); peak memory \
          {} per variant; default --jobs {jobs} ({} peak at once)",
         n,
         if shard.count > 1 {

@@ -10,7 +10,9 @@
 //! `t_setup + applications × t_apply × KRYLOV_OVERHEAD`, where `t_setup`
 //! (building the solver's system: shift, Green's tables) and `t_apply` (one
 //! application of the shifted operator `x − G_s V' x`) are **timed at plan
-//! time on this machine** for each distinct grid of the plan — on the grid
+//! time on this machine** — as the process's CPU time over its threads, so
+//! the estimate is the machine's when idle, whatever else shares it — for
+//! each distinct grid of the plan — on the grid
 //! itself when it has at most [`CALIBRATION_VOXELS`] voxels, otherwise on a
 //! grid with the same `nz` and fewer lateral cells, scaled by
 //! `N log₂(nx ny)` (the FFTs). `applications` starts from the measured rate
@@ -34,7 +36,6 @@ use crate::solver::{Problem, System};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
-use std::time::Instant;
 
 /// Largest grid timed directly at plan time.
 pub const CALIBRATION_VOXELS: usize = 1 << 19;
@@ -156,21 +157,37 @@ fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
         C64::new(((i + 2 * j) as f64 * 0.01).cos(), (k as f64 * 0.1).sin())
     });
     let mut out = Array3::zeros((nz, ny, nx));
+    // The process's CPU time over its threads: what the operator costs on
+    // this machine idle. Other jobs sharing the cores stretch the wall
+    // clock (by 2× and more on a loaded 2-core machine) but not this.
+    let threads = rayon::current_num_threads().max(1) as f64;
+    let elapsed = |t0: f64| (process_cpu_s() - t0) / threads;
     for _ in 0..3 {
-        let t = Instant::now();
+        let t = process_cpu_s();
         let Ok(sys) = System::new(&p, Background::DEFAULT) else {
             return (f64::NAN, f64::NAN);
         };
         let mut scr = sys.scratch();
-        setups.push(t.elapsed().as_secs_f64());
+        setups.push(elapsed(t));
         sys.apply_a_shifted(&mut scr, &x, &mut out);
-        let t = Instant::now();
+        let t = process_cpu_s();
         sys.apply_a_shifted(&mut scr, &x, &mut out);
-        applies.push(t.elapsed().as_secs_f64());
+        applies.push(elapsed(t));
     }
     setups.sort_by(f64::total_cmp);
     applies.sort_by(f64::total_cmp);
     (setups[1], applies[1])
+}
+
+/// CPU seconds (user + system) of every thread of this process so far.
+fn process_cpu_s() -> f64 {
+    // SAFETY: getrusage writes the struct it is given and nothing else.
+    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut ru) } != 0 {
+        return f64::NAN;
+    }
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(ru.ru_utime) + tv(ru.ru_stime)
 }
 
 /// Mean operator applications per solve over the finished results among

@@ -325,22 +325,22 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         assert_eq!(n, inksim::pipeline::planned_solves(&v.scene));
     }
     let (ok, plan2, _) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
-    // The finished results' mean, averaged with the background's rate
-    // counted as 5 results.
-    let (mut sum, mut n) = (0.0, 0.0);
-    for s in got.values() {
-        for e in &s.entries {
-            sum += (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
-            n += 1.0;
+    // The finished results' applications against the rates assumed for
+    // them, averaged with 1 counted as 5 results.
+    let (mut measured, mut assumed) = (0.0, 0.0);
+    for v in &three.variants {
+        for e in &got[&v.name].entries {
+            measured +=
+                (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
+            assumed += inksim::study::plan::default_applications(&v.scene);
         }
     }
-    let measured = sum / n;
-    let blended = (5.0 * inksim::study::plan::MEAN_APPLICATIONS + 4.0 * measured) / 9.0;
+    let r = measured / assumed;
+    let blended = (5.0 + 4.0 * r) / 9.0;
     assert!(
         ok && plan2.contains(&format!(
-            "applications per solve {blended:.0}: the mean of the 4 finished result(s) of this \
-             study ({measured:.0}), averaged with the background's measured rate (37) counted \
-             as 5 results"
+            "× {blended:.2}: the 4 finished result(s) of this study needed {r:.2}× the \
+             assumed rates, averaged with 1× counted as 5 results"
         )),
         "{plan2}"
     );

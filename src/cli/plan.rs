@@ -44,9 +44,14 @@ pub fn plan(
     let cal = plan::calibrate(&chosen.variants, &chosen.variants);
     println!(
         "time model (calibrated now on this machine, {nthreads} thread(s)): per solve = setup + \
-         applications × one operator application × {}; applications per solve {:.0}: {}",
+         applications × one operator application × {}; applications per solve {:.0} under a \
+         flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
+         background), × {:.2}: {}",
         plan::KRYLOV_OVERHEAD,
-        cal.applications,
+        plan::MEAN_APPLICATIONS,
+        plan::MEAN_APPLICATIONS_SURFACE,
+        plan::BINDER_APPLICATIONS,
+        cal.ratio,
         cal.applications_source
     );
     for (g, t) in &cal.grids {

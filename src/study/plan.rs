@@ -15,22 +15,24 @@
 //! each distinct grid of the plan — on the grid
 //! itself when it has at most [`CALIBRATION_VOXELS`] voxels, otherwise on a
 //! grid with the same `nz` and fewer lateral cells, scaled by
-//! `N log₂(nx ny)` (the FFTs). `applications` starts from the measured rate
-//! of the variants' `solver.background` ([`default_applications`]); once
-//! results of this study are finished, their mean number of operator
-//! applications per solve (iterations + 1 times the method's applications
-//! per iteration, from the solver's registry) takes over, with the rate
-//! counting as [`PRIOR_RESULTS`] results: a study's axes often run from easy
-//! to hard (small grains first), so its first results are a biased sample
-//! (the standard profile's red 30 % variants took 14 applications per solve
-//! for 100 nm spheres, 41 for 450 nm and 82 with surface relief); closed-form layers (no
-//! grid, [`ANALYTIC_SOLVE_S`] per solve) are left out of that mean and out
+//! `N log₂(nx ny)` (the FFTs). `applications` is the measured rate of the
+//! variant's kind of layer ([`default_applications`]: its solver background
+//! and, on the mean background, whether its top is flat — relief, conformal
+//! films and rough surfaces need 3–6× more); once results of this study are
+//! finished, every rate is scaled by what they needed against what was
+//! assumed for them (iterations + 1 times the method's applications per
+//! iteration, from the solver's registry), the assumption counting as
+//! [`PRIOR_RESULTS`] results: a study's axes often run from easy to hard
+//! (small grains first), so its first results are a biased sample (100 nm
+//! spheres take a third of the applications of 450 nm ones); closed-form
+//! layers (no grid, [`ANALYTIC_SOLVE_S`] per solve) are left out of that
+//! ratio and out
 //! of the model. Geometry packing and output are not modelled
 //! (seconds per variant). The estimate is a guide (±2×), not a promise.
 
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Background, Scene};
+use crate::config::{Background, Scene, Surface};
 use crate::pipeline;
 use crate::solver::{Problem, System};
 use ndarray::Array3;
@@ -43,19 +45,26 @@ pub const CALIBRATION_VOXELS: usize = 1 << 19;
 /// exists yet, on the binder background: BiCGStab on the demo layer needed
 /// 84–348 (median 232) to 1e-6 (docs/PERFORMANCE.md); 200 is the round middle.
 pub const BINDER_APPLICATIONS: f64 = 200.0;
-/// The same on the mean background: `auto` (BiCGStab) on the standard
-/// profile's layer (2 × 2 µm, 20 nm cells, red 30 % 200 nm) needed
-/// 370 over 10 solves (16–84 each, against 2534 on the binder background)
-/// at tolerance 1e-5 (`examples/study_cost`,
-/// docs/PERFORMANCE.md).
-pub const MEAN_APPLICATIONS: f64 = 37.0;
+/// The same on the mean background for a layer under a flat binder surface:
+/// `auto` (BiCGStab) over the standard profile's flat red variants (60 × 60 ×
+/// 50 cells, tolerance 1e-4, 0–60° from above and below; 100 nm spheres
+/// 12, 450 nm 37) — docs/PERFORMANCE.md, "The standard study".
+pub const MEAN_APPLICATIONS: f64 = 23.0;
+/// The same when the top is not a plane (relief, a conformal film or a
+/// rough surface): the binder–air interface crosses the grid's cells, and
+/// the standard profile's red variants of these kinds needed 3–6× the flat
+/// layers' applications.
+pub const MEAN_APPLICATIONS_SURFACE: f64 = 110.0;
 
-/// Operator applications per solve assumed on `background` when no result
-/// of the study exists yet.
-pub fn default_applications(background: Background) -> f64 {
-    match background {
+/// Operator applications per solve assumed for `scene` when no result of
+/// the study exists yet: by its solver background and, on the mean
+/// background, by whether its top is flat.
+pub fn default_applications(scene: &Scene) -> f64 {
+    let flat = scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat;
+    match scene.solver.background {
         Background::Binder => BINDER_APPLICATIONS,
-        Background::Mean => MEAN_APPLICATIONS,
+        Background::Mean if flat => MEAN_APPLICATIONS,
+        Background::Mean => MEAN_APPLICATIONS_SURFACE,
     }
 }
 /// How many finished results the background's measured rate counts as
@@ -85,8 +94,10 @@ pub struct GridTiming {
 pub struct Calibration {
     /// Per distinct grid (nx, ny, nz) → its timing, scaled to that grid.
     pub grids: BTreeMap<[usize; 3], GridTiming>,
-    pub applications: f64,
-    /// Where `applications` came from.
+    /// Factor on every variant's assumed applications per solve
+    /// ([`default_applications`]) from the study's finished results.
+    pub ratio: f64,
+    /// Where `ratio` came from.
     pub applications_source: String,
 }
 
@@ -190,10 +201,11 @@ fn process_cpu_s() -> f64 {
     tv(ru.ru_utime) + tv(ru.ru_stime)
 }
 
-/// Mean operator applications per solve over the finished results among
-/// `variants`, if any.
-pub fn measured_applications(variants: &[Variant]) -> Option<(f64, usize)> {
-    let (mut sum, mut n, mut files) = (0.0, 0usize, 0usize);
+/// Operator applications of the finished results among `variants` against
+/// what [`default_applications`] assumed for them, per solve: (measured /
+/// assumed, results counted), if any.
+pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
+    let (mut measured, mut assumed, mut files) = (0.0, 0.0, 0usize);
     for v in variants {
         // Closed-form layers have no applications: they would drag the mean down.
         if run::state(v) != State::Done || pipeline::RunPlan::of(&v.scene).analytic {
@@ -204,11 +216,12 @@ pub fn measured_applications(variants: &[Variant]) -> Option<(f64, usize)> {
         };
         files += 1;
         for e in &s.entries {
-            sum += (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
-            n += 1;
+            measured +=
+                (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
+            assumed += default_applications(&v.scene);
         }
     }
-    (n > 0).then(|| (sum / n as f64, files))
+    (assumed > 0.0).then(|| (measured / assumed, files))
 }
 
 /// Calibrate the time model for the grids of `variants`.
@@ -218,30 +231,24 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
         let g = grid_of(&v.scene);
         grids.entry(g).or_insert_with(|| time_grid(g));
     }
-    let prior = variants
-        .iter()
-        .map(|v| default_applications(v.scene.solver.background))
-        .sum::<f64>()
-        / variants.len().max(1) as f64;
-    let (applications, applications_source) = match measured_applications(finished) {
-        Some((a, files)) => (
-            (PRIOR_RESULTS * prior + files as f64 * a) / (PRIOR_RESULTS + files as f64),
+    let (ratio, applications_source) = match measured_ratio(finished) {
+        Some((r, files)) => (
+            (PRIOR_RESULTS + files as f64 * r) / (PRIOR_RESULTS + files as f64),
             format!(
-                "the mean of the {files} finished result(s) of this study ({a:.0}), averaged \
-                 with the background's measured rate ({prior:.0}) counted as {PRIOR_RESULTS} \
-                 results"
+                "the {files} finished result(s) of this study needed {r:.2}× the assumed \
+                 rates, averaged with 1× counted as {PRIOR_RESULTS} results"
             ),
         ),
         None => (
-            prior,
-            "assumed (no finished result yet): the measured rate of the variants' solver \
-             background (docs/PERFORMANCE.md, \"The mean background\")"
+            1.0,
+            "no finished result yet: the measured rates as assumed (docs/PERFORMANCE.md, \
+             \"The standard study\")"
                 .to_string(),
         ),
     };
     Calibration {
         grids,
-        applications,
+        ratio,
         applications_source,
     }
 }
@@ -258,7 +265,8 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
         solves as f64 * ANALYTIC_SOLVE_S
     } else {
         cal.grids.get(&grid).map_or(f64::NAN, |t| {
-            solves as f64 * (t.setup_s + cal.applications * t.apply_s * KRYLOV_OVERHEAD)
+            let applications = default_applications(scene) * cal.ratio;
+            solves as f64 * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)
         })
     };
     let bytes = pipeline::memory::estimate_bytes(scene);
@@ -294,6 +302,34 @@ mod tests {
         assert_eq!(human_time(30.0), "30.0 s");
         assert_eq!(human_time(600.0), "10 min");
         assert_eq!(human_time(7200.0), "2.0 h");
+    }
+
+    #[test]
+    fn a_layer_whose_top_is_not_flat_is_assumed_to_need_more_applications() {
+        let scene = |extra: &str| {
+            let text = format!(
+                "[layer]\nthickness_nm = 500.0\nfragment_nm = [400.0, 400.0]\npvc = 0.3\n{extra}\n\
+                 [[pigment]]\nname = \"red\"\nmaterial = {{ builtin = \"red\" }}\n\
+                 diameter_nm = 100.0\n[illumination]\nwavelengths_nm = [550.0]\npolar_deg = [0.0]\n[grid]\ncell_nm = 25.0\n"
+            );
+            crate::config::parse_scene(std::path::Path::new("t.toml"), &text).unwrap()
+        };
+        assert_eq!(default_applications(&scene("")), MEAN_APPLICATIONS);
+        for top in [
+            "relief_fraction = 0.3",
+            "surface = { kind = \"conformal\", film_nm = 20.0 }",
+            "surface = { kind = \"rough\", rms_nm = 20.0, correlation_nm = 100.0 }",
+        ] {
+            assert_eq!(
+                default_applications(&scene(top)),
+                MEAN_APPLICATIONS_SURFACE,
+                "{top}"
+            );
+        }
+        let mut binder = scene("");
+        binder.solver.background = Background::Binder;
+        assert_eq!(default_applications(&binder), BINDER_APPLICATIONS);
+        assert!(MEAN_APPLICATIONS_SURFACE > 2.0 * MEAN_APPLICATIONS);
     }
 
     #[test]

@@ -1,6 +1,6 @@
-//! The Kubelka–Munk baseline (`appearance.baseline = "kubelka-munk"`):
-//! the key's checks, the model on a scene against its closed forms, and its
-//! colour beside the wave solution's.
+//! The baselines (`appearance.baseline = "kubelka-munk"` or a list of
+//! models): the key's checks, the models on a scene against their closed
+//! forms, and their colours beside the wave solution's.
 
 use inksim::config::{Baseline, ConfigError, Measurement};
 use inksim::optics::baseline::{self, km};
@@ -35,20 +35,57 @@ fn invalid_key(scene: &SceneToml) -> (String, String) {
 fn the_key_is_checked() {
     let dir = tempfile::tempdir().unwrap();
     let s = with_baseline(SceneToml::grains()).scene(dir.path());
-    assert_eq!(s.appearance.baseline, Some(Baseline::KubelkaMunk));
-    assert_eq!(
-        SceneToml::grains().scene(dir.path()).appearance.baseline,
-        None
-    );
-    // A molecular pigment is Beer's law, which is fine.
-    assert!(with_baseline(SceneToml::slab())
+    assert_eq!(s.appearance.baseline, vec![Baseline::KubelkaMunk]);
+    assert!(SceneToml::grains()
         .scene(dir.path())
         .appearance
         .baseline
-        .is_some());
+        .is_empty());
+    // A molecular pigment is Beer's law, which is fine.
+    assert!(!with_baseline(SceneToml::slab())
+        .scene(dir.path())
+        .appearance
+        .baseline
+        .is_empty());
+    // A list, in its order.
+    let list = SceneToml::grains().raw(
+        "appearance.baseline",
+        r#"["adding-doubling", "kubelka-munk", "kubelka-munk-scene", "adding-doubling-contact"]"#,
+    );
+    assert_eq!(
+        list.scene(dir.path()).appearance.baseline,
+        vec![
+            Baseline::AddingDoubling,
+            Baseline::KubelkaMunk,
+            Baseline::KubelkaMunkScene,
+            Baseline::AddingDoublingContact
+        ]
+    );
+    for name in Baseline::ALL.map(Baseline::name) {
+        let one = SceneToml::grains().set("appearance.baseline", name);
+        assert_eq!(one.scene(dir.path()).appearance.baseline.len(), 1, "{name}");
+    }
     let (key, msg) = invalid_key(&SceneToml::grains().set("appearance.baseline", "four-flux"));
     assert_eq!(key, "appearance.baseline");
-    assert!(msg.contains("kubelka-munk"), "{msg}");
+    for name in Baseline::ALL.map(Baseline::name) {
+        assert!(msg.contains(&format!("\"{name}\"")), "{msg}");
+    }
+    let (key, msg) = invalid_key(
+        &SceneToml::grains().raw("appearance.baseline", r#"["adding-doubling", "four-flux"]"#),
+    );
+    assert_eq!(key, "appearance.baseline");
+    assert!(
+        msg.contains("four-flux") && msg.contains("allowed"),
+        "{msg}"
+    );
+    let (key, msg) = invalid_key(
+        &SceneToml::grains().raw("appearance.baseline", r#"["kubelka-munk", "kubelka-munk"]"#),
+    );
+    assert_eq!(key, "appearance.baseline");
+    assert!(msg.contains("twice"), "{msg}");
+    let (key, msg) = invalid_key(&SceneToml::grains().raw("appearance.baseline", "[]"));
+    assert_eq!(key, "appearance.baseline");
+    assert!(msg.contains("empty"), "{msg}");
     let (key, msg) = invalid_key(&with_baseline(SceneToml::grains()).no_substrate());
     assert_eq!(key, "appearance.baseline");
     assert!(msg.contains("paper"), "{msg}");
@@ -202,7 +239,7 @@ fn dilute_weak_spheres_beside_the_wave_solution() {
 
         // The result file holds the same, described.
         let f = hdf5::File::open(&rep.result_path).unwrap();
-        let g = f.group("appearance/baseline/45_0").unwrap();
+        let g = f.group("appearance/baseline/kubelka-munk/45_0").unwrap();
         for name in [
             "lab",
             "reflectance_factor",

@@ -91,6 +91,8 @@ pub enum PipelineError {
     Render(#[from] render::RenderError),
     #[error(transparent)]
     Appearance(#[from] optics_appearance::AppearanceError),
+    #[error(transparent)]
+    Baseline(#[from] crate::optics::baseline::BaselineError),
     #[error("MERL export: {0}")]
     Merl(#[from] merl::MerlError),
     #[error("structure: {0}")]

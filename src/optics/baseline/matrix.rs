@@ -109,45 +109,68 @@ impl Matrix {
     }
 
     /// `X` with `self · X = rhs`, by Gaussian elimination with partial
-    /// pivoting; an error when `self` is singular to working precision.
+    /// pivoting. A singular but consistent system — a direction no light
+    /// can reach, such as one trapped between two totally reflecting
+    /// surfaces in a layer that neither scatters nor absorbs, where the row
+    /// reads `0 = 0` — has that unknown set to 0; an inconsistent one is an
+    /// error.
     pub fn solve(&self, rhs: &Matrix) -> Result<Matrix, BaselineError> {
         let n = self.n;
         let mut a = self.data.clone();
-        let mut x = rhs.data.clone();
+        let mut b = rhs.data.clone();
         let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let rhs_scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if !(scale.is_finite() && rhs_scale.is_finite()) {
+            return Err(BaselineError::Singular);
+        }
+        let tiny = 1e-14 * scale;
+        // Row echelon form; `pivots[r]` is the column of row r's pivot.
+        let mut pivots = Vec::with_capacity(n);
+        let mut row = 0;
         for col in 0..n {
-            let pivot = (col..n)
-                .max_by(|&p, &q| a[p * n + col].abs().total_cmp(&a[q * n + col].abs()))
-                .unwrap_or(col);
-            let p = a[pivot * n + col];
-            if !(p.abs() > 1e-14 * scale) {
-                return Err(BaselineError::Singular);
+            if row == n {
+                break;
             }
-            if pivot != col {
+            let pivot = (row..n)
+                .max_by(|&p, &q| a[p * n + col].abs().total_cmp(&a[q * n + col].abs()))
+                .unwrap_or(row);
+            let p = a[pivot * n + col];
+            if p.abs() <= tiny {
+                continue; // a free unknown, set to 0
+            }
+            if pivot != row {
                 for k in 0..n {
-                    a.swap(pivot * n + k, col * n + k);
-                    x.swap(pivot * n + k, col * n + k);
+                    a.swap(pivot * n + k, row * n + k);
+                    b.swap(pivot * n + k, row * n + k);
                 }
             }
-            for r in col + 1..n {
+            for r in row + 1..n {
                 let f = a[r * n + col] / p;
                 if f == 0.0 {
                     continue;
                 }
                 for k in col..n {
-                    a[r * n + k] -= f * a[col * n + k];
+                    a[r * n + k] -= f * a[row * n + k];
                 }
                 for k in 0..n {
-                    x[r * n + k] -= f * x[col * n + k];
+                    b[r * n + k] -= f * b[row * n + k];
                 }
             }
+            pivots.push(col);
+            row += 1;
         }
-        for col in (0..n).rev() {
-            let p = a[col * n + col];
+        // The rows without a pivot must read 0 = 0.
+        let tolerance = 1e-12 * rhs_scale;
+        if b[row * n..].iter().any(|v| v.abs() > tolerance) {
+            return Err(BaselineError::Singular);
+        }
+        let mut x = vec![0.0; n * n];
+        for (r, &col) in pivots.iter().enumerate().rev() {
+            let p = a[r * n + col];
             for k in 0..n {
-                let mut v = x[col * n + k];
+                let mut v = b[r * n + k];
                 for c in col + 1..n {
-                    v -= a[col * n + c] * x[c * n + k];
+                    v -= a[r * n + c] * x[c * n + k];
                 }
                 x[col * n + k] = v / p;
             }
@@ -182,5 +205,12 @@ mod tests {
         let x = a.solve(&a.mul(&b)).unwrap();
         assert!(x.max_difference(&b) < 1e-12);
         assert!(Matrix::zeros(3).solve(&Matrix::identity(3)).is_err());
+        // Singular but consistent (a row 0 = 0): that unknown is 0.
+        let mut m = Matrix::identity(3);
+        m[(1, 1)] = 0.0;
+        let mut rhs = Matrix::identity(3);
+        rhs[(1, 1)] = 0.0;
+        let x = m.solve(&rhs).unwrap();
+        assert_eq!(x, rhs);
     }
 }

@@ -296,9 +296,9 @@ fn isotropic_scattering_semi_infinite_and_conservative() {
     let s = doubling::homogeneous(&o, &iso(0.9), 200.0).unwrap();
     let r = s.r_down.column_sums();
     let mut worst = 0.0f64;
-    for j in 0..o.len() {
-        let exact = 1.0 - h_function(0.9, o.mu[j]) * 0.1f64.sqrt();
-        worst = worst.max((r[j] - exact).abs());
+    for (rj, mu) in r.iter().zip(&o.mu) {
+        let exact = 1.0 - h_function(0.9, *mu) * 0.1f64.sqrt();
+        worst = worst.max((rj - exact).abs());
     }
     eprintln!("isotropic ω = 0.9: worst |plane albedo − H-function value| = {worst:.2e}");
     assert!(worst < 1.5e-4, "{worst}");

@@ -19,8 +19,8 @@
 //! - `solve`: the solves of one layer (iterative, or the closed-form slab);
 //! - `eps`: the permittivities of the scene's materials at a wavelength;
 //! - `appearance`: what the appearance stage is given;
-//! - `baseline`: the classical (Kubelka–Munk) colour beside the wave one,
-//!   when the scene asks for it;
+//! - `baseline`: the classical baselines' colours (Kubelka–Munk,
+//!   adding–doubling) beside the wave one, when the scene asks for them;
 //! - `result`: the result file assembled from a run's parts;
 //! - `run`: a run end to end ([`run`]), and the geometry-only run
 //!   ([`run_geometry`]);

@@ -22,12 +22,14 @@
 //! **Thin layer** (diamond initialisation, Wiscombe 1976): the radiative
 //! transfer equation over a layer of optical thickness `Δτ`, the radiance
 //! inside taken as the mean of its values on both faces, a linear system
-//! of `2N` unknowns per incident direction; error `O(Δτ³/μ³)` per layer.
-//! The start is `Δτ ≤ 10⁻⁴ μ_min`.
+//! of `2N` unknowns per incident direction, solved for the scattered part
+//! only (the unscattered light is `e^{−Δτ/μ}` exactly); error
+//! `O(Δτ³/μ³)` per layer, `O(τ Δτ²/μ³)` after the doublings. The start is
+//! `Δτ ≤ 10⁻⁶ μ_min` ([`START_THICKNESS`]).
 //!
 //! **Doubling.** Two equal layers: `R₂ = R + T (I − R R)⁻¹ R T`,
 //! `T₂ = T (I − R R)⁻¹ T` (a homogeneous slab reflects alike from both
-//! faces).
+//! faces), with the unscattered part kept apart ([`Homogeneous`]).
 
 use super::adding::Slab;
 use super::matrix::Matrix;

@@ -79,9 +79,14 @@ fn two_absorbing_slabs_are_the_incoherent_closed_form() {
         let d = 1.0 - f * f * tt * tt;
         let r_exact = f + (1.0 - f).powi(2) * f * tt * tt / d;
         let t_exact = (1.0 - f).powi(2) * tt / d;
+        // Energy with absorption: the absorbed fraction summed pass by pass,
+        // (1 − f)(1 − t)(1 + f t)/(1 − f² t²), closes R + T + A = 1.
+        let a_exact = (1.0 - f) * (1.0 - tt) * (1.0 + f * tt) / d;
+        assert!((r_exact + t_exact + a_exact - 1.0).abs() < 1e-14);
         worst = worst
             .max((r[i] - r_exact).abs())
-            .max((t[i] - t_exact).abs());
+            .max((t[i] - t_exact).abs())
+            .max((r[i] + t[i] + a_exact - 1.0).abs());
     }
     eprintln!("two slabs: worst |AD − closed form| = {worst:.2e}");
     assert!(worst < 1e-10, "{worst}");

@@ -166,8 +166,8 @@ enum Command {
     /// <name>-spectra.csv (ensemble-mean R, T, A ± standard errors per
     /// wavelength and angle) and <name>-colours.csv (CIELAB, LCh ± standard
     /// errors and XYZ of the measurement geometries and of every tile cell,
-    /// with illuminant and observer), and <name>-baseline.csv (the
-    /// Kubelka–Munk colour and its ΔE00 to the wave colour, with
+    /// with illuminant and observer), and <name>-baseline.csv (each
+    /// baseline model's colour and its ΔE00 to the wave colour, with
     /// appearance.baseline). For a study config: colours.csv in the study
     /// folder, one row per finished variant and measurement geometry, with
     /// the variant's label on every axis (and the baseline's colour beside,

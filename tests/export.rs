@@ -155,7 +155,10 @@ fn a_study_exports_every_finished_variants_colours_with_its_labels() {
         .realisations(1)
         .pigment(PigmentToml::builtin("red").named("p").diameter_nm(150.0))
         .outputs(&["tile"])
-        .set("appearance.baseline", "kubelka-munk");
+        .raw(
+            "appearance.baseline",
+            r#"["adding-doubling", "kubelka-munk"]"#,
+        );
     let study = StudyToml::new("t", 5, "out", &base).axis("pvc", "pigment.0.pvc", "[0.1, 0.2]");
     std::fs::write(dir.path().join("study.toml"), study.toml()).unwrap();
     let (ok, _, err) = inksim_in(dir.path(), &["run", "study.toml"]);
@@ -177,13 +180,29 @@ fn a_study_exports_every_finished_variants_colours_with_its_labels() {
         rows[0]["de00_se"].is_empty(),
         "one realisation: no standard error"
     );
-    // The Kubelka–Munk baseline beside the wave colour, geometry by geometry.
-    let km = read_baseline(&dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
+    // Each baseline beside the wave colour, geometry by geometry, its
+    // columns named by the model (km_*, ad_*), in the documented order.
+    let stored = read_baseline(&dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
     for r in rows.iter().filter(|r| &r["variant"] == name) {
-        let b = km.iter().find(|b| b.geometry == r["geometry"]).unwrap();
-        assert_eq!(num(r, "km_b_star"), b.lab[2]);
-        assert_eq!(num(r, "km_de00_to_wave"), b.de00_to_wave.unwrap());
+        for (model, prefix) in [("kubelka-munk", "km"), ("adding-doubling", "ad")] {
+            let b = stored
+                .iter()
+                .find(|b| b.geometry == r["geometry"] && b.model == model)
+                .unwrap();
+            assert_eq!(num(r, &format!("{prefix}_b_star")), b.lab[2]);
+            assert_eq!(
+                num(r, &format!("{prefix}_de00_to_wave")),
+                b.de00_to_wave.unwrap()
+            );
+        }
     }
+    let header = std::fs::read_to_string(dir.path().join(&path)).unwrap();
+    let header = header.lines().next().unwrap();
+    let (km, ad) = (
+        header.find("km_L_star").unwrap(),
+        header.find("ad_L_star").unwrap(),
+    );
+    assert!(km < ad, "{header}");
 
     // A variant not finished has no rows, and the user is told.
     std::fs::remove_file(dir.path().join(&variants).join(format!("{name}.h5"))).unwrap();
@@ -201,7 +220,10 @@ fn the_kubelka_munk_baseline_is_exported_beside_the_wave_colours() {
     let out = dir.path().join("out");
     let cfg = scene()
         .realisations(1)
-        .set("appearance.baseline", "kubelka-munk")
+        .raw(
+            "appearance.baseline",
+            r#"["kubelka-munk", "kubelka-munk-scene", "adding-doubling", "adding-doubling-contact"]"#,
+        )
         .output(&out, "km")
         .write(dir.path());
     assert!(inksim_in(dir.path(), &["run", cfg.to_str().unwrap()]).0);
@@ -213,9 +235,16 @@ fn the_kubelka_munk_baseline_is_exported_beside_the_wave_colours() {
     let rows = table(&out.join("km-baseline.csv"));
     let stored = read_baseline(&out.join("km.h5")).unwrap();
     let (measured, _, _) = read_measured(&out.join("km.h5")).unwrap().unwrap();
-    assert_eq!(rows.len(), measured.len());
-    for (r, b) in rows.iter().zip(&stored) {
-        assert_eq!(r["model"], "kubelka-munk");
+    assert_eq!(rows.len(), 4 * measured.len());
+    let models = [
+        "kubelka-munk",
+        "kubelka-munk-scene",
+        "adding-doubling",
+        "adding-doubling-contact",
+    ];
+    for (i, (r, b)) in rows.iter().zip(&stored).enumerate() {
+        assert_eq!(r["model"], models[i / measured.len()]);
+        assert_eq!(r["model"], b.model);
         assert_eq!(r["geometry"], b.geometry);
         assert_eq!(num(r, "L_star"), b.lab[0]);
         assert_eq!(num(r, "de00_to_wave"), b.de00_to_wave.unwrap());
@@ -224,4 +253,43 @@ fn the_kubelka_munk_baseline_is_exported_beside_the_wave_colours() {
         let de = inksim::optics::colour::delta_e2000(b.lab, wave.lab);
         assert!((de - b.de00_to_wave.unwrap()).abs() < 1e-12);
     }
+}
+
+#[test]
+fn a_result_with_the_earlier_single_model_layout_still_reads() {
+    // /appearance/baseline/<geometry> with the model as the group's
+    // attribute, as files written before the list of models have it.
+    use hdf5::types::VarLenUnicode;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("old.h5");
+    {
+        let f = hdf5::File::create(&path).unwrap();
+        let g = f.create_group("appearance/baseline").unwrap();
+        let text = |s: &str| s.parse::<VarLenUnicode>().unwrap();
+        g.new_attr::<VarLenUnicode>()
+            .create("model")
+            .unwrap()
+            .write_scalar(&text("kubelka-munk"))
+            .unwrap();
+        let d = g.create_group("45_0").unwrap();
+        d.new_attr::<VarLenUnicode>()
+            .create("geometry")
+            .unwrap()
+            .write_scalar(&text("45/0"))
+            .unwrap();
+        d.new_dataset_builder()
+            .with_data(&[50.0, 10.0, -5.0])
+            .create("lab")
+            .unwrap();
+        d.new_dataset_builder()
+            .with_data(&[3.5])
+            .create("de00_to_wave")
+            .unwrap();
+    }
+    let read = read_baseline(&path).unwrap();
+    assert_eq!(read.len(), 1);
+    assert_eq!(read[0].model, "kubelka-munk");
+    assert_eq!(read[0].geometry, "45/0");
+    assert_eq!(read[0].lab, [50.0, 10.0, -5.0]);
+    assert_eq!(read[0].de00_to_wave, Some(3.5));
 }

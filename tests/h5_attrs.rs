@@ -123,7 +123,10 @@ fn every_dataset_of_a_scene_result_has_units_a_description_and_axes() {
         .paper(0.8)
         .outputs(&["brdf", "btdf", "tile"])
         .measurements(&["45/0", "d/8 SCI"])
-        .set("appearance.baseline", "kubelka-munk")
+        .raw(
+            "appearance.baseline",
+            r#"["kubelka-munk", "adding-doubling"]"#,
+        )
         .output(dir.path(), "r")
         .run(dir.path());
     let seen = check_file(&report.result_path);
@@ -147,8 +150,10 @@ fn every_dataset_of_a_scene_result_has_units_a_description_and_axes() {
         "/appearance/tile_png",
         "/appearance/measured/45_0/spectrum",
         "/appearance/measured/d8_sci/de00_se",
-        "/appearance/baseline/45_0/de00_to_wave",
-        "/appearance/baseline/d8_sci/reflectance_factor",
+        "/appearance/baseline/kubelka-munk/45_0/de00_to_wave",
+        "/appearance/baseline/kubelka-munk/d8_sci/reflectance_factor",
+        "/appearance/baseline/adding-doubling/45_0/lab",
+        "/appearance/baseline/adding-doubling/d8_sci/reflectance_factor",
     ] {
         assert!(names.contains(&p), "{p} missing from {names:?}");
     }
@@ -184,7 +189,8 @@ fn every_dataset_of_a_scene_result_has_units_a_description_and_axes() {
     for p in [
         "/appearance/brdf_total",
         "/appearance/measured/d8_sci/spectrum",
-        "/appearance/baseline/d8_sci/reflectance_factor",
+        "/appearance/baseline/kubelka-munk/d8_sci/reflectance_factor",
+        "/appearance/baseline/adding-doubling/d8_sci/reflectance_factor",
         "/geometry/statistics/count",
     ] {
         assert!(

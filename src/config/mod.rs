@@ -401,9 +401,10 @@ pub struct Appearance {
     /// Measurement geometries reported with the tile (default all three:
     /// 45°/0°, d/8° SCI and SCE); each adds its angles to the solves from above.
     pub measurements: Vec<Measurement>,
-    /// A classical model's colour to report beside the wave solution's
-    /// (`baseline = "kubelka-munk"`); None: none.
-    pub baseline: Option<Baseline>,
+    /// Classical models whose colours are reported beside the wave
+    /// solution's (`baseline = "kubelka-munk"` or a list of names), in the
+    /// order given; empty: none.
+    pub baseline: Vec<Baseline>,
 }
 
 /// A classical colour model computed from the same scene (METHOD §6).
@@ -412,13 +413,68 @@ pub enum Baseline {
     /// Kubelka–Munk two-flux reflectance on the paper with Saunderson's
     /// surface correction, from the scalar sphere's cross sections.
     KubelkaMunk,
+    /// The same two-flux body on the wave scene's boundary: the binder's
+    /// lower surface and an air gap before the paper, scalar Fresnel surfaces.
+    KubelkaMunkScene,
+    /// Radiative transfer by adding–doubling with the wave scene's boundary.
+    AddingDoubling,
+    /// Radiative transfer by adding–doubling with the paper in optical
+    /// contact with the binder (Saunderson's assumption).
+    AddingDoublingContact,
 }
 
 impl Baseline {
+    /// Every model, in the order of the documentation.
+    pub const ALL: [Baseline; 4] = [
+        Baseline::KubelkaMunk,
+        Baseline::KubelkaMunkScene,
+        Baseline::AddingDoubling,
+        Baseline::AddingDoublingContact,
+    ];
+
     /// The name in a scene file.
     pub fn name(self) -> &'static str {
         match self {
             Baseline::KubelkaMunk => "kubelka-munk",
+            Baseline::KubelkaMunkScene => "kubelka-munk-scene",
+            Baseline::AddingDoubling => "adding-doubling",
+            Baseline::AddingDoublingContact => "adding-doubling-contact",
+        }
+    }
+
+    /// The model of a scene-file name.
+    pub fn from_name(name: &str) -> Option<Baseline> {
+        Baseline::ALL.into_iter().find(|b| b.name() == name)
+    }
+
+    /// Prefix of the model's columns in a study's colours.csv
+    /// (`km_L_star`, `ad_L_star`, …).
+    pub fn column_prefix(self) -> &'static str {
+        match self {
+            Baseline::KubelkaMunk => "km",
+            Baseline::KubelkaMunkScene => "km_scene",
+            Baseline::AddingDoubling => "ad",
+            Baseline::AddingDoublingContact => "ad_contact",
+        }
+    }
+
+    /// One line on what the model assumes (for the plan).
+    pub fn summary(self) -> &'static str {
+        match self {
+            Baseline::KubelkaMunk => {
+                "two-flux, K = 2 μa, S = 3/4 μs'; Saunderson's surface, paper in optical contact"
+            }
+            Baseline::KubelkaMunkScene => {
+                "two-flux, K = 2 μa, S = 3/4 μs'; scalar Fresnel surfaces, air gap over the paper"
+            }
+            Baseline::AddingDoubling => {
+                "radiative transfer (adding–doubling, phase function, δ-M); scalar Fresnel \
+                 surfaces with total internal reflection, air gap over the paper"
+            }
+            Baseline::AddingDoublingContact => {
+                "radiative transfer (adding–doubling, phase function, δ-M); scalar Fresnel top \
+                 surface, paper in optical contact"
+            }
         }
     }
 }

@@ -333,7 +333,15 @@ pub struct RawAppearance {
     pub illuminant: Option<String>,
     pub observer_deg: Option<i64>,
     pub measurements: Option<Vec<String>>,
-    pub baseline: Option<String>,
+    pub baseline: Option<RawBaseline>,
+}
+
+/// `appearance.baseline`: one model's name or a list of names.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged, expecting = "a baseline model's name or a list of names")]
+pub enum RawBaseline {
+    One(String),
+    Many(Vec<String>),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]

@@ -9,8 +9,8 @@
 //!   and the estimated error of replacing grains by it;
 //! - [`appearance`]: ensemble means with standard errors, natural light and
 //!   the colours of a result;
-//! - [`baseline`]: the classical two-flux colour of the same scene
-//!   (Kubelka–Munk with Saunderson's correction) beside the wave solution's.
+//! - [`baseline`]: classical colours of the same scene (Kubelka–Munk, and
+//!   radiative transfer by adding–doubling) beside the wave solution's.
 //!
 //! Imports only from `config`, `geometry`, `raster` and `solver`.
 

@@ -19,8 +19,9 @@
 //!   `C_star_ab`, `h_deg`, their standard errors `L_star_se`, `a_star_se`,
 //!   `b_star_se` and `de00_se` (empty for one realisation), and CIE `X`,
 //!   `Y`, `Z` (Y of the perfect diffuser = 100; measurement geometries only);
-//! - `<name>-baseline.csv` (with `appearance.baseline`): per measurement
-//!   geometry the baseline's `model`, `geometry`, `illuminant`,
+//! - `<name>-baseline.csv` (with `appearance.baseline`): per baseline
+//!   model (in the scene's order) and measurement geometry the `model`
+//!   (`kubelka-munk`, `adding-doubling`, …), `geometry`, `illuminant`,
 //!   `observer_deg`, `L_star`, `a_star`, `b_star`, `C_star_ab`, `h_deg` and
 //!   `de00_to_wave`, its CIEDE2000 to the wave colour of that geometry.
 //!

@@ -2,8 +2,8 @@
 //! as the Kubelka–Munk model sees them, on the colour grid of the spectral
 //! proxy, beside the wave solution's measured colours.
 
-use crate::config::{Baseline, GrainShape, Scene, Substrate};
-use crate::optics::appearance::{Appearance, AppearanceError};
+use crate::config::{GrainShape, Scene, Substrate};
+use crate::optics::appearance::Appearance;
 use crate::optics::baseline::{self, BaselineInput, BaselineSpecies};
 use crate::optics::colour::Observer;
 
@@ -52,22 +52,31 @@ pub fn baseline_input(scene: &Scene) -> Result<Option<BaselineInput>, PipelineEr
     }))
 }
 
-/// Add the scene's baseline colours, if it asks for any, to its appearance.
+/// Add the scene's baseline colours, if it asks for any, to its appearance
+/// (each model's, in the order the scene lists them).
 pub fn add_baseline(
     scene: &Scene,
     appearance: &mut Appearance,
     observer: &Observer,
 ) -> Result<(), PipelineError> {
-    let Some(Baseline::KubelkaMunk) = scene.appearance.baseline else {
+    if scene.appearance.baseline.is_empty() {
         return Ok(());
-    };
+    }
     let Some(input) = baseline_input(scene)? else {
         return Ok(());
     };
     let measured = &appearance.measured;
     let wave = |m| measured.iter().find(|c| c.geometry == m).map(|c| c.lab);
-    appearance.baseline =
-        baseline::kubelka_munk(&input, &scene.appearance.measurements, &wave, observer)
-            .map_err(AppearanceError::from)?;
+    let mut colours = Vec::new();
+    for &model in &scene.appearance.baseline {
+        colours.extend(baseline::baseline_colours(
+            model,
+            &input,
+            &scene.appearance.measurements,
+            &wave,
+            observer,
+        )?);
+    }
+    appearance.baseline = colours;
     Ok(())
 }

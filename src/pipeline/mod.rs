@@ -19,8 +19,8 @@
 //! - `solve`: the solves of one layer (iterative, or the closed-form slab);
 //! - `eps`: the permittivities of the scene's materials at a wavelength;
 //! - `appearance`: what the appearance stage is given;
-//! - `baseline`: the classical (Kubelka–Munk) colour beside the wave one,
-//!   when the scene asks for it;
+//! - `baseline`: the classical baselines' colours (Kubelka–Munk,
+//!   adding–doubling) beside the wave one, when the scene asks for them;
 //! - `result`: the result file assembled from a run's parts;
 //! - `run`: a run end to end ([`run`]), and the geometry-only run
 //!   ([`run_geometry`]);
@@ -91,6 +91,8 @@ pub enum PipelineError {
     Render(#[from] render::RenderError),
     #[error(transparent)]
     Appearance(#[from] optics_appearance::AppearanceError),
+    #[error(transparent)]
+    Baseline(#[from] crate::optics::baseline::BaselineError),
     #[error("MERL export: {0}")]
     Merl(#[from] merl::MerlError),
     #[error("structure: {0}")]

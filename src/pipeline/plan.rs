@@ -291,12 +291,12 @@ fn product_lines(scene: &Scene) -> Vec<String> {
             "tile and colours: skipped — not requested".to_string()
         },
     ];
-    if let Some(b) = scene.appearance.baseline {
+    for b in &scene.appearance.baseline {
         lines.push(format!(
             "baseline: {} computed beside the measured colours (equal-volume scalar spheres in \
-             the binder, independent scattering, diffuse light: K = 2 μa, S = 3/4 μs'; flat \
-             surface by Saunderson; nominal sizes, shapes and clusters not seen)",
-            b.name()
+             the binder, independent scattering; {}; nominal sizes, shapes and clusters not seen)",
+            b.name(),
+            b.summary()
         ));
     }
     if products.merl {

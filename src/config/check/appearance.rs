@@ -3,7 +3,7 @@
 //! `[substrate]` (none, or paper of an albedo).
 
 use super::Checker;
-use crate::config::raw::{RawAppearance, RawProduct, RawSubstrate};
+use crate::config::raw::{RawAppearance, RawBaseline, RawProduct, RawSubstrate};
 use crate::config::{
     Appearance, Baseline, ConfigError, Illuminant, Incidence, Measurement, Products,
     StandardObserver, Substrate,
@@ -106,16 +106,7 @@ impl Checker<'_> {
                 out
             }
         };
-        let baseline = match raw.and_then(|a| a.baseline.as_deref()) {
-            None => None,
-            Some("kubelka-munk") => Some(Baseline::KubelkaMunk),
-            Some(name) => {
-                return Err(self.invalid(
-                    "appearance.baseline",
-                    format!("unknown baseline \"{name}\"; allowed: \"kubelka-munk\""),
-                ))
-            }
-        };
+        let baseline = self.baseline(raw.and_then(|a| a.baseline.as_ref()))?;
         Ok(Appearance {
             viewing_deg,
             products,
@@ -126,6 +117,44 @@ impl Checker<'_> {
             measurements,
             baseline,
         })
+    }
+
+    /// `appearance.baseline`: one name or a list, each a known model, none
+    /// twice.
+    fn baseline(&self, raw: Option<&RawBaseline>) -> Result<Vec<Baseline>, ConfigError> {
+        let key = "appearance.baseline";
+        let names: Vec<&str> = match raw {
+            None => return Ok(Vec::new()),
+            Some(RawBaseline::One(name)) => vec![name.as_str()],
+            Some(RawBaseline::Many(list)) => list.iter().map(String::as_str).collect(),
+        };
+        if names.is_empty() {
+            return Err(self.invalid(
+                key,
+                "must not be an empty list (leave the key out for none)",
+            ));
+        }
+        let mut out = Vec::with_capacity(names.len());
+        for name in names {
+            let model = Baseline::from_name(name).ok_or_else(|| {
+                let allowed: Vec<String> = Baseline::ALL
+                    .iter()
+                    .map(|b| format!("\"{}\"", b.name()))
+                    .collect();
+                self.invalid(
+                    key,
+                    format!(
+                        "unknown baseline \"{name}\"; allowed: {}",
+                        allowed.join(", ")
+                    ),
+                )
+            })?;
+            if out.contains(&model) {
+                return Err(self.invalid(key, format!("\"{name}\" is listed twice")));
+            }
+            out.push(model);
+        }
+        Ok(out)
     }
 
     pub(super) fn substrate(&self, raw: Option<&RawSubstrate>) -> Result<Substrate, ConfigError> {

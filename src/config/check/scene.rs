@@ -71,7 +71,7 @@ impl Checker<'_> {
             ));
         }
         let substrate = self.substrate(raw.substrate.as_ref())?;
-        if appearance.baseline.is_some() {
+        if !appearance.baseline.is_empty() {
             let why = if structure.is_some() {
                 Some("the baseline is computed from the pigments' grains: an explicit structure has none")
             } else if matches!(substrate, Substrate::None) {

@@ -118,8 +118,9 @@ pub struct Appearance {
     pub colours: Option<Colours>,
     /// Colour in each of `spec.measurements`, in that order.
     pub measured: Vec<MeasuredColour>,
-    /// The classical baseline's colour in each measurement geometry, when
-    /// the scene asked for one (filled in by the pipeline).
+    /// The classical baselines' colours, model by model (in the scene's
+    /// order) and in each measurement geometry, when the scene asked for
+    /// them (filled in by the pipeline).
     pub baseline: Vec<BaselineColour>,
     /// The CIE illuminant and observer every colour was computed for (None
     /// for an observer built from custom tables).

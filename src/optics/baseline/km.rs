@@ -93,6 +93,51 @@ pub fn internal_reflectance(binder_index: f64) -> f64 {
     mu_c * mu_c + gauss(integrand, 0.0, 1.0, 64)
 }
 
+/// Scalar (TE) Fresnel reflectance of the binder's surface for light from
+/// air at `polar_deg`: the interface of the scalar wave equation the solver
+/// solves (`u` and `∂u/∂z` continuous, `solver/airy`),
+/// `((μ_a − n μ)/(μ_a + n μ))²`.
+pub fn external_reflectance_scalar(binder_index: f64, polar_deg: f64) -> f64 {
+    let mu_a = polar_deg.to_radians().cos();
+    let n = binder_index;
+    let mu = (1.0 - (1.0 - mu_a * mu_a) / (n * n)).max(0.0).sqrt();
+    let r = (mu_a - n * mu) / (mu_a + n * mu);
+    r * r
+}
+
+/// The scalar surface's reflectance for Lambertian light from air,
+/// `r_ed = ∫₀¹ R(μ_a) 2μ_a dμ_a` (smooth in `μ_a`: composite Gauss).
+pub fn diffuse_external_reflectance_scalar(binder_index: f64) -> f64 {
+    gauss(
+        |mu_a: f64| {
+            external_reflectance_scalar(binder_index, mu_a.clamp(0.0, 1.0).acos().to_degrees())
+                * 2.0
+                * mu_a
+        },
+        0.0,
+        1.0,
+        64,
+    )
+}
+
+/// The scalar surface's reflectance for Lambertian light from inside the
+/// binder, total internal reflection included: by étendue
+/// `1 − r_i = (1 − r_ed)/n²`.
+pub fn internal_reflectance_scalar(binder_index: f64) -> f64 {
+    let n2 = binder_index * binder_index;
+    1.0 - (1.0 - diffuse_external_reflectance_scalar(binder_index)) / n2
+}
+
+/// The backing a Kubelka–Munk layer sees in the wave scene: the binder's
+/// lower surface over an air gap over Lambertian paper of `albedo`. Diffuse
+/// light from inside is reflected by the surface (`r_i`) or leaves into the
+/// gap (`1 − r_i`); there paper and surface exchange light (`albedo`,
+/// `r_ed`) until it re-enters (`1 − r_ed`):
+/// `R_g = r_i + (1 − r_i) ρ (1 − r_ed) / (1 − ρ r_ed)`.
+pub fn scene_backing(albedo: f64, r_i: f64, r_ed: f64) -> f64 {
+    r_i + (1.0 - r_i) * albedo * (1.0 - r_ed) / (1.0 - albedo * r_ed)
+}
+
 /// Composite Gauss–Legendre (3 points per panel) of `f` over `[a, b]`.
 fn gauss(f: impl Fn(f64) -> f64, a: f64, b: f64, panels: usize) -> f64 {
     let x = (0.6f64).sqrt();

@@ -1,52 +1,91 @@
-//! Optics — the classical baseline beside the wave solution: Kubelka–Munk
-//! with Saunderson's correction (METHOD §6, "Kubelka–Munk baseline").
+//! Optics — the classical baselines beside the wave solution (METHOD §6):
+//! Kubelka–Munk with Saunderson's correction, Kubelka–Munk with the wave
+//! scene's boundary, and radiative transfer by adding–doubling with either
+//! boundary. Which ones a scene gets is `appearance.baseline`
+//! ([`crate::config::Baseline`]).
 //!
-//! The industry's two-flux picture of the same scene, for showing where
-//! radiative transfer and the wave solution part:
+//! All share the single scatterer and independent scattering:
 //! 1. **Single scatterer** ([`sphere`]): each pigment grain is replaced by
 //!    the sphere of equal volume (radius `d/2`, `d` = `diameter_nm`, the
 //!    nominal size: the size distribution, the shape and any clusters are
-//!    not seen) in the binder (real index `n_b`). Its cross sections and
-//!    asymmetry parameter `g` come from the *scalar* partial-wave solution
-//!    at the wavelength in the binder `λ/n_b` with relative permittivity
-//!    `ε_s/ε_b`, `ε_s = (n + ik)²`: the solver solves the scalar Helmholtz
-//!    equation, so the scalar sphere is its consistent single scatterer.
+//!    not seen) in the binder (real index `n_b`). Its cross sections,
+//!    asymmetry parameter `g` and phase function come from the *scalar*
+//!    partial-wave solution at the wavelength in the binder `λ/n_b` with
+//!    relative permittivity `ε_s/ε_b`, `ε_s = (n + ik)²`: the solver solves
+//!    the scalar Helmholtz equation, so the scalar sphere is its consistent
+//!    single scatterer.
 //! 2. **Independent scattering**: number density `N_s = f_s / (π d³/6)`,
-//!    absorption coefficient `μa = Σ N_s σ_abs,s` and reduced scattering
-//!    coefficient `μs' = Σ N_s σ_sca,s (1 − g_s)`: the grains scatter as if
-//!    alone (no near-field coupling, no correlated positions, no dependent
-//!    scattering at high PVC). A molecular (dissolved) pigment scatters
-//!    nothing and absorbs as its dilute limit `f_s k₀ Im ε_s / n_b` (the
-//!    small-sphere `σ_abs = k V Im(ε_s/ε_b)` per volume), so the layer is
-//!    Beer's law.
-//! 3. **Diffuse light**: `K = 2 μa`, `S = (3/4) μs'` — the common conversion
-//!    of the diffusion approximation (light inside fully diffuse, mean path
-//!    through a slab twice its thickness; S from matching the diffusion
-//!    equation's albedo) — and the KM reflectance of the layer of thickness
-//!    `X` on the Lambertian paper `R_g` ([`km::reflectance`]).
+//!    absorption coefficient `μa = Σ N_s σ_abs,s`, scattering coefficient
+//!    `μs = Σ N_s σ_sca,s`: the grains scatter as if alone (no near-field
+//!    coupling, no correlated positions, no dependent scattering at high
+//!    PVC). A molecular (dissolved) pigment scatters nothing and absorbs as
+//!    its dilute limit `f_s k₀ Im ε_s / n_b` (the small-sphere
+//!    `σ_abs = k V Im(ε_s/ε_b)` per volume), so the layer is Beer's law.
+//!
+//! **Kubelka–Munk** (`kubelka-munk`, [`kubelka_munk`]):
+//! 3. **Diffuse light**: `K = 2 μa`, `S = (3/4) μs'`, `μs' = μs (1 − g)` —
+//!    the common conversion of the diffusion approximation (light inside
+//!    fully diffuse, mean path through a slab twice its thickness; S from
+//!    matching the diffusion equation's albedo) — and the KM reflectance of
+//!    the layer of thickness `X` on the Lambertian paper `R_g`
+//!    ([`km::reflectance`]).
 //! 4. **Surface** (Saunderson, [`km::saunderson`]): `r_e` the unpolarised
 //!    Fresnel reflectance of the flat binder surface from air at the
 //!    geometry's directed angle (45° for 45°/0°, 8° for d/8°), `r_i` the
 //!    Fresnel reflectance from inside averaged over a Lambertian hemisphere
 //!    (computed). 45°/0° and d/8° SCE leave `r_e` itself out (specular
-//!    excluded), d/8° SCI includes it.
-//! 5. **Colour**: the spectrum on the spectral proxy's fine grid, through
-//!    the scene's observer and illuminant, CIELAB per geometry, and
-//!    CIEDE2000 to the wave solution's colour in the same geometry.
+//!    excluded), d/8° SCI includes it. The paper is in optical contact with
+//!    the binder, as Saunderson's correction assumes.
 //!
-//! The binder's own absorption and the layer's relief are not in the model.
-//! Nor is the wave scene's boundary under the layer: there the binder ends
-//! in vacuum above the paper (METHOD §1), here the paper is in optical
-//! contact with the binder, as Saunderson's correction assumes — the main
-//! reason the two colours differ for a weak layer (METHOD §6).
+//! **Kubelka–Munk, scene boundary** (`kubelka-munk-scene`): the same body,
+//! but under it the wave scene's boundary — the binder's lower surface, an
+//! air gap, the paper — as the effective backing
+//! `R_g = r_i + (1 − r_i) ρ (1 − r_ed)/(1 − ρ r_ed)` ([`km::scene_backing`]),
+//! and every surface with the scalar (TE) Fresnel reflectance of the
+//! solver's equation (`r_e`, `r_ed` from air, `r_i` from inside).
+//!
+//! **Adding–doubling** (`adding-doubling`, scene boundary;
+//! `adding-doubling-contact`, paper in optical contact): the radiative
+//! transfer equation itself for the same medium, with the phase function,
+//! refraction and total internal reflection at the surfaces and the exact
+//! measurement directions ([`transfer`]).
+//!
+//! **Colour**: the spectrum on the spectral proxy's fine grid, through the
+//! scene's observer and illuminant, CIELAB per geometry, and CIEDE2000 to
+//! the wave solution's colour in the same geometry.
+//!
+//! The binder's own absorption and the layer's relief are in none of them.
 
+pub mod adding;
+pub mod doubling;
 pub mod km;
+pub mod matrix;
+pub mod ordinates;
 pub mod sphere;
+pub mod transfer;
 
-use crate::config::Measurement;
+use crate::config::{Baseline, Measurement};
 use crate::optics::colour::{self, ColourError, Observer};
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
+use thiserror::Error;
+
+/// Why a baseline could not be computed.
+#[derive(Debug, Error)]
+pub enum BaselineError {
+    #[error("baseline: the binder index must be at least 1 for adding–doubling, got {0}")]
+    BinderIndex(f64),
+    #[error("baseline: the quadrature needs at least one node per panel")]
+    Nodes,
+    #[error("baseline: the layer's optical thickness is not a finite non-negative number ({0})")]
+    Thickness(f64),
+    #[error("baseline: a matrix of the adding–doubling inter-reflections is singular")]
+    Singular,
+    #[error("baseline: the quadrature has no node in the air direction {0}°")]
+    NoDirection(f64),
+    #[error("baseline: colour: {0}")]
+    Colour(#[from] ColourError),
+}
 
 /// One pigment as the baseline sees it.
 #[derive(Debug, Clone)]
@@ -140,6 +179,8 @@ pub fn measured_factor(m: Measurement, r: f64, binder_index: f64) -> f64 {
 /// The baseline's colour in one measurement geometry.
 #[derive(Debug, Clone)]
 pub struct BaselineColour {
+    /// The model that computed it.
+    pub model: Baseline,
     pub geometry: Measurement,
     /// The fine grid, nm.
     pub spectrum_wavelengths_nm: Vec<f64>,
@@ -161,15 +202,117 @@ pub fn kubelka_munk(
     observer: &Observer,
 ) -> Result<Vec<BaselineColour>, ColourError> {
     let body = body_reflectance(input);
-    let mut out = Vec::with_capacity(measurements.len());
-    for &m in measurements {
-        let factor: Vec<f64> = body
+    let factors: Vec<Vec<f64>> = measurements
+        .iter()
+        .map(|&m| {
+            body.iter()
+                .map(|&r| measured_factor(m, r, input.binder_index))
+                .collect()
+        })
+        .collect();
+    colours(
+        Baseline::KubelkaMunk,
+        input,
+        measurements,
+        factors,
+        wave,
+        observer,
+    )
+}
+
+/// The body reflectance of the KM layer on the wave scene's boundary
+/// ([`km::scene_backing`] with the scalar surface) on the grid.
+pub fn body_reflectance_scene(input: &BaselineInput) -> Vec<f64> {
+    let n = input.binder_index;
+    let r_g = km::scene_backing(
+        input.paper_albedo,
+        km::internal_reflectance_scalar(n),
+        km::diffuse_external_reflectance_scalar(n),
+    );
+    (0..input.wavelengths_nm.len())
+        .map(|l| {
+            let c = coefficients(input, l);
+            km::reflectance(c.k, c.s, input.thickness_nm, r_g)
+        })
+        .collect()
+}
+
+/// The reflectance factor of geometry `m` from a KM body reflectance `r`
+/// under the scalar (TE) surface of index `binder_index`: Saunderson's
+/// correction with the scalar `r_e` and `r_i`.
+pub fn measured_factor_scalar(m: Measurement, r: f64, binder_index: f64) -> f64 {
+    let r_i = km::internal_reflectance_scalar(binder_index);
+    let r_e = |deg| km::external_reflectance_scalar(binder_index, deg);
+    match m {
+        Measurement::FortyFiveZero => km::saunderson_excluded(r, r_e(45.0), r_i),
+        Measurement::DiffuseEightSce => km::saunderson_excluded(r, r_e(8.0), r_i),
+        Measurement::DiffuseEightSci => km::saunderson(r, r_e(8.0), r_i),
+    }
+}
+
+/// The reflectance factors of `model` for every geometry in
+/// `measurements` (outer) on the input's grid (inner).
+pub fn reflectance_factors(
+    model: Baseline,
+    input: &BaselineInput,
+    measurements: &[Measurement],
+) -> Result<Vec<Vec<f64>>, BaselineError> {
+    let km_factors = |body: Vec<f64>, f: fn(Measurement, f64, f64) -> f64| {
+        measurements
             .iter()
-            .map(|&r| measured_factor(m, r, input.binder_index))
-            .collect();
+            .map(|&m| body.iter().map(|&r| f(m, r, input.binder_index)).collect())
+            .collect()
+    };
+    let params = ordinates::OrdinateParams::default();
+    Ok(match model {
+        Baseline::KubelkaMunk => km_factors(body_reflectance(input), measured_factor),
+        Baseline::KubelkaMunkScene => {
+            km_factors(body_reflectance_scene(input), measured_factor_scalar)
+        }
+        Baseline::AddingDoubling => {
+            transfer::reflectance_factors(input, transfer::Boundary::Scene, measurements, params)?
+        }
+        Baseline::AddingDoublingContact => {
+            transfer::reflectance_factors(input, transfer::Boundary::Contact, measurements, params)?
+        }
+    })
+}
+
+/// The colours of `model` in every geometry in `measurements`; `wave` gives
+/// the wave solution's CIELAB in a geometry, when known.
+pub fn baseline_colours(
+    model: Baseline,
+    input: &BaselineInput,
+    measurements: &[Measurement],
+    wave: &dyn Fn(Measurement) -> Option<[f64; 3]>,
+    observer: &Observer,
+) -> Result<Vec<BaselineColour>, BaselineError> {
+    let factors = reflectance_factors(model, input, measurements)?;
+    Ok(colours(
+        model,
+        input,
+        measurements,
+        factors,
+        wave,
+        observer,
+    )?)
+}
+
+/// Colour of each geometry's spectrum (`factors[g]` on the input's grid).
+fn colours(
+    model: Baseline,
+    input: &BaselineInput,
+    measurements: &[Measurement],
+    factors: Vec<Vec<f64>>,
+    wave: &dyn Fn(Measurement) -> Option<[f64; 3]>,
+    observer: &Observer,
+) -> Result<Vec<BaselineColour>, ColourError> {
+    let mut out = Vec::with_capacity(measurements.len());
+    for (&m, factor) in measurements.iter().zip(factors) {
         let xyz = colour::xyz_from_reflectance(observer, &input.wavelengths_nm, &factor)?;
         let lab = colour::xyz_to_lab(xyz, observer.white_xyz());
         out.push(BaselineColour {
+            model,
             geometry: m,
             spectrum_wavelengths_nm: input.wavelengths_nm.clone(),
             reflectance_factor: factor,

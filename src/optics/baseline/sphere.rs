@@ -150,6 +150,37 @@ pub fn cross_sections(k: f64, eps_rel: C64, a: f64) -> CrossSections {
     }
 }
 
+/// Legendre moments of the scattered intensity, `m_n = 2π ∫₋₁¹ |f(θ)|² P_n(cos θ) d cos θ`
+/// for `n = 0..=2 l_max` (all that are non-zero: `|f|²` is a polynomial of
+/// degree `2 l_max` in `cos θ`), of a sphere of radius `a` and relative
+/// permittivity `eps_rel` in a host of wavenumber `k`. `m_0 = σ_sca`,
+/// `m_1/m_0 = g`, and the normalised phase function is
+/// `p(θ) = 4π|f|²/σ_sca = Σ (2n + 1) (m_n/m_0) P_n(cos θ)`. Computed by
+/// Gauss–Legendre quadrature with `2 l_max + 2` nodes, exact for these
+/// polynomials (empty for `a ≤ 0`).
+pub fn phase_moments(k: f64, eps_rel: C64, a: f64) -> Vec<f64> {
+    if a <= 0.0 {
+        return Vec::new();
+    }
+    let lmax = orders_needed(k * a, eps_rel.sqrt().norm());
+    let c = coefficients(k, eps_rel, a, lmax);
+    let orders = 2 * lmax + 1;
+    let (x, w) = super::ordinates::gauss_legendre(2 * lmax + 2);
+    let mut m = vec![0.0; orders];
+    for (&x, &w) in x.iter().zip(&w) {
+        let f2 = amplitude(&c, k, x).norm_sqr() * w * 2.0 * PI;
+        let (mut p0, mut p1) = (1.0, x);
+        m[0] += f2;
+        for (n, mn) in m.iter_mut().enumerate().skip(1) {
+            *mn += f2 * p1;
+            let p2 = ((2 * n + 1) as f64 * x * p1 - n as f64 * p0) / (n + 1) as f64;
+            p0 = p1;
+            p1 = p2;
+        }
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

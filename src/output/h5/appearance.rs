@@ -6,6 +6,7 @@ use ndarray::Array2;
 
 use super::attrs::{write_scalar_attr, write_str_attr};
 use super::described::{about, dim, standard_error, About, Scales};
+use crate::config::Baseline;
 use crate::optics::appearance::{Appearance, Colours, Estimate, MeasuredColour};
 use crate::optics::baseline::BaselineColour;
 
@@ -228,9 +229,20 @@ pub(super) fn write_appearance(
     }
     if !a.baseline.is_empty() {
         let bg = g.create_group("baseline")?;
-        write_str_attr(&bg, "model", "kubelka-munk")?;
+        let mut models: Vec<Baseline> = Vec::new();
         for b in &a.baseline {
-            write_baseline(s, &bg, b)?;
+            if !models.contains(&b.model) {
+                models.push(b.model);
+            }
+        }
+        let names: Vec<&str> = models.iter().map(|m| m.name()).collect();
+        write_str_attr(&bg, "models", &names.join(","))?;
+        for model in models {
+            let mg = bg.create_group(model.name())?;
+            write_str_attr(&mg, "model", model.name())?;
+            for b in a.baseline.iter().filter(|b| b.model == model) {
+                write_baseline(s, &mg, b)?;
+            }
         }
     }
     if let Some(png) = tile_png {
@@ -370,39 +382,45 @@ fn write_measured(s: &mut Scales, parent: &hdf5::Group, m: &MeasuredColour) -> h
     Ok(())
 }
 
-/// `/appearance/baseline/<slug>`: the Kubelka–Munk colour in one measurement
-/// geometry.
+/// `/appearance/baseline/<model>/<slug>`: one baseline model's colour in
+/// one measurement geometry.
 fn write_baseline(s: &mut Scales, parent: &hdf5::Group, b: &BaselineColour) -> hdf5::Result<()> {
     let g = parent.create_group(b.geometry.slug())?;
     write_str_attr(&g, "geometry", b.geometry.name())?;
-    let description =
-        "wavelengths of the Kubelka–Munk spectrum (the spectral proxy's grid); spectrum wavelength";
+    let model = b.model.name();
+    let description = format!(
+        "wavelengths of the {model} spectrum (the spectral proxy's grid); spectrum wavelength"
+    );
     s.coordinate(
         &g,
         "spectrum_wavelengths_nm",
         &b.spectrum_wavelengths_nm,
-        about("nm", description, &[dim::SPECTRUM_WAVELENGTH]),
+        about("nm", &description, &[dim::SPECTRUM_WAVELENGTH]),
     )?;
-    let description = "Kubelka–Munk reflectance factor in this geometry (Saunderson's surface \
-                       correction included); spectrum wavelength";
+    let description = format!(
+        "{model} reflectance factor in this geometry ({}); spectrum wavelength",
+        b.model.summary()
+    );
     s.write(
         &g,
         "reflectance_factor",
         &b.reflectance_factor[..],
-        about("1", description, &[dim::SPECTRUM_WAVELENGTH]),
+        about("1", &description, &[dim::SPECTRUM_WAVELENGTH]),
     )?;
     // One coordinate per geometry: the next geometry's replaces it.
     s.forget(dim::SPECTRUM_WAVELENGTH);
-    let description = "CIELAB L*, a*, b* of the Kubelka–Munk spectrum";
-    s.write(&g, "lab", &b.lab[..], about("1", description, &[dim::LAB]))?;
+    let description = format!("CIELAB L*, a*, b* of the {model} spectrum");
+    s.write(&g, "lab", &b.lab[..], about("1", &description, &[dim::LAB]))?;
     if let Some(de) = b.de00_to_wave {
-        let description = "CIEDE2000 from the Kubelka–Munk colour to the wave solution's colour \
-                           in the same geometry (/appearance/measured); one value";
+        let description = format!(
+            "CIEDE2000 from the {model} colour to the wave solution's colour in the same \
+             geometry (/appearance/measured); one value"
+        );
         s.write(
             &g,
             "de00_to_wave",
             &[de][..],
-            about("1", description, &[dim::VALUE]),
+            about("1", &description, &[dim::VALUE]),
         )?;
     }
     Ok(())

@@ -131,11 +131,11 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
     Ok(Some((out, illuminant, observer)))
 }
 
-/// One measurement geometry's Kubelka–Munk colour as read back from a
-/// result file (`/appearance/baseline`).
+/// One baseline model's colour in one measurement geometry as read back
+/// from a result file (`/appearance/baseline`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BaselineRecord {
-    /// The baseline's model (`kubelka-munk`).
+    /// The baseline's model (`kubelka-munk`, `adding-doubling`, …).
     pub model: String,
     /// The geometry's name (`45/0`, `d/8 SCI`, `d/8 SCE`).
     pub geometry: String,
@@ -144,7 +144,10 @@ pub struct BaselineRecord {
     pub de00_to_wave: Option<f64>,
 }
 
-/// The baseline colours of a result file; empty when it has none.
+/// The baseline colours of a result file, model by model; empty when it has
+/// none. Reads both layouts: `/appearance/baseline/<model>/<geometry>`
+/// (attribute `model` on each model's group) and the earlier single-model
+/// `/appearance/baseline/<geometry>` (attribute `model` on the group).
 pub fn read_baseline(path: &Path) -> Result<Vec<BaselineRecord>, IoError> {
     let hdf = |source| IoError::Hdf5 {
         path: path.to_path_buf(),
@@ -155,21 +158,42 @@ pub fn read_baseline(path: &Path) -> Result<Vec<BaselineRecord>, IoError> {
         return Ok(Vec::new());
     }
     let g = file.group("appearance/baseline").map_err(hdf)?;
-    let model = read_str_attr(&g, "model").map_err(hdf)?;
     let mut out = Vec::new();
-    for name in g.member_names().map_err(hdf)? {
-        let d = g.group(&name).map_err(hdf)?;
-        let lab = optional_values::<3>(&d, "lab")
-            .and_then(|v| v.ok_or_else(|| hdf5::Error::from(format!("{name}: no lab"))))
-            .map_err(hdf)?;
-        out.push(BaselineRecord {
-            model: model.clone(),
-            geometry: read_str_attr(&d, "geometry").map_err(hdf)?,
-            lab,
-            de00_to_wave: optional_values::<1>(&d, "de00_to_wave")
-                .map_err(hdf)?
-                .map(|[v]| v),
-        });
+    if g.attr("model").is_ok() {
+        let model = read_str_attr(&g, "model").map_err(hdf)?;
+        read_geometries(&g, &model, &mut out).map_err(hdf)?;
+        return Ok(out);
+    }
+    // Models in the order written.
+    let mut names = g.member_names().map_err(hdf)?;
+    if let Ok(order) = read_str_attr(&g, "models") {
+        let order: Vec<&str> = order.split(',').collect();
+        names.sort_by_key(|n| order.iter().position(|o| o == n).unwrap_or(usize::MAX));
+    }
+    for name in names {
+        let mg = g.group(&name).map_err(hdf)?;
+        let model = read_str_attr(&mg, "model").map_err(hdf)?;
+        read_geometries(&mg, &model, &mut out).map_err(hdf)?;
     }
     Ok(out)
+}
+
+/// The geometry groups of one model's baseline group.
+fn read_geometries(
+    g: &hdf5::Group,
+    model: &str,
+    out: &mut Vec<BaselineRecord>,
+) -> hdf5::Result<()> {
+    for name in g.member_names()? {
+        let d = g.group(&name)?;
+        let lab = optional_values::<3>(&d, "lab")
+            .and_then(|v| v.ok_or_else(|| hdf5::Error::from(format!("{name}: no lab"))))?;
+        out.push(BaselineRecord {
+            model: model.to_string(),
+            geometry: read_str_attr(&d, "geometry")?,
+            lab,
+            de00_to_wave: optional_values::<1>(&d, "de00_to_wave")?.map(|[v]| v),
+        });
+    }
+    Ok(())
 }

@@ -1,0 +1,216 @@
+//! Small dense square matrices for the adding–doubling baseline: the
+//! reflection and transmission matrices of a layer over the quadrature's
+//! directions in one hemisphere (a few tens of rows), with the products and
+//! the linear solve the adding formulas need.
+
+use super::BaselineError;
+
+/// A square matrix, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Matrix {
+    n: usize,
+    data: Vec<f64>,
+}
+
+impl Matrix {
+    /// The `n × n` zero matrix.
+    pub fn zeros(n: usize) -> Matrix {
+        Matrix {
+            n,
+            data: vec![0.0; n * n],
+        }
+    }
+
+    /// The `n × n` identity.
+    pub fn identity(n: usize) -> Matrix {
+        Matrix::diagonal(&vec![1.0; n])
+    }
+
+    /// The diagonal matrix of `d`.
+    pub fn diagonal(d: &[f64]) -> Matrix {
+        let mut m = Matrix::zeros(d.len());
+        for (i, &v) in d.iter().enumerate() {
+            m[(i, i)] = v;
+        }
+        m
+    }
+
+    /// The matrix with entries `f(i, j)`.
+    pub fn from_fn(n: usize, f: impl Fn(usize, usize) -> f64) -> Matrix {
+        let mut m = Matrix::zeros(n);
+        for i in 0..n {
+            for j in 0..n {
+                m[(i, j)] = f(i, j);
+            }
+        }
+        m
+    }
+
+    /// Number of rows (= columns).
+    pub fn size(&self) -> usize {
+        self.n
+    }
+
+    /// `self · other`.
+    pub fn mul(&self, other: &Matrix) -> Matrix {
+        let n = self.n;
+        let mut out = Matrix::zeros(n);
+        for i in 0..n {
+            for k in 0..n {
+                let a = self.data[i * n + k];
+                if a == 0.0 {
+                    continue;
+                }
+                let row = &other.data[k * n..(k + 1) * n];
+                let dst = &mut out.data[i * n..(i + 1) * n];
+                for (d, b) in dst.iter_mut().zip(row) {
+                    *d += a * b;
+                }
+            }
+        }
+        out
+    }
+
+    /// `self + other`.
+    pub fn add(&self, other: &Matrix) -> Matrix {
+        let mut out = self.clone();
+        for (a, b) in out.data.iter_mut().zip(&other.data) {
+            *a += b;
+        }
+        out
+    }
+
+    /// `I − self`.
+    pub fn identity_minus(&self) -> Matrix {
+        let mut out = self.clone();
+        for v in &mut out.data {
+            *v = -*v;
+        }
+        for i in 0..self.n {
+            out.data[i * self.n + i] += 1.0;
+        }
+        out
+    }
+
+    /// Column sums: `Σ_i M_ij` per column `j`.
+    pub fn column_sums(&self) -> Vec<f64> {
+        (0..self.n)
+            .map(|j| (0..self.n).map(|i| self[(i, j)]).sum())
+            .collect()
+    }
+
+    /// The largest absolute entry of `self − other`.
+    pub fn max_difference(&self, other: &Matrix) -> f64 {
+        self.data
+            .iter()
+            .zip(&other.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// `X` with `self · X = rhs`, by Gaussian elimination with partial
+    /// pivoting. A singular but consistent system — a direction no light
+    /// can reach, such as one trapped between two totally reflecting
+    /// surfaces in a layer that neither scatters nor absorbs, where the row
+    /// reads `0 = 0` — has that unknown set to 0; an inconsistent one is an
+    /// error.
+    pub fn solve(&self, rhs: &Matrix) -> Result<Matrix, BaselineError> {
+        let n = self.n;
+        let mut a = self.data.clone();
+        let mut b = rhs.data.clone();
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let rhs_scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if !(scale.is_finite() && rhs_scale.is_finite()) {
+            return Err(BaselineError::Singular);
+        }
+        let tiny = 1e-14 * scale;
+        // Row echelon form; `pivots[r]` is the column of row r's pivot.
+        let mut pivots = Vec::with_capacity(n);
+        let mut row = 0;
+        for col in 0..n {
+            if row == n {
+                break;
+            }
+            let pivot = (row..n)
+                .max_by(|&p, &q| a[p * n + col].abs().total_cmp(&a[q * n + col].abs()))
+                .unwrap_or(row);
+            let p = a[pivot * n + col];
+            if p.abs() <= tiny {
+                continue; // a free unknown, set to 0
+            }
+            if pivot != row {
+                for k in 0..n {
+                    a.swap(pivot * n + k, row * n + k);
+                    b.swap(pivot * n + k, row * n + k);
+                }
+            }
+            for r in row + 1..n {
+                let f = a[r * n + col] / p;
+                if f == 0.0 {
+                    continue;
+                }
+                for k in col..n {
+                    a[r * n + k] -= f * a[row * n + k];
+                }
+                for k in 0..n {
+                    b[r * n + k] -= f * b[row * n + k];
+                }
+            }
+            pivots.push(col);
+            row += 1;
+        }
+        // The rows without a pivot must read 0 = 0.
+        let tolerance = 1e-12 * rhs_scale;
+        if b[row * n..].iter().any(|v| v.abs() > tolerance) {
+            return Err(BaselineError::Singular);
+        }
+        let mut x = vec![0.0; n * n];
+        for (r, &col) in pivots.iter().enumerate().rev() {
+            let p = a[r * n + col];
+            for k in 0..n {
+                let mut v = b[r * n + k];
+                for c in col + 1..n {
+                    v -= a[r * n + c] * x[c * n + k];
+                }
+                x[col * n + k] = v / p;
+            }
+        }
+        Ok(Matrix { n, data: x })
+    }
+}
+
+impl std::ops::Index<(usize, usize)> for Matrix {
+    type Output = f64;
+    fn index(&self, (i, j): (usize, usize)) -> &f64 {
+        &self.data[i * self.n + j]
+    }
+}
+
+impl std::ops::IndexMut<(usize, usize)> for Matrix {
+    fn index_mut(&mut self, (i, j): (usize, usize)) -> &mut f64 {
+        &mut self.data[i * self.n + j]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solve_inverts_a_product() {
+        let a = Matrix::from_fn(5, |i, j| {
+            1.0 / (1.0 + i as f64 + j as f64) + (i == j) as u8 as f64
+        });
+        let b = Matrix::from_fn(5, |i, j| (i * 5 + j) as f64 - 3.0);
+        let x = a.solve(&a.mul(&b)).unwrap();
+        assert!(x.max_difference(&b) < 1e-12);
+        assert!(Matrix::zeros(3).solve(&Matrix::identity(3)).is_err());
+        // Singular but consistent (a row 0 = 0): that unknown is 0.
+        let mut m = Matrix::identity(3);
+        m[(1, 1)] = 0.0;
+        let mut rhs = Matrix::identity(3);
+        rhs[(1, 1)] = 0.0;
+        let x = m.solve(&rhs).unwrap();
+        assert_eq!(x, rhs);
+    }
+}

@@ -1,0 +1,217 @@
+//! The adding–doubling baseline: the layer as a radiative-transfer slab of
+//! independent scatterers between the binder's flat surfaces, solved by
+//! adding–doubling (METHOD §6).
+//!
+//! **Medium** (per wavelength, from the same single scatterers as the
+//! Kubelka–Munk baseline, [`super::coefficients`]): `μa = Σ N_s σ_abs,s`
+//! (plus a dissolved pigment's `f k₀ Im ε / n_b`), `μs = Σ N_s σ_sca,s`, and
+//! the phase function of the mixture weighted by `N_s σ_sca,s`: Legendre
+//! moments `χ_n = Σ N_s m_n,s / Σ N_s σ_sca,s` from the scalar sphere
+//! ([`super::sphere::phase_moments`]). No diffusion-approximation factors.
+//!
+//! **Stack**, from the top: air, the binder's surface, the layer (binder of
+//! index `n_b` with the scatterers, [`doubling::homogeneous`]), then the
+//! [`Boundary`]: the scene's (binder → air gap → Lambertian paper, as the
+//! wave scene is built) or Saunderson's contact (paper in optical contact
+//! with the binder).
+//!
+//! **Geometries** (azimuthally averaged radiance, Fourier term `m = 0`,
+//! suffices for all three): 45°/0° is the bidirectional reflectance factor
+//! `π f(45° → 0°)`, and a view along the normal sees only the `m = 0` term;
+//! d/8° is directional–hemispherical by reciprocity (the hemispherical
+//! reflectance for incidence at 8°), SCI with the mirror reflection and SCE
+//! without it. The mirror reflection is the unscattered light's: the
+//! surface's Fresnel reflection at 8° plus the direct beam's returns from
+//! the lower surface through the layer (what the wave scene's (0,0) order
+//! carries).
+
+use super::adding::{self, fresnel_scalar, Slab};
+use super::doubling::{self, Medium};
+use super::matrix::Matrix;
+use super::ordinates::{OrdinateParams, Ordinates};
+use super::{sphere, BaselineError, BaselineInput};
+use crate::config::Measurement;
+use std::f64::consts::PI;
+
+/// What lies under the layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Boundary {
+    /// The wave scene's: the binder ends in a flat surface over an air gap,
+    /// then the Lambertian paper (in air).
+    Scene,
+    /// Saunderson's: the Lambertian paper in optical contact with the
+    /// binder.
+    Contact,
+}
+
+/// The air directions the quadrature must contain: the measurement angles.
+pub const AIR_DIRECTIONS_DEG: [f64; 3] = [0.0, 8.0, 45.0];
+
+/// The radiative-transfer medium at wavelength index `l` of the grid.
+pub fn medium(input: &BaselineInput, l: usize) -> Medium {
+    let lambda = input.wavelengths_nm[l];
+    let nb = input.binder_index;
+    let eps_b = nb * nb;
+    let k0 = 2.0 * PI / lambda;
+    let (mut mu_a, mut mu_s) = (0.0, 0.0);
+    let mut moments: Vec<f64> = Vec::new();
+    for sp in &input.species {
+        let eps = sp.eps[l];
+        if sp.diameter_nm <= 0.0 {
+            mu_a += sp.volume_fraction * k0 * eps.im / nb;
+            continue;
+        }
+        let d = sp.diameter_nm;
+        let number = sp.volume_fraction / (PI * d.powi(3) / 6.0);
+        let c = sphere::cross_sections(k0 * nb, eps / eps_b, d / 2.0);
+        mu_a += number * c.absorption.max(0.0);
+        mu_s += number * c.scattering;
+        let m = sphere::phase_moments(k0 * nb, eps / eps_b, d / 2.0);
+        if moments.len() < m.len() {
+            moments.resize(m.len(), 0.0);
+        }
+        for (acc, v) in moments.iter_mut().zip(&m) {
+            *acc += number * v;
+        }
+    }
+    if mu_s > 0.0 && moments.first().is_some_and(|&m0| m0 > 0.0) {
+        let m0 = moments[0];
+        for v in &mut moments {
+            *v /= m0;
+        }
+    } else {
+        mu_s = 0.0;
+        moments.clear();
+    }
+    Medium {
+        mu_a,
+        mu_s,
+        moments,
+    }
+}
+
+/// The reflection matrix (from above, air to air) of the whole stack, and
+/// the mirror reflectance per bin.
+pub struct StackReflection {
+    pub ords: Ordinates,
+    /// Flux reflection matrix, air bins (rows and columns of trapped bins
+    /// are 0).
+    pub r: Matrix,
+    /// Reflectance of the unscattered light per bin (the mirror reflection).
+    pub specular: Vec<f64>,
+}
+
+impl StackReflection {
+    /// The reflectance factor an instrument in geometry `m` reads.
+    pub fn factor(&self, m: Measurement) -> Result<f64, BaselineError> {
+        let node = |deg: f64| {
+            self.ords
+                .air_node(deg)
+                .ok_or(BaselineError::NoDirection(deg))
+        };
+        Ok(match m {
+            Measurement::FortyFiveZero => {
+                let (i, j) = (node(0.0)?, node(45.0)?);
+                self.r[(i, j)] / self.ords.air_flux_weight(i)
+            }
+            Measurement::DiffuseEightSci => {
+                let j = node(8.0)?;
+                (0..self.ords.len()).map(|i| self.r[(i, j)]).sum()
+            }
+            Measurement::DiffuseEightSce => {
+                let j = node(8.0)?;
+                let total: f64 = (0..self.ords.len()).map(|i| self.r[(i, j)]).sum();
+                total - self.specular[j]
+            }
+        })
+    }
+}
+
+/// The stack's reflection for `medium` in a layer `thickness_nm` thick of
+/// binder index `binder_index` on paper of `albedo` under `boundary`.
+pub fn stack(
+    ords: Ordinates,
+    medium: &Medium,
+    thickness_nm: f64,
+    albedo: f64,
+    boundary: Boundary,
+) -> Result<StackReflection, BaselineError> {
+    let layer = doubling::homogeneous(&ords, medium, thickness_nm)?;
+    let backing = match boundary {
+        Boundary::Scene => adding::on_backing(
+            &adding::surface_binder_over_air(&ords),
+            &adding::lambertian_in_air(&ords, albedo),
+        )?,
+        Boundary::Contact => adding::lambertian_in_binder(&ords, albedo),
+    };
+    let under_surface = adding::on_backing(&layer, &backing)?;
+    let r = adding::on_backing(&adding::surface_air_over_binder(&ords), &under_surface)?;
+    let specular = mirror_reflectance(&ords, medium, thickness_nm, boundary);
+    Ok(StackReflection { ords, r, specular })
+}
+
+/// The unscattered light's reflectance per bin: the surface's Fresnel
+/// reflection `r_t` plus the direct beam's (transmittance `t` through the
+/// layer, δ-M extinction) returns from the lower surface (`r_b`, 0 in
+/// optical contact): `r_t + (1 − r_t)² t² r_b / (1 − r_t r_b t²)`.
+pub fn mirror_reflectance(
+    ords: &Ordinates,
+    medium: &Medium,
+    thickness_nm: f64,
+    boundary: Boundary,
+) -> Vec<f64> {
+    let (mu_s, _) = medium.delta_m(2 * ords.len());
+    let direct = doubling::direct(ords, medium.mu_a + mu_s, thickness_nm);
+    (0..ords.len())
+        .map(|i| {
+            let Some(mu_a) = ords.mu_air[i] else {
+                return 0.0;
+            };
+            let rt = fresnel_scalar(ords.binder_index, ords.mu[i], mu_a);
+            let rb = match boundary {
+                Boundary::Scene => rt,
+                Boundary::Contact => 0.0,
+            };
+            let t2 = direct.t_down[(i, i)].powi(2);
+            rt + (1.0 - rt).powi(2) * t2 * rb / (1.0 - rt * rb * t2)
+        })
+        .collect()
+}
+
+/// The reflectance factor of every geometry in `measurements` (outer) at
+/// every wavelength of the grid (inner).
+pub fn reflectance_factors(
+    input: &BaselineInput,
+    boundary: Boundary,
+    measurements: &[Measurement],
+    params: OrdinateParams,
+) -> Result<Vec<Vec<f64>>, BaselineError> {
+    let ords = Ordinates::new(input.binder_index, params, &AIR_DIRECTIONS_DEG)?;
+    let mut out = vec![Vec::with_capacity(input.wavelengths_nm.len()); measurements.len()];
+    for l in 0..input.wavelengths_nm.len() {
+        let m = medium(input, l);
+        let s = stack(
+            ords.clone(),
+            &m,
+            input.thickness_nm,
+            input.paper_albedo,
+            boundary,
+        )?;
+        for (g, &geometry) in measurements.iter().enumerate() {
+            out[g].push(s.factor(geometry)?);
+        }
+    }
+    Ok(out)
+}
+
+/// A slab's reflection and transmission on its own, for checks: the
+/// homogeneous layer of `medium` between the binder's two surfaces, in air.
+pub fn free_layer(
+    ords: &Ordinates,
+    medium: &Medium,
+    thickness_nm: f64,
+) -> Result<Slab, BaselineError> {
+    let layer = doubling::homogeneous(ords, medium, thickness_nm)?;
+    let lower = adding::add(&layer, &adding::surface_binder_over_air(ords))?;
+    adding::add(&adding::surface_air_over_binder(ords), &lower)
+}

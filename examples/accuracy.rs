@@ -1,4 +1,4 @@
-//! What accuracy costs in time (issue #6): for representative layers, vary
+//! What accuracy costs in time: for representative layers, vary
 //! one fidelity knob at a time from a baseline, run each variant through the
 //! `inksim` CLI (under `/usr/bin/time` for wall time, CPU time and peak
 //! memory) and compare what users look at against the knob's converged

@@ -62,7 +62,7 @@ pub use eps::fraction_eps;
 pub use grains::{build_geometry, build_geometry_seeded, grid_of, Packer, RSA_MAX_PVC};
 pub use plan::{plan_text, planned_solves, realisation_seed, RunPlan};
 pub use run::{run, run_geometry, run_with, GeometryReport, RunReport};
-pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
+pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps, ENERGY_BALANCE_LIMIT};
 
 /// Sub-samples per voxel edge for partially filled voxels.
 pub const SUPERSAMPLE: usize = 4;

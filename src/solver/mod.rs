@@ -86,6 +86,28 @@ pub struct SolveRecord {
     pub note: String,
 }
 
+impl SolveRecord {
+    /// An empty tally of what solves cost, to [`add`](Self::add) to.
+    pub fn spent() -> SolveRecord {
+        SolveRecord {
+            method: Method::Auto,
+            iterations: 0,
+            operator_applications: 0,
+            residual: 0.0,
+            seconds: 0.0,
+            note: String::new(),
+        }
+    }
+
+    /// Count the iterations, applications and seconds of `other` in this
+    /// record's (the cost of attempts it replaced).
+    pub fn add(&mut self, other: &SolveRecord) {
+        self.iterations += other.iterations;
+        self.operator_applications += other.operator_applications;
+        self.seconds += other.seconds;
+    }
+}
+
 /// Why a solve did not produce a trustworthy answer.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum SolveError {

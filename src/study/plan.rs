@@ -46,15 +46,15 @@ pub const CALIBRATION_VOXELS: usize = 1 << 19;
 /// 84–348 (median 232) to 1e-6 (docs/PERFORMANCE.md); 200 is the round middle.
 pub const BINDER_APPLICATIONS: f64 = 200.0;
 /// The same on the mean background for a layer under a flat binder surface:
-/// `auto` (BiCGStab) over the standard profile's flat red variants (60 × 60 ×
-/// 50 cells, tolerance 1e-4, 0–60° from above and below; 100 nm spheres
-/// 12, 450 nm 37) — docs/PERFORMANCE.md, "The standard study".
-pub const MEAN_APPLICATIONS: f64 = 23.0;
+/// `auto` (BiCGStab) over the 48 flat granular red variants of the standard
+/// profile (60 × 60 × 50 cells, tolerance 1e-4, 0–60° from above and below;
+/// 100 nm spheres 12, 450 nm 37; mean 20.8) — docs/PERFORMANCE.md, "The
+/// standard study".
+pub const MEAN_APPLICATIONS: f64 = 21.0;
 /// The same when the top is not a plane (relief, a conformal film or a
-/// rough surface): the binder–air interface crosses the grid's cells, and
-/// the standard profile's red variants of these kinds needed 3–6× the flat
-/// layers' applications.
-pub const MEAN_APPLICATIONS_SURFACE: f64 = 110.0;
+/// rough surface): the binder–air interface crosses the grid's cells; the
+/// standard profile's 9 red variants of these kinds needed 56–260, mean 93.
+pub const MEAN_APPLICATIONS_SURFACE: f64 = 93.0;
 
 /// Operator applications per solve assumed for `scene` when no result of
 /// the study exists yet: by its solver background and, on the mean

@@ -122,24 +122,53 @@ pub struct KmCoefficients {
     pub s: f64,
 }
 
-/// μa, μs', K and S of the layer at wavelength index `l` of the grid.
-pub fn coefficients(input: &BaselineInput, l: usize) -> KmCoefficients {
-    let lambda = input.wavelengths_nm[l];
+/// One grain species at one wavelength, as the independent-scattering
+/// models see it: number density (1/nm³), the binder's wavenumber `k`, the
+/// permittivity relative to the binder, the equal-volume radius and the
+/// scalar sphere's cross sections.
+pub(crate) struct GrainTerms {
+    pub number: f64,
+    pub k: f64,
+    pub eps_rel: C64,
+    pub radius: f64,
+    pub cross: sphere::CrossSections,
+}
+
+/// The layer at wavelength index `l`: the dissolved pigments' absorption
+/// coefficient (their dilute limit `f k₀ Im ε / n_b`, 1/nm) and each grain
+/// species' terms.
+pub(crate) fn at_wavelength(input: &BaselineInput, l: usize) -> (f64, Vec<GrainTerms>) {
     let nb = input.binder_index;
     let eps_b = nb * nb;
-    let k0 = 2.0 * PI / lambda;
-    let (mut mu_a, mut mu_s) = (0.0, 0.0);
+    let k0 = 2.0 * PI / input.wavelengths_nm[l];
+    let mut dissolved = 0.0;
+    let mut grains = Vec::new();
     for sp in &input.species {
         let eps = sp.eps[l];
         if sp.diameter_nm <= 0.0 {
-            mu_a += sp.volume_fraction * k0 * eps.im / nb;
+            dissolved += sp.volume_fraction * k0 * eps.im / nb;
             continue;
         }
         let d = sp.diameter_nm;
-        let number = sp.volume_fraction / (PI * d.powi(3) / 6.0);
-        let c = sphere::cross_sections(k0 * nb, eps / eps_b, d / 2.0);
-        mu_a += number * c.absorption.max(0.0);
-        mu_s += number * c.scattering * (1.0 - c.asymmetry);
+        let (k, eps_rel, radius) = (k0 * nb, eps / eps_b, d / 2.0);
+        grains.push(GrainTerms {
+            number: sp.volume_fraction / (PI * d.powi(3) / 6.0),
+            k,
+            eps_rel,
+            radius,
+            cross: sphere::cross_sections(k, eps_rel, radius),
+        });
+    }
+    (dissolved, grains)
+}
+
+/// μa, μs', K and S of the layer at wavelength index `l` of the grid.
+pub fn coefficients(input: &BaselineInput, l: usize) -> KmCoefficients {
+    let (mut mu_a, grains) = at_wavelength(input, l);
+    let mut mu_s = 0.0;
+    for g in &grains {
+        mu_a += g.number * g.cross.absorption.max(0.0);
+        mu_s += g.number * g.cross.scattering * (1.0 - g.cross.asymmetry);
     }
     KmCoefficients {
         mu_a,

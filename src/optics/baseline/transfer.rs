@@ -31,7 +31,6 @@ use super::matrix::Matrix;
 use super::ordinates::{OrdinateParams, Ordinates};
 use super::{sphere, BaselineError, BaselineInput};
 use crate::config::Measurement;
-use std::f64::consts::PI;
 
 /// What lies under the layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -49,29 +48,18 @@ pub const AIR_DIRECTIONS_DEG: [f64; 3] = [0.0, 8.0, 45.0];
 
 /// The radiative-transfer medium at wavelength index `l` of the grid.
 pub fn medium(input: &BaselineInput, l: usize) -> Medium {
-    let lambda = input.wavelengths_nm[l];
-    let nb = input.binder_index;
-    let eps_b = nb * nb;
-    let k0 = 2.0 * PI / lambda;
-    let (mut mu_a, mut mu_s) = (0.0, 0.0);
+    let (mut mu_a, grains) = super::at_wavelength(input, l);
+    let mut mu_s = 0.0;
     let mut moments: Vec<f64> = Vec::new();
-    for sp in &input.species {
-        let eps = sp.eps[l];
-        if sp.diameter_nm <= 0.0 {
-            mu_a += sp.volume_fraction * k0 * eps.im / nb;
-            continue;
-        }
-        let d = sp.diameter_nm;
-        let number = sp.volume_fraction / (PI * d.powi(3) / 6.0);
-        let c = sphere::cross_sections(k0 * nb, eps / eps_b, d / 2.0);
-        mu_a += number * c.absorption.max(0.0);
-        mu_s += number * c.scattering;
-        let m = sphere::phase_moments(k0 * nb, eps / eps_b, d / 2.0);
+    for g in &grains {
+        mu_a += g.number * g.cross.absorption.max(0.0);
+        mu_s += g.number * g.cross.scattering;
+        let m = sphere::phase_moments(g.k, g.eps_rel, g.radius);
         if moments.len() < m.len() {
             moments.resize(m.len(), 0.0);
         }
         for (acc, v) in moments.iter_mut().zip(&m) {
-            *acc += number * v;
+            *acc += g.number * v;
         }
     }
     if mu_s > 0.0 && moments.first().is_some_and(|&m0| m0 > 0.0) {

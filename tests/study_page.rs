@@ -209,3 +209,68 @@ fn summary_page_renders_in_headless_chromium() {
         "the plots did not load"
     );
 }
+
+/// A study whose variants carry classical baselines lists, on both pages,
+/// each model's ΔE00 to the wave colour as the result files hold it, beside
+/// the wave colour's own standard error; a study without them has no such
+/// section (the other tests' page).
+#[test]
+fn the_page_lists_each_baselines_de00_to_the_wave_colour() {
+    let sweep = SWEEP.replace(
+        "polar_deg = [0.0]\n",
+        "polar_deg = [0.0]\n[base.appearance]\nbaseline = [\"kubelka-munk\", \"adding-doubling\"]\n",
+    );
+    assert_ne!(sweep, SWEEP);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sweep.toml");
+    std::fs::write(&path, &sweep).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .args(["run", path.to_str().unwrap()])
+        .current_dir(dir.path())
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("SLURM_ARRAY_TASK_COUNT")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let study_dir = dir.path().join("out");
+    let md = std::fs::read_to_string(study_dir.join("summary.md")).unwrap();
+    let html = std::fs::read_to_string(study_dir.join("summary.html")).unwrap();
+    assert!(md.contains("## Classical baselines"), "{md}");
+    assert!(html.contains("<h2>Classical baselines</h2>"));
+    let mut variants = 0;
+    for entry in std::fs::read_dir(study_dir.join("variants")).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().and_then(|e| e.to_str()) != Some("h5") {
+            continue;
+        }
+        let name = p.file_stem().unwrap().to_str().unwrap().to_string();
+        let (measured, _, _) = read_measured(&p).unwrap().unwrap();
+        let m = measured.iter().find(|m| m.geometry == "45/0").unwrap();
+        let b = inksim::output::h5::read_baseline(&p).unwrap();
+        let de = |model: &str| {
+            let r = b.iter().find(|r| r.model == model && r.geometry == "45/0");
+            format!("{:.2}", r.unwrap().de00_to_wave.unwrap())
+        };
+        let tail = format!(
+            "| {:.2} | {} | {} |",
+            m.de00_se.unwrap(),
+            de("kubelka-munk"),
+            de("adding-doubling")
+        );
+        let head = format!("| {name} |");
+        assert!(
+            md.lines()
+                .any(|l| l.starts_with(&head) && l.ends_with(&tail)),
+            "{head} … {tail}\n{md}"
+        );
+        variants += 1;
+    }
+    assert_eq!(variants, 4);
+    let (_guard, plain, _) = run_study();
+    let md = std::fs::read_to_string(plain.join("summary.md")).unwrap();
+    assert!(!md.contains("Classical baselines"));
+}

@@ -1,7 +1,7 @@
 //! `summary.md`: the summary page's facts, effects table, plots, grids and
 //! variants in Markdown (see [`super::page`]).
 
-use super::page::{colour_cells, effect_table, PageInput};
+use super::page::{baseline_table, colour_cells, effect_table, PageInput, BASELINE_TEXT};
 use std::fmt::Write as _;
 
 fn row(cells: &[String]) -> String {
@@ -33,6 +33,12 @@ pub(super) fn page(p: &PageInput) -> String {
     } else {
         let head: Vec<String> = head.iter().map(|h| h.to_string()).collect();
         md += &table(&head, &rows);
+        md += "\n";
+    }
+    let (bhead, brows) = baseline_table(p);
+    if !brows.is_empty() {
+        md += &format!("## Classical baselines\n\n{BASELINE_TEXT}\n\n");
+        md += &table(&bhead, &brows);
         md += "\n";
     }
     md += "## Plots\n\n";

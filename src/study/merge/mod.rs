@@ -80,6 +80,8 @@ struct Row<'a> {
     /// The variant's colour in [`COLOUR_GEOMETRY`] (else its first
     /// measurement geometry), when the result has measured colours.
     measured: Option<Measured>,
+    /// The classical baselines' colours in the geometry of `measured`.
+    baseline: Vec<h5::BaselineRecord>,
 }
 
 /// The measurement geometry the plots, the effects table and the grid cards
@@ -151,6 +153,13 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             mean(|e| e.absorption),
         );
         let measured = measured(&run::paths(v).0)?;
+        let baseline = match &measured {
+            Some(m) => h5::read_baseline(&run::paths(v).0)?
+                .into_iter()
+                .filter(|b| b.geometry == m.record.geometry)
+                .collect(),
+            None => Vec::new(),
+        };
         rows.push(Row {
             v,
             s,
@@ -158,6 +167,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             t,
             a,
             measured,
+            baseline,
         });
     }
     let dir = &exp.study_dir;

@@ -200,6 +200,58 @@ fn tr(cells: &[String], tag: &str) -> String {
 
 /// The HTML page (the Markdown one is `markdown::page`, from the same
 /// input).
+/// The classical baselines' CIEDE2000 to the wave solution's colour, one
+/// row per variant that carries any, one column per model, beside the wave
+/// colour's own ΔE00 standard error: (head, rows), both empty when no
+/// variant has a baseline.
+pub(super) fn baseline_table(p: &PageInput) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut models: Vec<&str> = Vec::new();
+    for r in p.rows {
+        for b in &r.baseline {
+            if !models.contains(&b.model.as_str()) {
+                models.push(&b.model);
+            }
+        }
+    }
+    if models.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
+    let mut head: Vec<String> = vec!["variant".into()];
+    head.extend(axes.iter().map(|a| a.to_string()));
+    head.push("s.e. of the wave colour (ΔE00)".into());
+    head.extend(models.iter().map(|m| format!("{m}: ΔE00 to wave")));
+    let rows = p
+        .rows
+        .iter()
+        .filter(|r| !r.baseline.is_empty())
+        .map(|r| {
+            let mut cells = vec![r.v.name.clone()];
+            cells.extend(axes.iter().map(|a| r.v.label(a).unwrap_or("—").to_string()));
+            let se = r.measured.as_ref().and_then(|m| m.record.de00_se);
+            cells.push(se.map_or("—".into(), |x| format!("{x:.2}")));
+            for m in &models {
+                let de = r
+                    .baseline
+                    .iter()
+                    .find(|b| b.model == *m)
+                    .and_then(|b| b.de00_to_wave);
+                cells.push(de.map_or("—".into(), |x| format!("{x:.2}")));
+            }
+            cells
+        })
+        .collect();
+    (head, rows)
+}
+
+/// What the baseline table shows, in words (both pages).
+pub(super) const BASELINE_TEXT: &str = "CIEDE2000 between each classical baseline's colour \
+    (appearance.baseline: Kubelka–Munk, radiative transfer by adding–doubling; METHOD §6) and \
+    the wave solution's, in the geometry of the effects table, per variant; beside it the wave \
+    colour's own ΔE00 standard error, below which a disagreement is not resolved. Where a \
+    baseline stays below 1, independent scattering suffices; where it does not, the grains' \
+    coupling, the binder skin or the boundary matter (docs/VALIDATION.md).";
+
 pub(super) fn html_page(p: &PageInput) -> String {
     let e = html_escape;
     let title = format!("Study {} — profile {}", p.study.name, p.profile());
@@ -222,6 +274,18 @@ pub(super) fn html_page(p: &PageInput) -> String {
         body += "<table>\n";
         body += &tr(&head.iter().map(|h| e(h)).collect::<Vec<_>>(), "th");
         for r in rows {
+            body += &tr(&r.iter().map(|c| e(c)).collect::<Vec<_>>(), "td");
+        }
+        body += "</table>\n";
+    }
+    let (bhead, brows) = baseline_table(p);
+    if !brows.is_empty() {
+        body += &format!(
+            "<h2>Classical baselines</h2>\n<p>{}</p>\n<table>\n",
+            e(BASELINE_TEXT)
+        );
+        body += &tr(&bhead.iter().map(|h| e(h)).collect::<Vec<_>>(), "th");
+        for r in brows {
             body += &tr(&r.iter().map(|c| e(c)).collect::<Vec<_>>(), "td");
         }
         body += "</table>\n";

@@ -49,9 +49,14 @@ values = [0.1, 0.2]
 
 /// Run the study in a fresh folder: (folder guard, study folder, stdout).
 fn run_study() -> (tempfile::TempDir, PathBuf, String) {
+    run_sweep(SWEEP)
+}
+
+/// Run the sweep file `text` in a fresh folder, as [`run_study`] does.
+fn run_sweep(text: &str) -> (tempfile::TempDir, PathBuf, String) {
     let dir = tempfile::tempdir().unwrap();
     let sweep = dir.path().join("sweep.toml");
-    std::fs::write(&sweep, SWEEP).unwrap();
+    std::fs::write(&sweep, text).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
         .args(["run", sweep.to_str().unwrap()])
         .current_dir(dir.path())
@@ -221,22 +226,7 @@ fn the_page_lists_each_baselines_de00_to_the_wave_colour() {
         "polar_deg = [0.0]\n[base.appearance]\nbaseline = [\"kubelka-munk\", \"adding-doubling\"]\n",
     );
     assert_ne!(sweep, SWEEP);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("sweep.toml");
-    std::fs::write(&path, &sweep).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
-        .args(["run", path.to_str().unwrap()])
-        .current_dir(dir.path())
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("SLURM_ARRAY_TASK_COUNT")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let study_dir = dir.path().join("out");
+    let (_guard, study_dir, _) = run_sweep(&sweep);
     let md = std::fs::read_to_string(study_dir.join("summary.md")).unwrap();
     let html = std::fs::read_to_string(study_dir.join("summary.html")).unwrap();
     assert!(md.contains("## Classical baselines"), "{md}");

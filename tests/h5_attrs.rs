@@ -8,9 +8,9 @@
 use hdf5::types::{VarLenAscii, VarLenUnicode};
 use hdf5::{Dataset, Group, LinkType, LocationType};
 use std::path::Path;
-use std::process::Command;
 
 mod common;
+use common::cli::inksim_in;
 use common::scene::{PigmentToml, SceneToml};
 use common::study::StudyToml;
 
@@ -213,18 +213,8 @@ fn every_dataset_of_a_study_summary_has_units_a_description_and_axes() {
     let sweep = dir.path().join("sweep.toml");
     std::fs::write(&sweep, study.toml()).unwrap();
     for cmd in ["run", "merge"] {
-        let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
-            .args([cmd, sweep.to_str().unwrap()])
-            .current_dir(dir.path())
-            .env_remove("SLURM_ARRAY_TASK_ID")
-            .env_remove("SLURM_ARRAY_TASK_COUNT")
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{cmd}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let (ok, _, err) = inksim_in(dir.path(), &[cmd, sweep.to_str().unwrap()]);
+        assert!(ok, "{cmd}: {err}");
     }
     let summary = dir.path().join("out/summary.h5");
     let seen = check_file(&summary);

@@ -12,6 +12,9 @@ use inksim::output::h5::read_measured;
 use inksim::output::render::plot::palette;
 use inksim::output::render::Canvas;
 
+mod common;
+use common::cli::inksim_in;
+
 /// Two pigments × two PVCs, two realisations each, 8 × 8 × 4 grids.
 const SWEEP: &str = r#"
 [study]
@@ -57,20 +60,10 @@ fn run_sweep(text: &str) -> (tempfile::TempDir, PathBuf, String) {
     let dir = tempfile::tempdir().unwrap();
     let sweep = dir.path().join("sweep.toml");
     std::fs::write(&sweep, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
-        .args(["run", sweep.to_str().unwrap()])
-        .current_dir(dir.path())
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("SLURM_ARRAY_TASK_COUNT")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (ok, out, err) = inksim_in(dir.path(), &["run", sweep.to_str().unwrap()]);
+    assert!(ok, "{err}");
     let study_dir = dir.path().join("out");
-    (dir, study_dir, String::from_utf8_lossy(&out.stdout).into())
+    (dir, study_dir, out)
 }
 
 /// Every `href="…"` and `src="…"` target of `html`.

@@ -138,7 +138,8 @@ pub fn solve_layer(
                 ))
             };
             let mut ctl = ctl;
-            let (mut spent, mut again) = (solver::SolveRecord::spent(), String::new());
+            // Attempts a tighter solve replaced, and why.
+            let (mut replaced, mut again) = (Vec::new(), String::new());
             let (efficiencies, mut record) = loop {
                 let sol = heartbeat::scope(heartbeat_interval(), &beat, || {
                     solver::solve(&p, scene.solver.method, &ctl)
@@ -164,15 +165,17 @@ pub fn solve_layer(
                     ENERGY_BALANCE_LIMIT,
                     ctl.tolerance
                 ));
-                spent.add(&sol.record);
                 again.push_str(&format!(
                     "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",
                     eff.energy_balance, ctl.tolerance
                 ));
                 ctl.tolerance = tighter;
+                replaced.push(sol.record);
             };
             // The cost of the solve includes the attempts it replaced.
-            record.add(&spent);
+            for r in &replaced {
+                record.add(r);
+            }
             record.note.push_str(&again);
             let entry = SolveEntry {
                 wavelength_nm: lambda,

@@ -87,18 +87,6 @@ pub struct SolveRecord {
 }
 
 impl SolveRecord {
-    /// An empty tally of what solves cost, to [`add`](Self::add) to.
-    pub fn spent() -> SolveRecord {
-        SolveRecord {
-            method: Method::Auto,
-            iterations: 0,
-            operator_applications: 0,
-            residual: 0.0,
-            seconds: 0.0,
-            note: String::new(),
-        }
-    }
-
     /// Count the iterations, applications and seconds of `other` in this
     /// record's (the cost of attempts it replaced).
     pub fn add(&mut self, other: &SolveRecord) {

@@ -138,7 +138,8 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
     }
     let mut rows = Vec::with_capacity(exp.variants.len());
     for v in &exp.variants {
-        let s = h5::read_summary(&run::paths(v).0)?;
+        let path = run::paths(v).0;
+        let s = h5::read_summary(&path)?;
         // Light from above only (solves from below feed the paper term).
         let above: Vec<&h5::EntrySummary> = s
             .entries
@@ -152,9 +153,9 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             mean(|e| e.total_transmittance),
             mean(|e| e.absorption),
         );
-        let measured = measured(&run::paths(v).0)?;
+        let measured = measured(&path)?;
         let baseline = match &measured {
-            Some(m) => h5::read_baseline(&run::paths(v).0)?
+            Some(m) => h5::read_baseline(&path)?
                 .into_iter()
                 .filter(|b| b.geometry == m.record.geometry)
                 .collect(),

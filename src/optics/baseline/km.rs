@@ -101,8 +101,7 @@ pub fn external_reflectance_scalar(binder_index: f64, polar_deg: f64) -> f64 {
     let mu_a = polar_deg.to_radians().cos();
     let n = binder_index;
     let mu = (1.0 - (1.0 - mu_a * mu_a) / (n * n)).max(0.0).sqrt();
-    let r = (mu_a - n * mu) / (mu_a + n * mu);
-    r * r
+    super::adding::fresnel_scalar(n, mu, mu_a)
 }
 
 /// The scalar surface's reflectance for Lambertian light from air,

@@ -33,6 +33,7 @@ fn entries() -> Vec<SolveEntry> {
             wavelength_nm: 450.0,
             side: Side::Above,
             realisation: 0,
+            layer: 0,
             incidence: Incidence {
                 polar_deg: 0.0,
                 azimuth_deg: 0.0,
@@ -63,6 +64,7 @@ fn entries() -> Vec<SolveEntry> {
             wavelength_nm: 632.8,
             side: Side::Above,
             realisation: 0,
+            layer: 0,
             incidence: Incidence {
                 polar_deg: 30.0,
                 azimuth_deg: 45.0,
@@ -89,6 +91,7 @@ fn entries() -> Vec<SolveEntry> {
             wavelength_nm: 700.000_000_000_1,
             side: Side::Below,
             realisation: 1,
+            layer: 0,
             incidence: Incidence {
                 polar_deg: 60.0,
                 azimuth_deg: -90.0,
@@ -170,6 +173,7 @@ fn set<'a>(g: &'a Geo, e: &'a [SolveEntry], hash: &'a str, png: Option<&'a [u8]>
         realisations: &[(7, 0.3)],
         realisation_stop: None,
         appearance: None,
+        stack: None,
         tile_png: None,
     }
 }

@@ -65,6 +65,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
         wavelength_nm: wl,
         side: Side::Above,
         realisation: 0,
+        layer: 0,
         incidence: Incidence {
             polar_deg: polar,
             azimuth_deg: 0.0,

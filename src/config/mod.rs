@@ -13,6 +13,7 @@ pub mod colour;
 pub mod materials;
 mod method;
 mod raw;
+mod stack;
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +21,10 @@ pub use check::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
 pub use colour::{Illuminant, Measurement, StandardObserver};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
+pub use stack::{
+    stack_layer_seed, Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS,
+    DEFAULT_TRAPPED_DIRECTIONS, MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
+};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
 /// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).
@@ -513,6 +518,11 @@ pub struct Scene {
     /// An explicit structure instead of generated grains (then `species` is
     /// empty).
     pub structure: Option<Structure>,
+    /// Layers from the top down instead of one (`[[stack]]`). Then `layer`
+    /// is the whole stack (thicknesses summed, the top layer's fragment),
+    /// `species` every layer's pigments in stack order with their volume
+    /// fractions of the whole, and `grid` the whole stack's.
+    pub stack: Option<Stack>,
 }
 
 impl Scene {

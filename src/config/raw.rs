@@ -15,9 +15,16 @@ use serde::Deserialize;
 pub struct RawConfig {
     pub seed: Option<i64>,
     pub realisations: Option<RawRealisations>,
-    pub layer: RawLayer,
+    /// The layer; absent when `[[stack]]` gives the layers instead.
+    pub layer: Option<RawLayer>,
     #[serde(default)]
     pub pigment: Vec<RawPigment>,
+    /// Layers from the top down, each with its pigments, instead of
+    /// `[layer]` and `[[pigment]]`.
+    #[serde(default)]
+    pub stack: Vec<RawStackLayer>,
+    /// How the layers of a stack are combined.
+    pub stacking: Option<RawStacking>,
     pub grid: RawGrid,
     pub illumination: RawIllumination,
     pub solver: Option<RawSolver>,
@@ -68,6 +75,26 @@ impl<'de> Deserialize<'de> for RawRealisations {
         }
         d.deserialize_any(V)
     }
+}
+
+/// One `[[stack]]` element: a layer as `[layer]` gives it, and its
+/// pigments as `[[pigment]]` does.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStackLayer {
+    pub layer: RawLayer,
+    #[serde(default)]
+    pub pigment: Vec<RawPigment>,
+}
+
+/// `[stacking]`: `coupling = "incoherent" | "coherent"` and the directions
+/// of the adding method.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawStacking {
+    pub coupling: Option<String>,
+    pub trapped_directions: Option<i64>,
+    pub escape_directions: Option<i64>,
 }
 
 /// `[structure]`: the layer given explicitly instead of generated grains.

@@ -30,6 +30,7 @@ pub mod mc;
 mod periodic;
 mod rsa;
 mod shapes;
+mod stacked;
 pub mod stats;
 mod vec3;
 
@@ -40,6 +41,7 @@ pub use shapes::{
     axis_from_uniforms, order_parameter, union_volume, Orientation, Shape, ShapeTemplate,
     SizeDistribution,
 };
+pub use stacked::{stacked, without_grains, StackPart};
 pub use stats::{analyse, Statistics, StatsParams};
 
 use cells::CellList;

@@ -5,10 +5,10 @@
 
 use std::fmt;
 
-use crate::config::{GrainOrientation, GrainShape, GrainSize, Scene};
+use crate::config::{stack_layer_seed, GrainOrientation, GrainShape, GrainSize, Scene};
 use crate::geometry::{
     self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SizeDistribution,
-    SpeciesOptions, SpeciesParams,
+    SpeciesOptions, SpeciesParams, StackPart,
 };
 use crate::raster::Grid;
 
@@ -108,8 +108,34 @@ pub fn build_geometry(scene: &Scene) -> Result<Geometry, PipelineError> {
     build_geometry_seeded(scene, scene.seed)
 }
 
-/// Build the particle set of a scene from a given seed.
+/// Build the particle set of a scene from a given seed. A stack's is its
+/// layers' fragments on top of each other, layer `i` packed from
+/// [`stack_layer_seed`]`(seed, i)` (so an incoherent run of the same stack
+/// solves the same fragments); a layer of dissolved pigments has no grains.
 pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, PipelineError> {
+    if let Some(st) = &scene.stack {
+        let mut layers = Vec::with_capacity(st.layers.len());
+        for i in 0..st.layers.len() {
+            let ls = scene.stack_layer(i).expect("a layer of the stack");
+            let g = if ls.is_molecular() {
+                geometry::without_grains(
+                    fragment_nm(&ls),
+                    ls.species.iter().map(|s| s.volume_fraction).collect(),
+                )
+            } else {
+                build_geometry_seeded(&ls, stack_layer_seed(seed, i))?
+            };
+            layers.push((g, ls.species.len()));
+        }
+        let parts: Vec<StackPart> = layers
+            .iter()
+            .map(|(geometry, species)| StackPart {
+                geometry,
+                species: *species,
+            })
+            .collect();
+        return Ok(geometry::stacked(&parts));
+    }
     let l = &scene.layer;
     let size_nm = fragment_nm(scene);
     let options: Vec<SpeciesOptions> = scene

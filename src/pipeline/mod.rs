@@ -43,6 +43,7 @@ mod plan;
 mod result;
 mod run;
 mod solve;
+mod stack;
 mod surface;
 
 use std::path::{Path, PathBuf};
@@ -61,7 +62,8 @@ pub use baseline::{add_baseline, baseline_input};
 pub use eps::fraction_eps;
 pub use grains::{build_geometry, build_geometry_seeded, grid_of, Packer, RSA_MAX_PVC};
 pub use plan::{plan_text, planned_solves, realisation_seed, RunPlan};
-pub use run::{run, run_geometry, run_with, GeometryReport, RunReport};
+pub use result::RunReport;
+pub use run::{run, run_geometry, run_with, GeometryReport};
 pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps, ENERGY_BALANCE_LIMIT};
 
 /// Sub-samples per voxel edge for partially filled voxels.
@@ -126,6 +128,14 @@ pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
     let p = scene.appearance.products;
     let orders = p.brdf || p.btdf;
     let mut files = vec![h5];
+    // A stack solved layer by layer writes its colours in the result alone.
+    if scene
+        .stack
+        .as_ref()
+        .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent)
+    {
+        return files;
+    }
     if p.tile || orders {
         files.push(png);
     }

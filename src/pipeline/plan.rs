@@ -5,7 +5,10 @@
 //! which appearance products. Every decision is one line of the plan that is
 //! logged and stored with the results.
 
-use crate::config::{GrainShape, Incidence, Scene, Structure, Substrate, Surface};
+use crate::config::{
+    stack_layer_seed, GrainShape, Incidence, Scene, StackCoupling, Structure, Substrate, Surface,
+};
+use crate::optics::baseline::ordinates::{OrdinateParams, Ordinates};
 use crate::optics::effective_medium::{self, GrainClass, WorstError};
 use crate::optics::farfield::table::TableSpec;
 use crate::optics::farfield::{Side, SolveEntry};
@@ -44,11 +47,27 @@ pub struct RunPlan {
     pub table: TableSpec,
     /// One line per decision: what runs, what is skipped, and why.
     pub lines: Vec<String>,
+    /// Solved inside its binder (a layer of an incoherent stack): the
+    /// medium above and below is the binder, not air, so the problem is
+    /// solved at the wavelength in the binder `λ/n_b` with `ε/ε_b`, and the
+    /// orders' angles are angles in the binder.
+    pub embedded: bool,
+    /// The plans of an incoherent stack's layers, from the top (empty for
+    /// one layer, or a stack solved as one fragment); then the fields above
+    /// describe the stack as a whole.
+    pub layers: Vec<RunPlan>,
 }
 
 impl RunPlan {
     /// Derive the plan of a scene.
     pub fn of(scene: &Scene) -> RunPlan {
+        if scene
+            .stack
+            .as_ref()
+            .is_some_and(|s| s.coupling == StackCoupling::Incoherent)
+        {
+            return stack_plan(scene);
+        }
         let explicit = scene.structure.is_some();
         let (above, extra) = above_angles(scene);
         let paper = matches!(scene.substrate, Substrate::Paper { .. });
@@ -56,14 +75,16 @@ impl RunPlan {
         let products = scene.appearance.products;
         let below = ((products.tile || products.preview) && paper)
             .then(|| Hemisphere::new(scene.appearance.quadrature_points));
-        let shortcut = if scene.is_molecular() || explicit {
+        // A stack in one fragment is never one homogeneous slab.
+        let shortcut = if scene.is_molecular() || explicit || scene.stack.is_some() {
             None
         } else {
             let mut angles = above.clone();
             angles.extend(below.iter().flat_map(|h| h.polar_deg()));
             Some(effective_medium_shortcut(scene, &angles))
         };
-        let analytic = scene.is_molecular() || matches!(shortcut, Some(Ok(_)));
+        let analytic =
+            (scene.is_molecular() && scene.stack.is_none()) || matches!(shortcut, Some(Ok(_)));
         let mut lines = layer_lines(scene, shortcut.as_ref());
         if !analytic && !explicit {
             lines.extend(grain_lines(scene));
@@ -85,6 +106,8 @@ impl RunPlan {
             below,
             table,
             lines,
+            embedded: false,
+            layers: Vec::new(),
         }
     }
 
@@ -95,7 +118,13 @@ impl RunPlan {
 
     /// Total solves of a run.
     pub fn solves(&self, scene: &Scene) -> usize {
-        self.realisations * scene.wavelengths_nm.len() * self.solves_per_wavelength()
+        let per_layer = |p: &RunPlan| p.realisations * p.solves_per_wavelength();
+        let per_wavelength = if self.layers.is_empty() {
+            per_layer(self)
+        } else {
+            self.layers.iter().map(per_layer).sum()
+        };
+        scene.wavelengths_nm.len() * per_wavelength
     }
 }
 
@@ -477,7 +506,12 @@ pub fn plan_text(plan: &RunPlan, entries: &[SolveEntry]) -> String {
     }
     for e in entries {
         lines.push(format!(
-            "solve {} nm, {}°/{}° {} #{}: {} ({})",
+            "solve {}{} nm, {}°/{}° {} #{}: {} ({})",
+            if plan.layers.is_empty() {
+                String::new()
+            } else {
+                format!("stack[{}] ", e.layer)
+            },
             e.wavelength_nm,
             e.incidence.polar_deg,
             e.incidence.azimuth_deg,
@@ -488,4 +522,141 @@ pub fn plan_text(plan: &RunPlan, entries: &[SolveEntry]) -> String {
         ));
     }
     lines.join("\n")
+}
+
+/// The adding method's directions for a stack: the stack's binder, its
+/// direction counts, and every air angle a measurement or the white sky
+/// reads among the nodes.
+pub fn stack_ordinates(scene: &Scene) -> Ordinates {
+    let st = scene.stack.as_ref().expect("a stack");
+    let mut air: Vec<f64> = scene
+        .appearance
+        .measurements
+        .iter()
+        .flat_map(|m| m.above_deg().iter().copied())
+        .chain(scene.appearance.viewing_deg.iter().copied())
+        .collect();
+    air.sort_by(f64::total_cmp);
+    air.dedup();
+    let params = OrdinateParams {
+        trapped_nodes: st.trapped_directions,
+        escape_nodes: st.escape_directions,
+    };
+    // The config holds the binder at ≥ 1 and the counts at ≥ 1, polar < 90°.
+    Ordinates::new(scene.layer.binder_index, params, &air)
+        .expect("a checked stack has valid directions")
+}
+
+/// Polar angle in the binder of each node.
+pub(super) fn node_deg(ords: &Ordinates) -> Vec<f64> {
+    ords.mu.iter().map(|m| m.acos().to_degrees()).collect()
+}
+
+/// The plan of an incoherent stack: the stack as a whole, with each
+/// layer's plan in `layers` (layer `i`'s scene is `scene.stack_layer(i)`).
+pub fn stack_plan(scene: &Scene) -> RunPlan {
+    let st = scene.stack.as_ref().expect("a stack");
+    let ords = stack_ordinates(scene);
+    let nodes = node_deg(&ords);
+    let mut scenes = Vec::with_capacity(st.layers.len());
+    let mut plans = Vec::with_capacity(st.layers.len());
+    let mut lines = vec![format!(
+        "stack: {} layer{} from the top ({}), coupled incoherently: each solved on its own \
+         inside the binder (n = {}: at λ/n with ε/n²), from above and from below at {} \
+         directions ({} trapped by the surface, {} escaping; binder polar angles {}), combined \
+         by adding under the flat binder surface on {}",
+        st.layers.len(),
+        if st.layers.len() == 1 { "" } else { "s" },
+        st.layers
+            .iter()
+            .map(|l| format!(
+                "{} nm of {}",
+                l.layer.thickness_nm,
+                l.species
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(" + ")
+            ))
+            .collect::<Vec<_>>()
+            .join(", "),
+        scene.layer.binder_index,
+        ords.len(),
+        ords.mu_air.iter().filter(|m| m.is_none()).count(),
+        ords.mu_air.iter().filter(|m| m.is_some()).count(),
+        nodes
+            .iter()
+            .map(|d| format!("{d:.1}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        match scene.substrate {
+            Substrate::Paper { albedo } => format!("paper of albedo {albedo} in air"),
+            Substrate::None => "air".to_string(),
+        }
+    )];
+    lines.push(
+        "not made for an incoherent stack: the BRDF square, the tile picture and the plots — \
+         the adding carries each layer's azimuthal mean, which gives the measurement \
+         geometries and the white sky exactly, not the BRDF at other azimuths (coupling \
+         \"coherent\" makes them)"
+            .to_string(),
+    );
+    for i in 0..st.layers.len() {
+        let ls = scene.stack_layer(i).expect("a layer of the stack");
+        let mut p = RunPlan::of(&ls);
+        p.above_deg = nodes.clone();
+        p.below = Some(Hemisphere {
+            mu: ords.mu.clone(),
+            weight: ords.weight.clone(),
+        });
+        p.embedded = true;
+        p.seeds = (0..p.realisations)
+            .map(|r| stack_layer_seed(realisation_seed(scene.seed, r), i))
+            .collect();
+        // The layer's own decisions (geometry, realisations); its solves and
+        // products are the stack's, stated here and above.
+        let own = p
+            .lines
+            .iter()
+            .position(|l| l.starts_with("realisations"))
+            .map_or(p.lines.len(), |k| k + 1);
+        lines.extend(p.lines[..own].iter().map(|l| format!("stack[{i}]: {l}")));
+        lines.push(format!(
+            "stack[{i}]: solves from above and from below at the {} directions: {} per \
+             wavelength and realisation{}",
+            nodes.len(),
+            2 * nodes.len(),
+            if p.analytic { ", in closed form" } else { "" }
+        ));
+        scenes.push(ls);
+        plans.push(p);
+    }
+    let realisations = plans.iter().map(|p| p.realisations).max().unwrap_or(1);
+    let cell = scenes
+        .iter()
+        .map(|ls| {
+            TableSpec::default_cell(
+                scene.wavelengths_nm.last().copied().unwrap_or(1.0) / scene.layer.binder_index,
+                [ls.layer.fragment_x_nm, ls.layer.fragment_y_nm],
+            )
+        })
+        .fold(0.0, f64::max);
+    lines.push(format!(
+        "stack tables: each solve's orders spread on a table of cell {cell:.4} in sin θ (binder) \
+         and integrated over each direction's bin"
+    ));
+    let plan = RunPlan {
+        analytic: plans.iter().all(|p| p.analytic),
+        realisations,
+        seeds: (0..realisations)
+            .map(|r| realisation_seed(scene.seed, r))
+            .collect(),
+        above_deg: nodes,
+        below: plans.first().and_then(|p| p.below.clone()),
+        table: TableSpec::new(cell),
+        lines,
+        embedded: true,
+        layers: plans,
+    };
+    plan
 }

@@ -2,17 +2,37 @@
 //! plan, the layer (particles, statistics, fractions, grid), the solves, the
 //! realisations, the pictures and the appearance, handed to the HDF5 writer.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::config::{Scene, Structure};
 use crate::geometry::{self, Geometry, StatsParams};
 use crate::optics::appearance::Appearance;
 use crate::optics::farfield::SolveEntry;
-use crate::output::h5::{self, GeometrySummary, RealisationStop, ResultSet};
+use crate::output::h5::{self, GeometrySummary, RealisationStop, ResultSet, StackTables};
 use crate::raster::Raster;
 
 use super::grains::{fragment_nm, grid_of};
 use super::PipelineError;
+
+/// What a finished run produced.
+pub struct RunReport {
+    pub result_path: PathBuf,
+    /// The tile (or the orders picture when a BRDF or BTDF but no tile was
+    /// asked for); None when `outputs` asks for neither.
+    pub picture_path: Option<PathBuf>,
+    /// Every reflected order of every solve, drawn per wavelength and angle
+    /// (with a BRDF or BTDF output).
+    pub orders_picture_path: Option<PathBuf>,
+    /// The plots, when the run assembled its appearance:
+    /// `<name>-spectra.png` (R, T, A against wavelength),
+    /// `<name>-brdf-plane.png` (the BRDF in the plane of incidence) and
+    /// `<name>-brdf-polar.png` (the BRDF as a polar map).
+    pub plot_paths: Vec<PathBuf>,
+    /// Geometry of realisation 0 (None for a molecular mixture).
+    pub geometry: Option<Geometry>,
+    pub entries: Vec<SolveEntry>,
+    pub appearance: Option<Appearance>,
+}
 
 /// Everything a result file is made from.
 #[derive(Clone, Copy)]
@@ -33,6 +53,8 @@ pub struct ResultParts<'a> {
     pub orders_png: &'a [u8],
     pub tile_png: Option<&'a [u8]>,
     pub appearance: Option<&'a Appearance>,
+    /// A stack solved layer by layer (then `appearance` is None).
+    pub stack: Option<&'a StackTables>,
 }
 
 impl ResultParts<'_> {
@@ -49,6 +71,7 @@ impl ResultParts<'_> {
             orders_png,
             tile_png,
             appearance,
+            stack,
         } = *self;
         let mut centers = Vec::new();
         let mut radii = Vec::new();
@@ -122,11 +145,12 @@ impl ResultParts<'_> {
             grid,
             size_nm: fragment_nm(scene),
             entries,
-            picture_png: Some(orders_png),
+            picture_png: (!orders_png.is_empty()).then_some(orders_png),
             realisations,
             realisation_stop,
             appearance,
             tile_png,
+            stack,
         };
         h5::write_result(path, &set)?;
         Ok(())

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::config::{Scene, Structure};
+use crate::config::{Scene, StackCoupling, Structure};
 use crate::geometry::{self, Geometry, StatsParams};
 use crate::optics::appearance::{self, Appearance};
 use crate::optics::colour::Observer;
@@ -21,28 +21,8 @@ use super::grains::{build_geometry, grid_of, Packer};
 use super::layer;
 use super::memory::{self, MemoryLimit};
 use super::plan::{plan_text, RunPlan};
-use super::result::ResultParts;
+use super::result::{ResultParts, RunReport};
 use super::{check_output_dir, check_output_files, result_paths, PipelineError, SUPERSAMPLE};
-
-/// What a finished run produced.
-pub struct RunReport {
-    pub result_path: PathBuf,
-    /// The tile (or the orders picture when a BRDF or BTDF but no tile was
-    /// asked for); None when `outputs` asks for neither.
-    pub picture_path: Option<PathBuf>,
-    /// Every reflected order of every solve, drawn per wavelength and angle
-    /// (with a BRDF or BTDF output).
-    pub orders_picture_path: Option<PathBuf>,
-    /// The plots, when the run assembled its appearance:
-    /// `<name>-spectra.png` (R, T, A against wavelength),
-    /// `<name>-brdf-plane.png` (the BRDF in the plane of incidence) and
-    /// `<name>-brdf-polar.png` (the BRDF as a polar map).
-    pub plot_paths: Vec<PathBuf>,
-    /// Geometry of realisation 0 (None for a molecular mixture).
-    pub geometry: Option<Geometry>,
-    pub entries: Vec<SolveEntry>,
-    pub appearance: Option<Appearance>,
-}
 
 /// Run a scene end to end and write its result files, with a progress bar
 /// (terminal) or log lines, held to the machine's available memory.
@@ -59,6 +39,13 @@ pub fn run_with(
     quiet: bool,
     limit: Option<MemoryLimit>,
 ) -> Result<RunReport, PipelineError> {
+    if scene
+        .stack
+        .as_ref()
+        .is_some_and(|s| s.coupling == StackCoupling::Incoherent)
+    {
+        return super::stack::run(scene, quiet, limit);
+    }
     let (result_path, picture_path) = result_paths(scene);
     let orders_path = scene
         .output
@@ -128,6 +115,7 @@ pub fn run_with(
         orders_png: &pictures.orders_png,
         tile_png: pictures.tile_png.as_deref(),
         appearance: pictures.appearance.as_ref(),
+        stack: None,
     }
     .write(&result_path)?;
     Ok(RunReport {
@@ -370,6 +358,7 @@ fn write_geometry_only(
         orders_png: &png,
         tile_png: None,
         appearance: None,
+        stack: None,
     }
     .write(result_path)
 }

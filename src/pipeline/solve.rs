@@ -82,6 +82,8 @@ pub fn solve_layer(
         LayerEps::Grid(_, g) => g,
     };
     let eps_b = scene.layer.binder_index.powi(2);
+    // Inside the binder: λ/n_b and ε/ε_b (RunPlan::embedded).
+    let outside = if plan.embedded { eps_b } else { 1.0 };
     let ctl = controls(scene);
     let incs = incidences(scene, plan);
     let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
@@ -98,6 +100,10 @@ pub fn solve_layer(
             }
             LayerEps::Grid(grid_eps, _) => grid_eps.epsilon_into(lambda, &mut eps),
         }
+        if plan.embedded {
+            eps.mapv_inplace(|e| e / outside);
+        }
+        let lambda_solved = lambda / outside.sqrt();
         if let Some(f) = flipped.as_mut() {
             f.assign(&eps.slice(s![..;-1, .., ..]));
         }
@@ -105,7 +111,7 @@ pub fn solve_layer(
             let lattice = Problem::lattice(
                 [g.nx, g.ny, g.nz],
                 g.size_nm,
-                lambda,
+                lambda_solved,
                 inc.polar_deg,
                 inc.azimuth_deg,
             );
@@ -116,7 +122,7 @@ pub fn solve_layer(
             let p = Problem {
                 lattice,
                 eps: grid_eps,
-                eps_binder: eps_b,
+                eps_binder: eps_b / outside,
             };
             // A long solve reports where it stands (solver::heartbeat).
             let beat = |b: Beat| {
@@ -182,6 +188,7 @@ pub fn solve_layer(
                 incidence: *inc,
                 side: *side,
                 realisation,
+                layer: 0,
                 efficiencies,
                 record,
             };
@@ -223,6 +230,8 @@ pub fn solve_analytic(
     let incs = incidences(scene, plan);
     let ctl = controls(scene);
     let eps_b = scene.layer.binder_index.powi(2);
+    // Inside the binder: λ/n_b and ε/ε_b (RunPlan::embedded).
+    let outside = if plan.embedded { eps_b } else { 1.0 };
     let why = if scene.is_molecular() {
         "molecular mixture"
     } else {
@@ -230,16 +239,17 @@ pub fn solve_analytic(
     };
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
-        let mean = Array3::from_elem((1, 1, 1), mean_eps(scene, lambda)?);
+        let mean = Array3::from_elem((1, 1, 1), mean_eps(scene, lambda)? / outside);
         for (side, inc) in &incs {
             // A homogeneous slab is symmetric (from below = from above) and
             // the same at every azimuth: one cell, lit at azimuth 0.
             let size = [1.0, 1.0, scene.layer.thickness_nm];
-            let lattice = Problem::lattice([1, 1, 1], size, lambda, inc.polar_deg, 0.0);
+            let lattice =
+                Problem::lattice([1, 1, 1], size, lambda / outside.sqrt(), inc.polar_deg, 0.0);
             let p = Problem {
                 lattice,
                 eps: &mean,
-                eps_binder: eps_b,
+                eps_binder: eps_b / outside,
             };
             let mut sol =
                 solver::solve(&p, Method::Airy, &ctl).map_err(|source| PipelineError::Solve {
@@ -253,6 +263,7 @@ pub fn solve_analytic(
                 incidence: *inc,
                 side: *side,
                 realisation: 0,
+                layer: 0,
                 efficiencies: farfield::slab_efficiencies(&sol.slab_response(), inc),
                 record: sol.record,
             };

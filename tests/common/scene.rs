@@ -290,6 +290,28 @@ impl SceneToml {
     pub fn run(&self, dir: &Path) -> RunReport {
         pipeline::run(&self.scene(dir)).unwrap()
     }
+
+    /// This scene with `layers` (each one's `[layer]` and `[[pigment]]`),
+    /// top first, as its `[[stack]]` instead of its own layer, coupled
+    /// `coupling` (`"incoherent"` or `"coherent"`).
+    pub fn stack_of(mut self, layers: &[SceneToml], coupling: &str) -> Self {
+        let stack: Vec<Value> = layers
+            .iter()
+            .map(|l| {
+                let mut t = Table::new();
+                for key in ["layer", "pigment"] {
+                    if let Some(v) = l.0.get(key) {
+                        t.insert(key.to_string(), v.clone());
+                    }
+                }
+                Value::Table(t)
+            })
+            .collect();
+        self.0.remove("layer");
+        self.0.remove("pigment");
+        self.0.insert("stack".to_string(), Value::Array(stack));
+        self.raw("stacking", &format!("{{ coupling = \"{coupling}\" }}"))
+    }
 }
 
 impl PigmentToml {
@@ -298,6 +320,13 @@ impl PigmentToml {
         Self(Table::new())
             .set("name", name)
             .raw("material", &format!("{{ builtin = \"{name}\" }}"))
+    }
+
+    /// A pigment of constant index `n + ik` at every wavelength.
+    pub fn index(name: &str, n: f64, k: f64) -> Self {
+        Self(Table::new())
+            .set("name", name)
+            .raw("material", &format!("{{ index = [{n}, {k}] }}"))
     }
 
     /// A pigment from a CSV table of n, k.

@@ -46,6 +46,7 @@ mod material;
 mod pigments;
 mod scene;
 mod solver;
+mod stack;
 mod structure;
 
 use super::raw::RawConfig;
@@ -75,7 +76,11 @@ pub fn parse_scene(path: &Path, text: &str) -> Result<Scene, ConfigError> {
         file: path.to_path_buf(),
         message: parse_message(text, &e),
     })?;
-    Checker { file: path }.scene(path, text, raw)
+    Checker {
+        file: path,
+        prefix: String::new(),
+    }
+    .scene(path, text, raw)
 }
 
 /// The toml error on one line: `line L, column C: message; more`.
@@ -212,13 +217,15 @@ pub(crate) fn num(v: f64) -> String {
 /// Checks the parts of one file's raw scene; every error names `file`.
 struct Checker<'a> {
     file: &'a Path,
+    /// Put before every key an error names (`stack[1].` inside a stack).
+    prefix: String,
 }
 
 impl Checker<'_> {
     fn invalid(&self, key: impl Into<String>, message: impl Into<String>) -> ConfigError {
         ConfigError::Invalid {
             file: self.file.to_path_buf(),
-            key: key.into(),
+            key: format!("{}{}", self.prefix, key.into()),
             message: message.into(),
         }
     }

@@ -42,23 +42,42 @@ impl Checker<'_> {
             Some(s) => return Err(self.invalid("seed", format!("must be >= 0, got {s}"))),
         };
         let (realisations, realisation_target) = self.realisations(raw.realisations.as_ref())?;
-        let layer = self.layer(&raw.layer)?;
-        let structure = match &raw.structure {
-            None => None,
-            Some(st) => Some(self.structure(st, &layer)?),
-        };
-        let species = if structure.is_some() {
-            if !raw.pigment.is_empty() || raw.layer.pvc.is_some() {
-                return Err(self.invalid(
-                    "structure",
-                    "an explicit structure replaces the generated grains: remove [[pigment]] and layer.pvc",
-                ));
+        let (layer, structure, species, grid, stack) = match &raw.layer {
+            _ if !raw.stack.is_empty() => {
+                let s = self.stack(&raw)?;
+                (s.layer, None, s.species, s.grid, Some(s.stack))
             }
-            Vec::new()
-        } else {
-            self.pigments(&raw.pigment, &layer, raw.layer.pvc)?
+            None => return Err(self.invalid(
+                "layer",
+                "missing: give [layer] (one layer) or [[stack]] tables (layers from the top down)",
+            )),
+            Some(raw_layer) => {
+                if raw.stacking.is_some() {
+                    return Err(self.invalid(
+                        "stacking",
+                        "goes with [[stack]]: a single [layer] has nothing to stack",
+                    ));
+                }
+                let layer = self.layer(raw_layer)?;
+                let structure = match &raw.structure {
+                    None => None,
+                    Some(st) => Some(self.structure(st, &layer)?),
+                };
+                let species = if structure.is_some() {
+                    if !raw.pigment.is_empty() || raw_layer.pvc.is_some() {
+                        return Err(self.invalid(
+                            "structure",
+                            "an explicit structure replaces the generated grains: remove [[pigment]] and layer.pvc",
+                        ));
+                    }
+                    Vec::new()
+                } else {
+                    self.pigments(&raw.pigment, &layer, raw_layer.pvc)?
+                };
+                let grid = self.grid(&raw.grid, &layer)?;
+                (layer, structure, species, grid, None)
+            }
         };
-        let grid = self.grid(&raw.grid, &layer)?;
         let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
         let incidence = self.incidence(&raw.illumination)?;
         let solver = self.solver(raw.solver.as_ref())?;
@@ -71,6 +90,9 @@ impl Checker<'_> {
             ));
         }
         let substrate = self.substrate(raw.substrate.as_ref())?;
+        if let Some(st) = &stack {
+            self.stack_products(st, &appearance, realisation_target.is_some())?;
+        }
         if !appearance.baseline.is_empty() {
             let why = if structure.is_some() {
                 Some("the baseline is computed from the pigments' grains: an explicit structure has none")
@@ -157,6 +179,7 @@ impl Checker<'_> {
             appearance,
             substrate,
             structure,
+            stack,
         })
     }
 

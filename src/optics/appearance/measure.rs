@@ -152,53 +152,78 @@ pub(super) fn measure(
             (Some(p), Some(pp)) => Some((p, proxy_factor(m, p, pp.albedo, spec))),
             _ => None,
         };
-        let spectrum_of = |values: &Array1<f64>| -> (Vec<f64>, Vec<f64>) {
-            match &proxy {
-                Some((p, fine)) => (
-                    p.wavelengths_nm.clone(),
-                    through_proxy(wl, values.as_slice().unwrap(), &p.wavelengths_nm, fine),
-                ),
-                None => (wl.clone(), values.to_vec()),
-            }
-        };
-        let lab_of = |values: &Array1<f64>| -> Result<([f64; 3], [f64; 3]), AppearanceError> {
-            let (w, s) = spectrum_of(values);
-            let xyz = colour::xyz_from_reflectance(observer, &w, &s)?;
-            Ok((xyz, colour::xyz_to_lab(xyz, observer.white_xyz())))
-        };
-        let mut reflectance = reduce(&samples);
-        if spec.deterministic && reflectance.se.is_none() {
-            reflectance.se = Some(Array1::zeros(reflectance.mean.len()));
-        }
-        let (spectrum_wavelengths_nm, spectrum) = spectrum_of(&reflectance.mean);
-        let (xyz, lab) = lab_of(&reflectance.mean)?;
-        let (mut lab_se, mut de00_se) = (None, None);
-        if rr >= 2 {
-            let labs: Vec<[f64; 3]> = samples
-                .iter()
-                .map(|s| lab_of(s).map(|x| x.1))
-                .collect::<Result<_, _>>()?;
-            let as_arrays: Vec<Array1<f64>> =
-                labs.iter().map(|l| Array1::from(l.to_vec())).collect();
-            let se = reduce(&as_arrays).se.expect("two or more realisations");
-            lab_se = Some([se[0], se[1], se[2]]);
-            de00_se = Some(de00_standard_error(&labs, lab));
-        } else if spec.deterministic {
-            // Nothing random in the layer: every realisation is this one.
-            lab_se = Some([0.0; 3]);
-            de00_se = Some(0.0);
-        }
-        out.push(MeasuredColour {
-            geometry: m,
-            reflectance,
-            spectrum_wavelengths_nm,
-            spectrum,
-            xyz,
-            lab,
-            lch: colour::lab_to_lch(lab),
-            lab_se,
-            de00_se,
-        });
+        let proxy = proxy
+            .as_ref()
+            .map(|(p, fine)| (&p.wavelengths_nm[..], &fine[..]));
+        out.push(colour_of_samples(
+            m,
+            wl,
+            &samples,
+            proxy,
+            spec.deterministic,
+            observer,
+        )?);
     }
     Ok(out)
+}
+
+/// The colour in geometry `m` of per-realisation reflectance factors
+/// `samples` at the solved wavelengths `wl`: the mean's spectrum (through
+/// the spectral proxy `(fine grid, proxy factor on it)` where there is one),
+/// XYZ, CIELAB and LCh, and with two or more realisations the standard
+/// errors of L*, a*, b* and of ΔE00 (exactly 0 for a `deterministic` layer).
+pub fn colour_of_samples(
+    m: Measurement,
+    wl: &[f64],
+    samples: &[Array1<f64>],
+    proxy: Option<(&[f64], &[f64])>,
+    deterministic: bool,
+    observer: &Observer,
+) -> Result<MeasuredColour, AppearanceError> {
+    let spectrum_of = |values: &Array1<f64>| -> (Vec<f64>, Vec<f64>) {
+        match proxy {
+            Some((fine_wl, fine)) => (
+                fine_wl.to_vec(),
+                through_proxy(wl, values.as_slice().unwrap(), fine_wl, fine),
+            ),
+            None => (wl.to_vec(), values.to_vec()),
+        }
+    };
+    let lab_of = |values: &Array1<f64>| -> Result<([f64; 3], [f64; 3]), AppearanceError> {
+        let (w, s) = spectrum_of(values);
+        let xyz = colour::xyz_from_reflectance(observer, &w, &s)?;
+        Ok((xyz, colour::xyz_to_lab(xyz, observer.white_xyz())))
+    };
+    let mut reflectance = reduce(samples);
+    if deterministic && reflectance.se.is_none() {
+        reflectance.se = Some(Array1::zeros(reflectance.mean.len()));
+    }
+    let (spectrum_wavelengths_nm, spectrum) = spectrum_of(&reflectance.mean);
+    let (xyz, lab) = lab_of(&reflectance.mean)?;
+    let (mut lab_se, mut de00_se) = (None, None);
+    if samples.len() >= 2 {
+        let labs: Vec<[f64; 3]> = samples
+            .iter()
+            .map(|s| lab_of(s).map(|x| x.1))
+            .collect::<Result<_, _>>()?;
+        let as_arrays: Vec<Array1<f64>> = labs.iter().map(|l| Array1::from(l.to_vec())).collect();
+        let se = reduce(&as_arrays).se.expect("two or more realisations");
+        lab_se = Some([se[0], se[1], se[2]]);
+        de00_se = Some(de00_standard_error(&labs, lab));
+    } else if deterministic {
+        // Nothing random in the layer: every realisation is this one.
+        lab_se = Some([0.0; 3]);
+        de00_se = Some(0.0);
+    }
+    Ok(MeasuredColour {
+        geometry: m,
+        reflectance,
+        spectrum_wavelengths_nm,
+        spectrum,
+        xyz,
+        lab,
+        lch: colour::lab_to_lch(lab),
+        lab_se,
+        de00_se,
+    })
 }

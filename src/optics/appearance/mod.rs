@@ -28,7 +28,7 @@ mod measure;
 mod proxy;
 
 pub use colours::{ColourSpread, Colours};
-pub use measure::{MeasuredColour, Measurement};
+pub use measure::{colour_of_samples, MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
 use crate::optics::baseline::BaselineColour;
@@ -144,7 +144,7 @@ pub enum AppearanceError {
 }
 
 /// Mean and standard error along the first axis of `samples`.
-pub(super) fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
+pub fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
     let n = samples.len() as f64;
     let mut mean = samples[0].clone();
     for s in &samples[1..] {

@@ -81,6 +81,8 @@ pub struct SolveEntry {
     pub side: Side,
     /// Index of the random fragment (0-based).
     pub realisation: usize,
+    /// Index of the layer in a stack from the top (0 for a single layer).
+    pub layer: usize,
     pub efficiencies: Efficiencies,
     pub record: SolveRecord,
 }

@@ -10,7 +10,7 @@ use crate::config::Baseline;
 use crate::optics::appearance::{Appearance, Colours, Estimate, MeasuredColour};
 use crate::optics::baseline::BaselineColour;
 
-fn write_estimate<D: ndarray::Dimension>(
+pub(super) fn write_estimate<D: ndarray::Dimension>(
     s: &Scales,
     g: &hdf5::Group,
     name: &str,
@@ -321,7 +321,11 @@ fn write_colours(s: &Scales, g: &hdf5::Group, c: &Colours) -> hdf5::Result<()> {
 }
 
 /// `/appearance/measured/<slug>`: one measurement geometry's colour.
-fn write_measured(s: &mut Scales, parent: &hdf5::Group, m: &MeasuredColour) -> hdf5::Result<()> {
+pub(super) fn write_measured(
+    s: &mut Scales,
+    parent: &hdf5::Group,
+    m: &MeasuredColour,
+) -> hdf5::Result<()> {
     let g = parent.create_group(m.geometry.slug())?;
     write_str_attr(&g, "geometry", m.geometry.name())?;
     let description = "reflectance factor in this geometry at the solved wavelengths; wavelength";

@@ -14,6 +14,7 @@ use super::appearance::write_appearance;
 use super::attrs::{vlu, write_scalar_attr, write_str_attr};
 use super::described::{about, dim, Scales};
 use super::geometry::{write_geometry, GeometrySummary};
+use super::stack::{write_stack, StackTables};
 use super::{IoError, FORMAT_VERSION};
 use crate::optics::appearance::Appearance;
 use crate::optics::farfield::{Side, SolveEntry};
@@ -45,6 +46,9 @@ pub struct ResultSet<'a> {
     pub appearance: Option<&'a Appearance>,
     /// The tile PNG (stored in `/appearance`).
     pub tile_png: Option<&'a [u8]>,
+    /// A stack solved layer by layer: `/stack` and its colours in
+    /// `/appearance` (then `appearance` is None).
+    pub stack: Option<&'a StackTables>,
 }
 
 /// A run with `realisations = { target_de00, … }`: the target, the standard
@@ -93,6 +97,7 @@ struct SummaryRow {
     /// lit from the paper's side, for the paper term).
     side: u8,
     realisation: u64,
+    layer: u64,
 }
 
 /// The sign convention of the order indices, stored with `orders_mn`.
@@ -104,7 +109,7 @@ pub const ORDER_CONVENTION: &str =
 
 /// Units and meaning of each `/summary` field, stored as attributes
 /// `<field>_units` and `<field>_description` on the dataset.
-const SUMMARY_FIELDS: [(&str, &str, &str); 11] = [
+const SUMMARY_FIELDS: [(&str, &str, &str); 12] = [
     ("wavelength_nm", "nm", "vacuum wavelength"),
     ("polar_deg", "deg", "polar angle of incidence"),
     ("azimuth_deg", "deg", "azimuth of incidence"),
@@ -121,6 +126,12 @@ const SUMMARY_FIELDS: [(&str, &str, &str); 11] = [
          flipped and lit from the paper's side, used for the paper term)",
     ),
     ("realisation", "1", "index of the random fragment (0-based)"),
+    (
+        "layer",
+        "1",
+        "index of the layer in a stack solved layer by layer, from the top (0-based; 0 for one \
+         layer)",
+    ),
 ];
 
 /// Refuse inconsistent input before any file is touched.
@@ -273,6 +284,7 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
                 Side::Below => 1,
             },
             realisation: e.realisation as u64,
+            layer: e.layer as u64,
         });
     }
     let description = "one row per solve, in solve order; select side == 0 for what a viewer \
@@ -300,6 +312,8 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     }
     if let Some(app) = set.appearance {
         write_appearance(file, app, set.tile_png, s)?;
+    } else if let Some(st) = set.stack {
+        write_stack(file, st, s)?;
     }
     file.flush()
 }

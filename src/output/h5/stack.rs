@@ -1,0 +1,206 @@
+//! `/stack` and the colours of a stack solved layer by layer: the adding
+//! method's directions, each layer's flux matrices (ensemble means), the
+//! whole stack's reflectance, transmittance and absorption in air, and in
+//! `/appearance` the white sky and the measured colours as a single layer
+//! stores them (docs/FORMAT.md).
+
+use ndarray::{Array3, Ix2};
+
+use super::appearance::{write_estimate, write_measured};
+use super::attrs::{write_scalar_attr, write_str_attr};
+use super::described::{about, dim, Scales};
+use crate::optics::appearance::{Estimate, MeasuredColour};
+use crate::optics::colour::{Illuminant, StandardObserver};
+
+/// Dimension names of the stack's tables.
+const NODE: &str = "node";
+const NODE_IN: &str = "node_in";
+const LAYER: &str = "layer";
+
+/// One layer's flux matrices, ensemble means, (wavelength, out, in).
+#[derive(Debug, Clone)]
+pub struct LayerMatrices {
+    pub r_down: Array3<f64>,
+    pub t_down: Array3<f64>,
+    pub r_up: Array3<f64>,
+    pub t_up: Array3<f64>,
+}
+
+/// What a stack solved layer by layer stores besides the solves.
+#[derive(Debug, Clone)]
+pub struct StackTables {
+    pub coupling: String,
+    pub layer_thickness_nm: Vec<f64>,
+    /// The pigments of each layer, comma-separated.
+    pub layer_pigments: Vec<String>,
+    /// The directions: polar angle in the binder, in air (NaN where trapped),
+    /// flux weight.
+    pub binder_polar_deg: Vec<f64>,
+    pub air_polar_deg: Vec<f64>,
+    pub flux_weight: Vec<f64>,
+    pub wavelengths_nm: Vec<f64>,
+    pub layers: Vec<LayerMatrices>,
+    pub realisations: usize,
+    /// Air angles of the whole stack's R, T, A.
+    pub above_deg: Vec<f64>,
+    /// The stack in air without paper, (wavelength, above).
+    pub reflectance: Estimate<Ix2>,
+    pub transmittance: Estimate<Ix2>,
+    pub absorption: Estimate<Ix2>,
+    pub viewing_deg: Vec<f64>,
+    /// Radiance factor under a white sky, on the paper, (wavelength, viewing).
+    pub natural: Estimate<Ix2>,
+    pub measured: Vec<MeasuredColour>,
+    pub conditions: (Illuminant, StandardObserver),
+}
+
+pub(super) fn write_stack(file: &hdf5::File, t: &StackTables, s: &mut Scales) -> hdf5::Result<()> {
+    let g = file.create_group("stack")?;
+    write_str_attr(&g, "coupling", &t.coupling)?;
+    write_scalar_attr(&g, "realisations", t.realisations as u64)?;
+    s.coordinate(
+        &g,
+        "layer_thickness_nm",
+        &t.layer_thickness_nm,
+        about(
+            "nm",
+            "thickness of each layer, from the top; layer",
+            &[LAYER],
+        ),
+    )?;
+    let names: Vec<hdf5::types::VarLenUnicode> = t
+        .layer_pigments
+        .iter()
+        .map(|n| n.parse().unwrap_or_default())
+        .collect();
+    s.write(
+        &g,
+        "layer_pigments",
+        &names[..],
+        about("", "the pigments of each layer (text); layer", &[LAYER]),
+    )?;
+    s.coordinate(
+        &g,
+        "binder_polar_deg",
+        &t.binder_polar_deg,
+        about(
+            "deg",
+            "polar angle in the binder of each direction of the adding method (ascending \
+             cos θ); node",
+            &[NODE],
+        ),
+    )?;
+    s.write(
+        &g,
+        "air_polar_deg",
+        &t.air_polar_deg[..],
+        about(
+            "deg",
+            "the same direction in air after refraction at the flat surface (NaN: trapped by \
+             total internal reflection); node",
+            &[NODE],
+        ),
+    )?;
+    s.write(
+        &g,
+        "flux_weight",
+        &t.flux_weight[..],
+        about(
+            "1",
+            "share of a Lambertian radiance's flux in each direction's bin (sum 1); node",
+            &[NODE],
+        ),
+    )?;
+    s.coordinate(
+        &g,
+        "wavelengths_nm",
+        &t.wavelengths_nm,
+        about(
+            "nm",
+            "vacuum wavelengths solved; wavelength",
+            &[dim::WAVELENGTH],
+        ),
+    )?;
+    for (i, l) in t.layers.iter().enumerate() {
+        let lg = g.create_group(&format!("layer{i}"))?;
+        for (name, m, what) in [
+            ("r_down", &l.r_down, "reflection of light from above"),
+            ("t_down", &l.t_down, "transmission of light from above"),
+            ("r_up", &l.r_up, "reflection of light from below"),
+            ("t_up", &l.t_up, "transmission of light from below"),
+        ] {
+            let description = format!(
+                "{what}, inside the binder: flux into each direction (row) per unit flux \
+                 arriving in each direction (column), azimuthal mean, ensemble mean; \
+                 wavelength × node × node_in"
+            );
+            s.write(
+                &lg,
+                name,
+                m.view(),
+                about("1", &description, &[dim::WAVELENGTH, NODE, NODE_IN]),
+            )?;
+        }
+    }
+    s.coordinate(
+        &g,
+        "above_deg",
+        &t.above_deg,
+        about(
+            "deg",
+            "air polar angles of incidence from above; above",
+            &[dim::ABOVE],
+        ),
+    )?;
+    for (name, e, what) in [
+        ("reflectance", &t.reflectance, "total reflectance"),
+        (
+            "transmittance",
+            &t.transmittance,
+            "total transmittance into the air below",
+        ),
+        ("absorption", &t.absorption, "absorbed fraction"),
+    ] {
+        let description =
+            format!("{what} of the stack in air, without paper, ensemble mean; wavelength × above");
+        write_estimate(
+            s,
+            &g,
+            name,
+            e,
+            about("1", &description, &[dim::WAVELENGTH, dim::ABOVE]),
+        )?;
+    }
+
+    let a = file.create_group("appearance")?;
+    let (ill, obs) = t.conditions;
+    write_str_attr(&a, "illuminant", ill.name())?;
+    write_str_attr(&a, "observer", obs.name())?;
+    write_scalar_attr(&a, "observer_deg", obs.degrees())?;
+    write_scalar_attr(&a, "realisations", t.realisations as u64)?;
+    s.coordinate(
+        &a,
+        "viewing_deg",
+        &t.viewing_deg,
+        about("deg", "viewing polar angles; viewing", &[dim::VIEWING]),
+    )?;
+    write_estimate(
+        s,
+        &a,
+        "natural",
+        &t.natural,
+        about(
+            "1",
+            "radiance factor of the stack on its substrate under a uniform white sky, \
+             specular included; wavelength × viewing",
+            &[dim::WAVELENGTH, dim::VIEWING],
+        ),
+    )?;
+    if !t.measured.is_empty() {
+        let mg = a.create_group("measured")?;
+        for m in &t.measured {
+            write_measured(s, &mg, m)?;
+        }
+    }
+    Ok(())
+}

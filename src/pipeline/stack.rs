@@ -1,0 +1,359 @@
+//! A stack solved layer by layer (`stacking.coupling = "incoherent"`):
+//! each layer made and solved on its own, inside its binder, from above and
+//! from below at the directions of the adding method; per realisation and
+//! wavelength the layers' flux matrices combined by adding under the flat
+//! binder surface on the paper (`optics::stack`); colours through the
+//! spectral proxy of the stack of homogeneous slabs. A stack solved as one
+//! fragment (`coherent`) is an ordinary run whose geometry is the layers'
+//! fragments on top of each other (`grains::build_geometry_seeded`).
+
+use ndarray::{Array1, Array2, Array3};
+use num_complex::Complex64 as C64;
+
+use crate::config::{Scene, Substrate};
+use crate::geometry::{self, Geometry, StackPart};
+use crate::optics::appearance::{self, AppearanceError, MeasuredColour};
+use crate::optics::baseline::adding::Slab;
+use crate::optics::baseline::matrix::Matrix;
+use crate::optics::baseline::ordinates::Ordinates;
+use crate::optics::colour::Observer;
+use crate::optics::farfield::{Side, SolveEntry};
+use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab};
+use crate::output::h5::{LayerMatrices, StackTables};
+use crate::output::progress::Progress;
+use crate::solver::airy;
+
+use super::appearance::fine_grid;
+use super::eps::mean_eps;
+use super::grains::fragment_nm;
+use super::layer::{self, SolvedLayer};
+use super::memory::{self, MemoryLimit};
+use super::plan::{node_deg, plan_text, stack_ordinates, stack_plan, RunPlan};
+use super::result::{ResultParts, RunReport};
+use super::{check_output_dir, check_output_files, result_paths, PipelineError};
+
+/// The air angles the stack's R, T, A and the white sky are reported at.
+fn air_angles(ords: &Ordinates) -> Vec<f64> {
+    let mut v: Vec<f64> = ords
+        .mu_air
+        .iter()
+        .flatten()
+        .map(|m| m.clamp(-1.0, 1.0).acos().to_degrees())
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v
+}
+
+/// Run an incoherent stack end to end and write its result file.
+pub fn run(
+    scene: &Scene,
+    quiet: bool,
+    limit: Option<MemoryLimit>,
+) -> Result<RunReport, PipelineError> {
+    let (result_path, _) = result_paths(scene);
+    check_output_files(scene)?;
+    check_output_dir(&scene.output.dir)?;
+    let mut plan = stack_plan(scene);
+    let scenes: Vec<Scene> = (0..plan.layers.len())
+        .map(|i| scene.stack_layer(i).expect("a layer of the stack"))
+        .collect();
+    for ls in &scenes {
+        memory::preflight(ls, limit)?;
+    }
+    super::disk::preflight(
+        &scene.output.dir,
+        scenes
+            .iter()
+            .zip(&plan.layers)
+            .map(|(ls, p)| super::disk::estimate_bytes(ls, p))
+            .sum(),
+    )?;
+    let total = plan.solves(scene) as u64;
+    let progress = if quiet {
+        Progress::hidden(total, &scene.output.name)
+    } else {
+        Progress::new(total, &scene.output.name)
+    };
+    for l in &plan.lines {
+        progress.log(l);
+    }
+    let mut solved: Vec<SolvedLayer> = Vec::with_capacity(scenes.len());
+    let mut entries = Vec::new();
+    for (i, (ls, p)) in scenes.iter().zip(&plan.layers).enumerate() {
+        progress.log(&format!("stack[{i}]: solving"));
+        let mut s = layer::solve(ls, p, &progress)?;
+        for e in &mut s.entries {
+            e.layer = i;
+        }
+        entries.extend(s.entries.iter().cloned());
+        solved.push(s);
+    }
+    progress.finish("all solves done");
+    let tables = combine(scene, &plan, &scenes, &solved)?;
+    let geometry = stacked_geometry(&scenes, &solved);
+    let thickness = scene.layer.thickness_nm;
+    let realisations: Vec<(u64, f64)> = (0..plan.realisations)
+        .map(|r| {
+            let pvc = scenes
+                .iter()
+                .zip(&solved)
+                .map(|(ls, s)| {
+                    let n = s.realisations.len().max(1);
+                    s.realisations.get(r % n).map_or(0.0, |x| x.1) * ls.layer.thickness_nm
+                        / thickness
+                })
+                .sum();
+            (plan.seeds[r], pvc)
+        })
+        .collect();
+    plan.lines.push(format!(
+        "stack colours: {} realisation{} of the whole stack (realisation r of every layer)",
+        plan.realisations,
+        if plan.realisations == 1 { "" } else { "s" }
+    ));
+    ResultParts {
+        scene,
+        geometry: Some(&geometry),
+        raster: None,
+        entries: &entries,
+        realisations: &realisations,
+        realisation_stop: None,
+        plan: &plan_text(&plan, &entries),
+        orders_png: &[],
+        tile_png: None,
+        appearance: None,
+        stack: Some(&tables),
+    }
+    .write(&result_path)?;
+    Ok(RunReport {
+        result_path,
+        picture_path: None,
+        orders_picture_path: None,
+        plot_paths: Vec::new(),
+        geometry: Some(geometry),
+        entries,
+        appearance: None,
+    })
+}
+
+/// Realisation 0 of every layer as one fragment.
+fn stacked_geometry(scenes: &[Scene], solved: &[SolvedLayer]) -> Geometry {
+    let own: Vec<Geometry> = scenes
+        .iter()
+        .zip(solved)
+        .map(|(ls, s)| {
+            s.geometry.clone().unwrap_or_else(|| {
+                geometry::without_grains(
+                    fragment_nm(ls),
+                    ls.species.iter().map(|x| x.volume_fraction).collect(),
+                )
+            })
+        })
+        .collect();
+    let parts: Vec<StackPart> = own
+        .iter()
+        .zip(scenes)
+        .map(|(geometry, ls)| StackPart {
+            geometry,
+            species: ls.species.len(),
+        })
+        .collect();
+    geometry::stacked(&parts)
+}
+
+/// The solves of the layers combined: per realisation and wavelength the
+/// stack's reflection, its measured colours, white sky and R, T, A.
+fn combine(
+    scene: &Scene,
+    plan: &RunPlan,
+    scenes: &[Scene],
+    solved: &[SolvedLayer],
+) -> Result<StackTables, PipelineError> {
+    let ords = stack_ordinates(scene);
+    let nodes = node_deg(&ords);
+    let k = ords.len();
+    let q = BinQuadrature::new(&ords, plan.table);
+    let below = match scene.substrate {
+        Substrate::Paper { albedo } => Below::Paper { albedo },
+        Substrate::None => Below::Air,
+    };
+    let wl = &scene.wavelengths_nm;
+    let measurements = &scene.appearance.measurements;
+    let viewing = &scene.appearance.viewing_deg;
+    let above = air_angles(&ords);
+    let rr = plan.realisations;
+    let mut factors = vec![vec![Array1::zeros(wl.len()); rr]; measurements.len()];
+    let mut natural = vec![Array2::zeros((wl.len(), viewing.len())); rr];
+    let mut rta = vec![[(); 3].map(|_| Array2::zeros((wl.len(), above.len()))); rr];
+    let mut means: Vec<[Array3<f64>; 4]> = solved
+        .iter()
+        .map(|_| [(); 4].map(|_| Array3::zeros((wl.len(), k, k))))
+        .collect();
+    for r in 0..rr {
+        for (l, &w) in wl.iter().enumerate() {
+            let mut slabs = Vec::with_capacity(solved.len());
+            for (i, s) in solved.iter().enumerate() {
+                let n = s.realisations.len().max(1);
+                let find = |side: Side, j: usize| {
+                    find_solve(&s.entries, side, r % n, w, nodes[j]).map(|e| &e.efficiencies)
+                };
+                let slab = stack::layer_slab(&q, k, &find).ok_or(AppearanceError::Missing {
+                    side: Side::Above,
+                    realisation: r % n,
+                    wavelength_nm: w,
+                    polar_deg: nodes[0],
+                })?;
+                let t = &slab.total;
+                for (acc, m) in means[i]
+                    .iter_mut()
+                    .zip([&t.r_down, &t.t_down, &t.r_up, &t.t_up])
+                {
+                    for a in 0..k {
+                        for b in 0..k {
+                            acc[[l, a, b]] += m[(a, b)] / rr as f64;
+                        }
+                    }
+                }
+                slabs.push(slab);
+            }
+            let sr = stack::stack_reflection(&ords, &slabs, below)?;
+            for (g, &m) in measurements.iter().enumerate() {
+                factors[g][r][l] = sr.factor(m)?;
+            }
+            for (v, &deg) in viewing.iter().enumerate() {
+                natural[r][[l, v]] = stack::white_sky(&sr, deg)?;
+            }
+            let free =
+                stack::free_stack(&ords, &slabs.iter().map(|s| &s.total).collect::<Vec<_>>())?;
+            for (a, &deg) in above.iter().enumerate() {
+                let j = ords
+                    .air_node(deg)
+                    .ok_or(crate::optics::baseline::BaselineError::NoDirection(deg))?;
+                let rs: f64 = (0..k).map(|i| free.r_down[(i, j)]).sum();
+                let ts: f64 = (0..k).map(|i| free.t_down[(i, j)]).sum();
+                rta[r][0][[l, a]] = rs;
+                rta[r][1][[l, a]] = ts;
+                rta[r][2][[l, a]] = 1.0 - rs - ts;
+            }
+        }
+    }
+    let observer = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
+    let proxy = proxy_factors(scene, scenes, &ords, below)?;
+    let mut measured: Vec<MeasuredColour> = Vec::with_capacity(measurements.len());
+    for (g, &m) in measurements.iter().enumerate() {
+        let p = proxy.as_ref().map(|(fine, per)| (&fine[..], &per[g][..]));
+        measured.push(appearance::colour_of_samples(
+            m,
+            wl,
+            &factors[g],
+            p,
+            plan.analytic,
+            &observer,
+        )?);
+    }
+    let pick = |c: usize| appearance::reduce(&rta.iter().map(|x| x[c].clone()).collect::<Vec<_>>());
+    Ok(StackTables {
+        coupling: "incoherent".to_string(),
+        layer_thickness_nm: scenes.iter().map(|s| s.layer.thickness_nm).collect(),
+        layer_pigments: scenes
+            .iter()
+            .map(|s| {
+                s.species
+                    .iter()
+                    .map(|x| x.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            })
+            .collect(),
+        binder_polar_deg: nodes,
+        air_polar_deg: ords
+            .mu_air
+            .iter()
+            .map(|m| m.map_or(f64::NAN, |m| m.clamp(-1.0, 1.0).acos().to_degrees()))
+            .collect(),
+        flux_weight: ords.flux_weight.clone(),
+        wavelengths_nm: wl.clone(),
+        layers: means
+            .into_iter()
+            .map(|[r_down, t_down, r_up, t_up]| LayerMatrices {
+                r_down,
+                t_down,
+                r_up,
+                t_up,
+            })
+            .collect(),
+        realisations: rr,
+        above_deg: above,
+        reflectance: pick(0),
+        transmittance: pick(1),
+        absorption: pick(2),
+        viewing_deg: viewing.clone(),
+        natural: appearance::reduce(&natural),
+        measured,
+        conditions: (scene.appearance.illuminant, scene.appearance.observer),
+    })
+}
+
+/// The solve of `entries` from `side` at `polar` for realisation `r` at `wl`.
+fn find_solve(
+    entries: &[SolveEntry],
+    side: Side,
+    r: usize,
+    wl: f64,
+    polar: f64,
+) -> Option<&SolveEntry> {
+    entries.iter().find(|e| {
+        e.side == side
+            && e.realisation == r
+            && e.wavelength_nm == wl
+            && e.incidence.polar_deg == polar
+    })
+}
+
+/// The spectral proxy of the stack: every layer its homogeneous slab (the
+/// volume-averaged ε, in closed form inside the binder), stacked the same
+/// way, on the fine colour grid; the reflectance factor of each
+/// measurement on it. None for one wavelength, without paper, or where a
+/// material has no data on the grid.
+#[allow(clippy::type_complexity)]
+fn proxy_factors(
+    scene: &Scene,
+    scenes: &[Scene],
+    ords: &Ordinates,
+    below: Below,
+) -> Result<Option<(Vec<f64>, Vec<Vec<f64>>)>, PipelineError> {
+    let wl = &scene.wavelengths_nm;
+    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
+        return Ok(None);
+    }
+    let fine = fine_grid(wl);
+    let nb = scene.layer.binder_index;
+    let nodes = node_deg(ords);
+    let measurements = &scene.appearance.measurements;
+    let mut per = vec![Vec::with_capacity(fine.len()); measurements.len()];
+    for &w in &fine {
+        let mut slabs = Vec::with_capacity(scenes.len());
+        for ls in scenes {
+            let Ok(eps) = mean_eps(ls, w) else {
+                return Ok(None);
+            };
+            let eps_rel: C64 = eps / (nb * nb);
+            let (mut r, mut t) = (vec![0.0; nodes.len()], vec![0.0; nodes.len()]);
+            for (j, &deg) in nodes.iter().enumerate() {
+                let s = airy::slab(eps_rel, ls.layer.thickness_nm, w / nb, deg);
+                r[j] = s.r.norm_sqr();
+                t[j] = s.t.norm_sqr();
+            }
+            let slab = Slab::symmetric(Matrix::diagonal(&r), Matrix::diagonal(&t));
+            slabs.push(LayerSlab {
+                specular: slab.clone(),
+                total: slab,
+            });
+        }
+        let sr = stack::stack_reflection(ords, &slabs, below)?;
+        for (g, &m) in measurements.iter().enumerate() {
+            per[g].push(sr.factor(m)?);
+        }
+    }
+    Ok(Some((fine, per)))
+}

@@ -1,0 +1,294 @@
+//! Stacks of layers: each layer solved inside the binder and the layers
+//! combined by adding (`coupling = "incoherent"`), or all in one fragment
+//! (`"coherent"`). Checked against the closed form of a stack of
+//! homogeneous slabs, against energy conservation, and for solving the same
+//! fragments under either coupling; bad stacks are refused naming the key.
+
+mod common;
+use common::scene::{PigmentToml, SceneToml};
+use inksim::solver::airy;
+use std::path::Path;
+
+/// A layer of `pigment` `thickness_nm` thick in a binder of index 1.5.
+fn layer(pigment: PigmentToml, thickness_nm: f64) -> SceneToml {
+    SceneToml::grains()
+        .thickness_nm(thickness_nm)
+        .fragment_nm(600.0)
+        .binder_index(1.5)
+        .pigment(pigment)
+}
+
+/// The stack's settings around `layers`: 50 nm cells, three wavelengths,
+/// colours in the three geometries.
+fn stack(dir: &Path, layers: &[SceneToml], coupling: &str, name: &str) -> SceneToml {
+    SceneToml::grains()
+        .seed(5)
+        .realisations(2)
+        .cell_nm(50.0)
+        .z_cell_nm(50.0)
+        .wavelengths_nm(&[450.0, 550.0, 650.0])
+        .polar_deg(&[0.0])
+        .outputs(&["tile"])
+        .output(dir, name)
+        .stack_of(layers, coupling)
+}
+
+/// A dataset of a result file, read whole.
+fn read(path: &Path, name: &str) -> Vec<f64> {
+    let f = hdf5::File::open(path).unwrap();
+    f.dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+/// Reflection from above, from below and transmission of one direction
+/// through two layers, incoherently: `a` on top of `b`.
+fn on(a: (f64, f64, f64), b: (f64, f64, f64)) -> (f64, f64, f64) {
+    let (ra, ra_up, ta) = a;
+    let (rb, rb_up, tb) = b;
+    let d = 1.0 - ra_up * rb;
+    (
+        ra + ta * ta * rb / d,
+        rb_up + tb * tb * ra_up / d,
+        ta * tb / d,
+    )
+}
+
+#[test]
+fn two_dissolved_layers_equal_the_incoherent_closed_form() {
+    // Each layer is a homogeneous slab (Airy inside the binder); between
+    // them and at the binder's two flat surfaces only fluxes pass, so every
+    // direction is a one-dimensional incoherent chain, and the paper in air
+    // below sees the stack's diffuse reflectance and transmittance. Written
+    // out here per direction, without the adding method's matrices.
+    let dir = tempfile::tempdir().unwrap();
+    let (h1, h2) = (300.0, 500.0);
+    let layers = [
+        layer(PigmentToml::builtin("yellow").pvc(0.2).molecular(), h1),
+        layer(PigmentToml::builtin("blue").pvc(0.1).molecular(), h2),
+    ];
+    let scene = stack(dir.path(), &layers, "incoherent", "dissolved");
+    let report = scene.run(dir.path());
+    let path = &report.result_path;
+
+    let n: f64 = 1.5;
+    let binder_deg = read(path, "stack/binder_polar_deg");
+    let air_deg = read(path, "stack/air_polar_deg");
+    let flux = read(path, "stack/flux_weight");
+    let wl = read(path, "stack/wavelengths_nm");
+    let sc = scene.scene(dir.path());
+    let eps = |s: &str, pvc: f64, w: f64| {
+        let sp = sc.species.iter().find(|x| x.name == s).unwrap();
+        let m = sp.material.index_at(w).unwrap();
+        // The layer's volume average in the binder, relative to the binder.
+        (m * m * pvc + (1.0 - pvc) * n * n) / (n * n)
+    };
+    let albedo = 0.9;
+    for (l, &w) in wl.iter().enumerate() {
+        // (R↓, R↑, T) of every escaping direction, in air.
+        let chain = |k: usize| {
+            let (tb, ta) = (binder_deg[k].to_radians(), air_deg[k].to_radians());
+            let rs = ((n * tb.cos() - ta.cos()) / (n * tb.cos() + ta.cos())).powi(2);
+            let surface = (rs, rs, 1.0 - rs);
+            let slab = |e, h| {
+                let s = airy::slab(e, h, w / n, binder_deg[k]);
+                (s.r.norm_sqr(), s.r.norm_sqr(), s.t.norm_sqr())
+            };
+            let l1 = slab(eps("yellow", 0.2, w), h1);
+            let l2 = slab(eps("blue", 0.1, w), h2);
+            on(on(on(surface, l1), l2), surface)
+        };
+        let escaping: Vec<usize> = (0..air_deg.len())
+            .filter(|&k| air_deg[k].is_finite())
+            .collect();
+        // Lambertian flux weights in air: n² c.
+        let rd: f64 = escaping.iter().map(|&k| n * n * flux[k] * chain(k).1).sum();
+        let td: f64 = escaping.iter().map(|&k| n * n * flux[k] * chain(k).2).sum();
+        let at = |deg: f64| {
+            let k = *escaping
+                .iter()
+                .find(|&&k| (air_deg[k] - deg).abs() < 1e-9)
+                .unwrap();
+            chain(k)
+        };
+        let paper = |t: f64| albedo * t / (1.0 - albedo * rd);
+        let expect = [
+            ("45_0", paper(at(45.0).2 * at(0.0).2)),
+            ("d8_sci", at(8.0).0 + paper(at(8.0).2 * td)),
+            ("d8_sce", paper(at(8.0).2 * td)),
+        ];
+        for (slug, e) in expect {
+            let got = read(
+                path,
+                &format!("appearance/measured/{slug}/reflectance_factor"),
+            )[l];
+            assert!(
+                (got - e).abs() < 1e-12 * e.max(1e-3),
+                "{slug} at {w} nm: {got} vs closed form {e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_stack_that_absorbs_nothing_conserves_energy() {
+    // Grains of a real index in a real binder: every solve conserves power,
+    // and so must the flux matrices and their adding, in every direction.
+    let dir = tempfile::tempdir().unwrap();
+    let layers = [
+        layer(
+            PigmentToml::index("white", 2.0, 0.0)
+                .pvc(0.2)
+                .diameter_nm(150.0),
+            300.0,
+        ),
+        layer(
+            PigmentToml::index("clear", 1.7, 0.0)
+                .pvc(0.3)
+                .diameter_nm(100.0),
+            200.0,
+        ),
+    ];
+    let scene = stack(dir.path(), &layers, "incoherent", "lossless").no_substrate();
+    let report = scene.run(dir.path());
+    let r = read(&report.result_path, "stack/reflectance");
+    let t = read(&report.result_path, "stack/transmittance");
+    let a = read(&report.result_path, "stack/absorption");
+    assert_eq!(r.len(), t.len());
+    for k in 0..r.len() {
+        assert!(
+            (r[k] + t[k] - 1.0).abs() < 1e-5,
+            "R {} + T {} ≠ 1",
+            r[k],
+            t[k]
+        );
+        assert!(a[k].abs() < 1e-5, "absorption {}", a[k]);
+        // Something scatters: the stack reflects more than its two surfaces.
+        assert!(r[k] > 0.0 && t[k] > 0.0);
+    }
+}
+
+#[test]
+fn both_couplings_solve_the_same_fragments() {
+    let dir = tempfile::tempdir().unwrap();
+    let layers = [
+        layer(
+            PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0),
+            300.0,
+        ),
+        layer(
+            PigmentToml::builtin("blue").pvc(0.2).diameter_nm(150.0),
+            200.0,
+        ),
+    ];
+    let apart = stack(dir.path(), &layers, "incoherent", "apart").run(dir.path());
+    let together = stack(dir.path(), &layers, "coherent", "together").run(dir.path());
+    let centres = |p: &Path| read(p, "geometry/centers_nm");
+    let (a, b) = (centres(&apart.result_path), centres(&together.result_path));
+    assert!(!a.is_empty());
+    assert_eq!(a, b);
+    // The lower layer's grains lie below the upper layer.
+    let g = together.geometry.unwrap();
+    for p in &g.particles {
+        let z = p.spheres[0].center[2];
+        assert!(if p.species == 0 { z < 300.0 } else { z > 300.0 }, "{z}");
+    }
+    // Both report colours in every geometry.
+    for p in [&apart.result_path, &together.result_path] {
+        let (m, _, _) = inksim::output::h5::read_measured(p).unwrap().unwrap();
+        assert_eq!(m.len(), 3);
+        assert!(m.iter().all(|c| c.lab_se.is_some() && c.lab[0] > 0.0));
+    }
+}
+
+#[test]
+fn bad_stacks_are_refused_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let red = |h| layer(PigmentToml::builtin("red").pvc(0.2).diameter_nm(100.0), h);
+    let red2 = |h| {
+        layer(
+            PigmentToml::builtin("red")
+                .named("red2")
+                .pvc(0.2)
+                .diameter_nm(100.0),
+            h,
+        )
+    };
+    let cases: Vec<(SceneToml, &str, &str)> = vec![
+        (
+            stack(
+                dir.path(),
+                &[red(300.0), red2(300.0).binder_index(1.6)],
+                "incoherent",
+                "a",
+            ),
+            "stack[1].layer.binder_index",
+            "share one binder",
+        ),
+        (
+            stack(dir.path(), &[red(300.0), red(300.0)], "incoherent", "b"),
+            "stack[1].pigment[0].name",
+            "unique across the stack",
+        ),
+        (
+            stack(
+                dir.path(),
+                &[red(300.0), red2(300.0).fragment_nm(500.0)],
+                "coherent",
+                "c",
+            ),
+            "stack[1].layer.fragment_nm",
+            "one fragment",
+        ),
+        (
+            stack(dir.path(), &[red(300.0)], "incoherent", "d").outputs(&["tile", "brdf"]),
+            "appearance.outputs",
+            "azimuthal mean",
+        ),
+        (
+            stack(dir.path(), &[red(300.0)], "sideways", "e"),
+            "stacking.coupling",
+            "\"incoherent\" or \"coherent\"",
+        ),
+        (
+            stack(
+                dir.path(),
+                &[red(300.0).relief_fraction(0.2)],
+                "incoherent",
+                "f",
+            ),
+            "stack[0].layer",
+            "flat slabs",
+        ),
+        (
+            stack(dir.path(), &[red(300.0)], "incoherent", "g").raw(
+                "layer",
+                "{ thickness_nm = 300.0, fragment_nm = [600.0, 600.0] }",
+            ),
+            "stack",
+            "remove [layer]",
+        ),
+    ];
+    for (scene, key, words) in cases {
+        let e = scene
+            .parse(&scene.write(dir.path()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(key) && e.contains(words), "{key}: {e}");
+    }
+    // A different second pigment name fixes the duplicate.
+    let ok = stack(
+        dir.path(),
+        &[
+            red(300.0),
+            layer(
+                PigmentToml::builtin("red")
+                    .named("red2")
+                    .pvc(0.2)
+                    .diameter_nm(100.0),
+                300.0,
+            ),
+        ],
+        "incoherent",
+        "h",
+    );
+    assert!(ok.parse(&ok.write(dir.path())).is_ok());
+}

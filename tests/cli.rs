@@ -375,6 +375,20 @@ fn plan_on_a_scene_says_it_is_not_a_study() {
 }
 
 #[test]
+fn plan_on_a_file_that_is_not_toml_names_the_line() {
+    // A study whose inline table spans two lines (not TOML 1.0): the
+    // parser's position, not "no [study] table".
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("broken.toml");
+    std::fs::write(&cfg, "[study]\nname = \"s\"\nset = { a = 1,\n  b = 2 }\n").unwrap();
+    let (ok, _, err) = inksim(&["plan", cfg.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("line 3") && !err.contains("not a study"),
+        "{err}"
+    );
+}
+
+#[test]
 fn a_huge_thread_count_is_capped_with_a_message() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = SceneToml::tiny().write(dir.path());

@@ -139,8 +139,10 @@ impl ConfigFile {
     /// The study it describes; `output_dir` (from `--output-dir`) replaces
     /// its `study.output_dir`.
     pub fn study(&self, output_dir: Option<PathBuf>) -> Result<Study> {
+        // A file that is not TOML at all gets the parser's line and column
+        // from `Study::parse`, not "no [study] table".
         anyhow::ensure!(
-            self.is_study(),
+            self.is_study() || self.text.parse::<toml::Table>().is_err(),
             "{}: not a study (no [study] table); `inksim run` and `inksim check` take a scene",
             self.display()
         );

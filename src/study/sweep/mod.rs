@@ -237,10 +237,18 @@ impl Study {
     /// then the checks.
     pub fn parse(path: &Path, text: &str) -> Result<Study, StudyError> {
         let raw: RawSweep = toml::from_str(text).map_err(|e| {
+            // Where the parser stopped, as a line number.
+            let at = e.span().map_or(String::new(), |s| {
+                let start = (0..=s.start.min(text.len()))
+                    .rev()
+                    .find(|&i| text.is_char_boundary(i))
+                    .unwrap_or(0);
+                format!("line {}: ", text[..start].matches('\n').count() + 1)
+            });
             sweep_error(
                 path,
                 format!(
-                    "{} (a sweep file has [study], base, [profiles.*], [[axis]], zip, \
+                    "{at}{} (a sweep file has [study], base, [profiles.*], [[axis]], zip, \
                      [[variant]], [[exclude]], [[grid]])",
                     e.message().trim()
                 ),

@@ -292,3 +292,35 @@ fn bad_stacks_are_refused_naming_the_key() {
     );
     assert!(ok.parse(&ok.write(dir.path())).is_ok());
 }
+
+#[test]
+fn without_surfaces_one_layer_as_a_stack_equals_the_layer_solved_whole() {
+    // A binder of index 1 has no surfaces and makes no film: one layer
+    // combined by adding and the same fragment solved as one differ only by
+    // the adding method's discretisation (orders binned into its directions,
+    // the azimuthal mean) against the single layer's paper term (table read
+    // at the exact directions, Gauss–Legendre below). The same fragments:
+    // no statistics in the difference.
+    let dir = tempfile::tempdir().unwrap();
+    let one = [layer(PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0), 400.0)
+        .binder_index(1.0)
+        .fragment_nm(1000.0)];
+    let factors = |coupling: &str| {
+        let r = stack(dir.path(), &one, coupling, coupling)
+            .realisations(1)
+            .wavelengths_nm(&[450.0, 650.0])
+            .run(dir.path());
+        ["45_0", "d8_sci", "d8_sce"].map(|g| {
+            read(
+                &r.result_path,
+                &format!("appearance/measured/{g}/reflectance_factor"),
+            )
+        })
+    };
+    let (apart, whole) = (factors("incoherent"), factors("coherent"));
+    for (a, w) in apart.iter().zip(&whole) {
+        for (x, y) in a.iter().zip(w) {
+            assert!((x - y).abs() < 0.02 * y + 0.002, "{a:?} vs {w:?}");
+        }
+    }
+}

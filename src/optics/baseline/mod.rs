@@ -61,6 +61,7 @@ pub mod doubling;
 pub mod km;
 pub mod matrix;
 pub mod ordinates;
+pub mod sizes;
 pub mod sphere;
 pub mod transfer;
 

@@ -1,6 +1,7 @@
 //! The classical baseline of a scene (`appearance.baseline`): its pigments
-//! as the Kubelka–Munk model sees them, on the colour grid of the spectral
-//! proxy, beside the wave solution's measured colours.
+//! as the baselines see them (volume fraction, nominal diameter and size
+//! distribution, permittivity), on the colour grid of the spectral proxy,
+//! beside the wave solution's measured colours.
 
 use crate::config::{GrainShape, Scene, Substrate};
 use crate::optics::appearance::Appearance;
@@ -40,6 +41,7 @@ pub fn baseline_input(scene: &Scene) -> Result<Option<BaselineInput>, PipelineEr
             } else {
                 sp.diameter_nm
             },
+            size: sp.size,
             eps: eps.iter().map(|e| e[s]).collect(),
         })
         .collect();
@@ -49,6 +51,7 @@ pub fn baseline_input(scene: &Scene) -> Result<Option<BaselineInput>, PipelineEr
         thickness_nm: scene.layer.thickness_nm,
         paper_albedo: albedo,
         species,
+        size_quadrature: Default::default(),
     }))
 }
 

@@ -6,16 +6,26 @@
 //!
 //! All share the single scatterer and independent scattering:
 //! 1. **Single scatterer** ([`sphere`]): each pigment grain is replaced by
-//!    the sphere of equal volume (radius `d/2`, `d` = `diameter_nm`, the
-//!    nominal size: the size distribution, the shape and any clusters are
-//!    not seen) in the binder (real index `n_b`). Its cross sections,
+//!    the sphere of equal volume (radius `d/2`, `d` the grain's effective
+//!    diameter: the shape and any clusters are not seen) in the binder
+//!    (real index `n_b`). Its cross sections,
 //!    asymmetry parameter `g` and phase function come from the *scalar*
 //!    partial-wave solution at the wavelength in the binder `λ/n_b` with
 //!    relative permittivity `ε_s/ε_b`, `ε_s = (n + ik)²`: the solver solves
 //!    the scalar Helmholtz equation, so the scalar sphere is its consistent
 //!    single scatterer.
-//! 2. **Independent scattering**: number density `N_s = f_s / (π d³/6)`,
-//!    absorption coefficient `μa = Σ N_s σ_abs,s`, scattering coefficient
+//! 2. **Sizes** ([`sizes`]): a fixed size is the one sphere of the nominal
+//!    diameter `d` (`diameter_nm`). A size distribution (`pigment.size`,
+//!    normal or log-normal, truncated at 3σ as the geometry draws it) is a
+//!    Gauss–Legendre quadrature over the diameters, each node a sub-species
+//!    holding its share of the volume fraction: number densities in
+//!    proportion to the number distribution the geometry draws from, with
+//!    `Σ N(d_i) π d_i³/6 = f`, so μa, μs and the phase moments below are
+//!    averaged over the *number* of grains of each size at the species'
+//!    volume fraction.
+//! 3. **Independent scattering**: number density `N_s = f_s / (π d³/6)`
+//!    per species (per size node), absorption coefficient
+//!    `μa = Σ N_s σ_abs,s`, scattering coefficient
 //!    `μs = Σ N_s σ_sca,s`: the grains scatter as if alone (no near-field
 //!    coupling, no correlated positions, no dependent scattering at high
 //!    PVC). A molecular (dissolved) pigment scatters nothing and absorbs as
@@ -23,13 +33,13 @@
 //!    `σ_abs = k V Im(ε_s/ε_b)` per volume), so the layer is Beer's law.
 //!
 //! **Kubelka–Munk** (`kubelka-munk`, [`kubelka_munk`]):
-//! 3. **Diffuse light**: `K = 2 μa`, `S = (3/4) μs'`, `μs' = μs (1 − g)` —
+//! 4. **Diffuse light**: `K = 2 μa`, `S = (3/4) μs'`, `μs' = μs (1 − g)` —
 //!    the common conversion of the diffusion approximation (light inside
 //!    fully diffuse, mean path through a slab twice its thickness; S from
 //!    matching the diffusion equation's albedo) — and the KM reflectance of
 //!    the layer of thickness `X` on the Lambertian paper `R_g`
 //!    ([`km::reflectance`]).
-//! 4. **Surface** (Saunderson, [`km::saunderson`]): `r_e` the unpolarised
+//! 5. **Surface** (Saunderson, [`km::saunderson`]): `r_e` the unpolarised
 //!    Fresnel reflectance of the flat binder surface from air at the
 //!    geometry's directed angle (45° for 45°/0°, 8° for d/8°), `r_i` the
 //!    Fresnel reflectance from inside averaged over a Lambertian hemisphere
@@ -61,10 +71,11 @@ pub mod doubling;
 pub mod km;
 pub mod matrix;
 pub mod ordinates;
+pub mod sizes;
 pub mod sphere;
 pub mod transfer;
 
-use crate::config::{Baseline, Measurement};
+use crate::config::{Baseline, GrainSize, Measurement};
 use crate::optics::colour::{self, ColourError, Observer};
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
@@ -93,7 +104,11 @@ pub struct BaselineSpecies {
     /// Volume fraction of the layer.
     pub volume_fraction: f64,
     /// Diameter of the equal-volume sphere, nm; 0 for a dissolved pigment.
+    /// The nominal diameter of `size`.
     pub diameter_nm: f64,
+    /// The distribution of the grains' diameters around `diameter_nm`, as
+    /// the geometry draws them ([`sizes`]).
+    pub size: GrainSize,
     /// Permittivity `(n + ik)²` at each wavelength of the grid.
     pub eps: Vec<C64>,
 }
@@ -107,6 +122,8 @@ pub struct BaselineInput {
     pub thickness_nm: f64,
     pub paper_albedo: f64,
     pub species: Vec<BaselineSpecies>,
+    /// The quadrature over each species' size distribution.
+    pub size_quadrature: sizes::SizeQuadrature,
 }
 
 /// The KM coefficients at one wavelength (1/nm).
@@ -122,10 +139,10 @@ pub struct KmCoefficients {
     pub s: f64,
 }
 
-/// One grain species at one wavelength, as the independent-scattering
-/// models see it: number density (1/nm³), the binder's wavenumber `k`, the
-/// permittivity relative to the binder, the equal-volume radius and the
-/// scalar sphere's cross sections.
+/// One grain species, or one diameter of its size distribution, at one
+/// wavelength, as the independent-scattering models see it: number density
+/// (1/nm³), the binder's wavenumber `k`, the permittivity relative to the
+/// binder, the equal-volume radius and the scalar sphere's cross sections.
 pub(crate) struct GrainTerms {
     pub number: f64,
     pub k: f64,
@@ -135,8 +152,10 @@ pub(crate) struct GrainTerms {
 }
 
 /// The layer at wavelength index `l`: the dissolved pigments' absorption
-/// coefficient (their dilute limit `f k₀ Im ε / n_b`, 1/nm) and each grain
-/// species' terms.
+/// coefficient (their dilute limit `f k₀ Im ε / n_b`, 1/nm) and the terms
+/// of each grain species' size nodes ([`sizes::size_nodes`]; one for a
+/// fixed size), in species order: node `i` of a species holds the volume
+/// fraction `f s_i` (`s_i` its volume share) as grains of its diameter.
 pub(crate) fn at_wavelength(input: &BaselineInput, l: usize) -> (f64, Vec<GrainTerms>) {
     let nb = input.binder_index;
     let eps_b = nb * nb;
@@ -149,15 +168,22 @@ pub(crate) fn at_wavelength(input: &BaselineInput, l: usize) -> (f64, Vec<GrainT
             dissolved += sp.volume_fraction * k0 * eps.im / nb;
             continue;
         }
-        let d = sp.diameter_nm;
-        let (k, eps_rel, radius) = (k0 * nb, eps / eps_b, d / 2.0);
-        grains.push(GrainTerms {
-            number: sp.volume_fraction / (PI * d.powi(3) / 6.0),
-            k,
-            eps_rel,
-            radius,
-            cross: sphere::cross_sections(k, eps_rel, radius),
-        });
+        let index = eps.sqrt().norm().max(nb);
+        let n =
+            input
+                .size_quadrature
+                .nodes(sp.size, sp.diameter_nm, index, input.wavelengths_nm[l]);
+        for node in sizes::size_nodes(sp.size, sp.diameter_nm, n) {
+            let d = node.diameter_nm;
+            let (k, eps_rel, radius) = (k0 * nb, eps / eps_b, d / 2.0);
+            grains.push(GrainTerms {
+                number: sp.volume_fraction * node.volume_share / (PI * d.powi(3) / 6.0),
+                k,
+                eps_rel,
+                radius,
+                cross: sphere::cross_sections(k, eps_rel, radius),
+            });
+        }
     }
     (dissolved, grains)
 }

@@ -7,7 +7,9 @@
 //! (plus a dissolved pigment's `f k₀ Im ε / n_b`), `μs = Σ N_s σ_sca,s`, and
 //! the phase function of the mixture weighted by `N_s σ_sca,s`: Legendre
 //! moments `χ_n = Σ N_s m_n,s / Σ N_s σ_sca,s` from the scalar sphere
-//! ([`super::sphere::phase_moments`]). No diffusion-approximation factors.
+//! ([`super::sphere::phase_moments`]), `s` running over the species and,
+//! for a size distribution, over its diameters ([`super::sizes`]). No
+//! diffusion-approximation factors.
 //!
 //! **Stack**, from the top: air, the binder's surface, the layer (binder of
 //! index `n_b` with the scatterers, [`doubling::homogeneous`]), then the

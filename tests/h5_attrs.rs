@@ -243,3 +243,32 @@ fn every_dataset_of_a_study_summary_has_units_a_description_and_axes() {
     assert!(attr_names(&f, "/name").contains(&"REFERENCE_LIST".to_string()));
     assert!(attr_names(&f, "/colour/45_0/xyz").contains(&"DIMENSION_LIST".to_string()));
 }
+
+#[test]
+fn every_dataset_of_a_stack_result_has_units_a_description_and_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let layer = |name: &str, h: f64| {
+        tiny()
+            .thickness_nm(h)
+            .pigment(PigmentToml::builtin(name).diameter_nm(100.0))
+    };
+    let report = tiny()
+        .realisations(2)
+        .outputs(&["tile"])
+        .output(dir.path(), "s")
+        .stack_of(
+            &[layer("yellow", 200.0), layer("blue", 200.0)],
+            "incoherent",
+        )
+        .run(dir.path());
+    let seen = check_file(&report.result_path);
+    assert_eq!(
+        labels(&seen, "/stack/layer1/r_down"),
+        ["wavelength_nm", "node", "node_in"]
+    );
+    assert_eq!(
+        labels(&seen, "/appearance/natural"),
+        ["wavelength_nm", "viewing_deg"]
+    );
+    assert_eq!(labels(&seen, "/appearance/measured/45_0/lab"), ["lab"]);
+}

@@ -302,9 +302,12 @@ fn without_surfaces_one_layer_as_a_stack_equals_the_layer_solved_whole() {
     // at the exact directions, Gauss–Legendre below). The same fragments:
     // no statistics in the difference.
     let dir = tempfile::tempdir().unwrap();
-    let one = [layer(PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0), 400.0)
-        .binder_index(1.0)
-        .fragment_nm(1000.0)];
+    let one = [layer(
+        PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0),
+        400.0,
+    )
+    .binder_index(1.0)
+    .fragment_nm(1000.0)];
     let factors = |coupling: &str| {
         let r = stack(dir.path(), &one, coupling, coupling)
             .realisations(1)
@@ -323,4 +326,25 @@ fn without_surfaces_one_layer_as_a_stack_equals_the_layer_solved_whole() {
             assert!((x - y).abs() < 0.02 * y + 0.002, "{a:?} vs {w:?}");
         }
     }
+}
+
+#[test]
+fn a_stack_result_exports_its_solves_and_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let layers = [layer(
+        PigmentToml::builtin("yellow").pvc(0.2).molecular(),
+        300.0,
+    )];
+    let r = stack(dir.path(), &layers, "incoherent", "exported").run(dir.path());
+    let (ok, _, err) =
+        common::cli::inksim_in(dir.path(), &["export", r.result_path.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let colours = std::fs::read_to_string(dir.path().join("exported-colours.csv")).unwrap();
+    let rows: Vec<&str> = colours.lines().collect();
+    assert_eq!(rows.len(), 4, "{colours}");
+    assert!(
+        rows[1..].iter().any(|r| r.starts_with("45/0,")),
+        "{colours}"
+    );
+    assert!(dir.path().join("exported-solves.csv").exists());
 }

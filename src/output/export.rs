@@ -166,6 +166,25 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
     }
     let mut tables = vec![("solves", solves.into_text())];
     let Some(a) = read_appearance(path)? else {
+        // A stack solved layer by layer: its measured colours alone.
+        if let Some((records, ill, obs)) = read_measured(path)? {
+            let mut header = vec!["geometry", "viewing_deg", "illumination_deg"];
+            header.extend(COLOUR_COLUMNS);
+            let mut colours = Csv::new(&header);
+            for r in records {
+                let mut f = vec![r.geometry.clone(), String::new(), String::new()];
+                f.extend(colour_fields(
+                    &ill,
+                    &obs.to_string(),
+                    r.lab,
+                    r.lab_se,
+                    r.de00_se,
+                    Some(r.xyz),
+                ));
+                colours.row(f);
+            }
+            tables.push(("colours", colours.into_text()));
+        }
         return Ok(tables);
     };
     let extra = Extra::read(path)?;

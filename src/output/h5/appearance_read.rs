@@ -51,14 +51,17 @@ pub struct AppearanceArrays {
     pub tile_lab: Option<ndarray::Array3<f64>>,
 }
 
-/// Read the `/appearance` arrays of a result file (None when absent).
+/// Read the `/appearance` arrays of a result file (None when absent, or
+/// for a stack solved layer by layer, whose `/appearance` has its colours
+/// only).
 pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError> {
     let hdf = |source| IoError::Hdf5 {
         path: path.to_path_buf(),
         source,
     };
     let file = hdf5::File::open(path).map_err(hdf)?;
-    if !file.link_exists("appearance") {
+    // A stack solved layer by layer keeps only its colours in /appearance.
+    if !file.link_exists("appearance") || !file.link_exists("appearance/wavelengths_nm") {
         return Ok(None);
     }
     let g = file.group("appearance").map_err(hdf)?;

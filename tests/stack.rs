@@ -348,3 +348,39 @@ fn a_stack_result_exports_its_solves_and_colours() {
     );
     assert!(dir.path().join("exported-solves.csv").exists());
 }
+
+#[test]
+fn a_study_sweeps_stacks_and_merges_them() {
+    // Both couplings of a two-layer stack as a study's axis: each variant
+    // finishes (an incoherent stack draws no tile) and the merge compares
+    // them.
+    let dir = tempfile::tempdir().unwrap();
+    let layer = |name: &str| {
+        format!(
+            "[[base.stack]]\n[base.stack.layer]\nthickness_nm = 200.0\nfragment_nm = [400.0, 400.0]\n\
+             binder_index = 1.5\n[[base.stack.pigment]]\nname = \"{name}\"\n\
+             material = {{ builtin = \"{name}\" }}\npvc = 0.15\ndiameter_nm = 100.0\n"
+        )
+    };
+    let text = format!(
+        "[study]\nname = \"stacks\"\nseed = 3\noutput_dir = \"out\"\n\n[base]\nrealisations = 2\n\
+         {}{}[base.grid]\ncell_nm = 50.0\nz_cell_nm = 50.0\n[base.illumination]\n\
+         wavelengths_nm = [450.0, 600.0]\npolar_deg = [0.0]\n[base.appearance]\n\
+         outputs = [\"tile\"]\n\n[[axis]]\nname = \"coupling\"\nkey = \"stacking.coupling\"\n\
+         values = [\"incoherent\", \"coherent\"]\n",
+        layer("yellow"),
+        layer("blue")
+    );
+    std::fs::write(dir.path().join("stacks.toml"), text).unwrap();
+    let run = |args: &[&str]| {
+        let (ok, out, err) = common::cli::inksim_in(dir.path(), args);
+        assert!(ok, "{args:?}: {out}\n{err}");
+    };
+    run(&["run", "stacks.toml"]);
+    run(&["merge", "stacks.toml"]);
+    let summary = std::fs::read_to_string(dir.path().join("out/summary.md")).unwrap();
+    for v in ["incoherent", "coherent"] {
+        assert!(summary.contains(v), "{summary}");
+    }
+    assert!(dir.path().join("out/summary.h5").exists());
+}

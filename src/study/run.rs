@@ -160,7 +160,8 @@ pub fn state(v: &Variant) -> State {
             found: s.entries.len(),
             planned: pipeline::planned_solves(&v.scene),
         },
-        Ok(_) if !png.is_file() => State::NoTile,
+        // A stack solved layer by layer draws no tile (pipeline::output_files).
+        Ok(_) if !png.is_file() && pipeline::output_files(&v.scene).contains(&png) => State::NoTile,
         Ok(_) => State::Done,
     }
 }

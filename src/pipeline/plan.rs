@@ -524,20 +524,29 @@ pub fn plan_text(plan: &RunPlan, entries: &[SolveEntry]) -> String {
     lines.join("\n")
 }
 
-/// The adding method's directions for a stack: the stack's binder, its
-/// direction counts, and every air angle a measurement or the white sky
-/// reads among the nodes.
-pub fn stack_ordinates(scene: &Scene) -> Ordinates {
-    let st = scene.stack.as_ref().expect("a stack");
+/// The air angles a stack reports at: the illumination and viewing angles
+/// and every measurement geometry's, increasing (the single layer's solves
+/// from above).
+pub(super) fn stack_air_angles(scene: &Scene) -> Vec<f64> {
     let mut air: Vec<f64> = scene
         .appearance
         .measurements
         .iter()
         .flat_map(|m| m.above_deg().iter().copied())
         .chain(scene.appearance.viewing_deg.iter().copied())
+        .chain(scene.incidence.iter().map(|i| i.polar_deg))
         .collect();
     air.sort_by(f64::total_cmp);
     air.dedup();
+    air
+}
+
+/// The adding method's directions for a stack: the stack's binder, its
+/// direction counts, and every air angle a measurement or the white sky
+/// reads among the nodes.
+pub fn stack_ordinates(scene: &Scene) -> Ordinates {
+    let st = scene.stack.as_ref().expect("a stack");
+    let air = stack_air_angles(scene);
     let params = OrdinateParams {
         trapped_nodes: st.trapped_directions,
         escape_nodes: st.escape_directions,

@@ -28,21 +28,9 @@ use super::eps::mean_eps;
 use super::grains::fragment_nm;
 use super::layer::{self, SolvedLayer};
 use super::memory::{self, MemoryLimit};
-use super::plan::{node_deg, plan_text, stack_ordinates, stack_plan, RunPlan};
+use super::plan::{node_deg, plan_text, stack_air_angles, stack_ordinates, stack_plan, RunPlan};
 use super::result::{ResultParts, RunReport};
 use super::{check_output_dir, check_output_files, result_paths, PipelineError};
-
-/// The air angles the stack's R, T, A and the white sky are reported at.
-fn air_angles(ords: &Ordinates) -> Vec<f64> {
-    let mut v: Vec<f64> = ords
-        .mu_air
-        .iter()
-        .flatten()
-        .map(|m| m.clamp(-1.0, 1.0).acos().to_degrees())
-        .collect();
-    v.sort_by(f64::total_cmp);
-    v
-}
 
 /// Run an incoherent stack end to end and write its result file.
 pub fn run(
@@ -180,7 +168,7 @@ fn combine(
     let wl = &scene.wavelengths_nm;
     let measurements = &scene.appearance.measurements;
     let viewing = &scene.appearance.viewing_deg;
-    let above = air_angles(&ords);
+    let above = stack_air_angles(scene);
     let rr = plan.realisations;
     let mut factors = vec![vec![Array1::zeros(wl.len()); rr]; measurements.len()];
     let mut natural = vec![Array2::zeros((wl.len(), viewing.len())); rr];

@@ -43,7 +43,7 @@ pub use appearance_read::{
 pub(crate) use described::{about, dim, Scales};
 pub use geometry::GeometrySummary;
 pub use result::{write_result, RealisationStop, ResultSet};
-pub use stack::{LayerMatrices, StackTables};
+pub use stack::{read_stack_totals, LayerMatrices, StackTables};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 
 /// Version of the layout described in docs/FORMAT.md, stored as `format_version`.

@@ -204,3 +204,29 @@ pub(super) fn write_stack(file: &hdf5::File, t: &StackTables, s: &mut Scales) ->
     }
     Ok(())
 }
+
+/// The mean reflectance, transmittance and absorption of a stack solved
+/// layer by layer (`/stack`, over wavelengths and angles, the stack in air
+/// without paper); None for any other result.
+pub fn read_stack_totals(path: &std::path::Path) -> Result<Option<[f64; 3]>, super::IoError> {
+    let hdf = |source| super::IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = hdf5::File::open(path).map_err(hdf)?;
+    if !file.link_exists("stack/reflectance") {
+        return Ok(None);
+    }
+    let mean = |name: &str| -> Result<f64, super::IoError> {
+        let v: Vec<f64> = file
+            .dataset(&format!("stack/{name}"))
+            .and_then(|d| d.read_raw())
+            .map_err(hdf)?;
+        Ok(v.iter().sum::<f64>() / v.len().max(1) as f64)
+    };
+    Ok(Some([
+        mean("reflectance")?,
+        mean("transmittance")?,
+        mean("absorption")?,
+    ]))
+}

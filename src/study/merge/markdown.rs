@@ -55,7 +55,7 @@ pub(super) fn page(p: &PageInput) -> String {
         }
     }
     md += "## Variants\n\nR, T, A: mean total reflectance, transmittance and absorption over \
-           the solves from above; L*, C*ab, h°: the measured colour ± s.e.\n\n";
+           the solves from above (for a stack combined by adding, of the whole stack in air over its angles); L*, C*ab, h°: the measured colour ± s.e.\n\n";
     let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
     head.extend(axes.iter().map(|a| a.to_string()));

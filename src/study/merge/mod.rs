@@ -148,11 +148,15 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             .collect();
         let n = above.len().max(1) as f64;
         let mean = |f: fn(&h5::EntrySummary) -> f64| above.iter().map(|e| f(e)).sum::<f64>() / n;
-        let (r, t, a) = (
-            mean(|e| e.total_reflectance),
-            mean(|e| e.total_transmittance),
-            mean(|e| e.absorption),
-        );
+        // A stack solved layer by layer: the whole stack's, not its layers'.
+        let (r, t, a) = match h5::read_stack_totals(&path)? {
+            Some([r, t, a]) => (r, t, a),
+            None => (
+                mean(|e| e.total_reflectance),
+                mean(|e| e.total_transmittance),
+                mean(|e| e.absorption),
+            ),
+        };
         let measured = measured(&path)?;
         let baseline = match &measured {
             Some(m) => h5::read_baseline(&path)?

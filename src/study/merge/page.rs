@@ -341,7 +341,7 @@ fn variants_html(p: &PageInput) -> String {
     }
     let mut s = String::from(
         "<h2>Variants</h2>\n<p>R, T, A: mean total reflectance, transmittance and absorption \
-         over the solves from above. L*, C*ab, h°: the measured colour ± s.e.; swatch: sRGB \
+         over the solves from above (for a stack combined by adding, of the whole stack in air over its angles). L*, C*ab, h°: the measured colour ± s.e.; swatch: sRGB \
          under natural light at the first viewing angle.</p>\n<table>\n",
     );
     s += &tr(&head, "th");

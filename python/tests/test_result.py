@@ -189,3 +189,66 @@ def test_datatree(tiny):
     t = tiny.to_datatree()
     assert t["appearance"]["reflectance"].dims == ("wavelength_nm", "above_deg")
     assert t.attrs["seed"] == 3
+
+
+STACK_SCENE = """\
+seed = 3
+realisations = 2
+
+[[stack]]
+[stack.layer]
+thickness_nm = 200.0
+fragment_nm = [400.0, 400.0]
+binder_index = 1.5
+[[stack.pigment]]
+name = "yellow"
+material = { builtin = "yellow" }
+pvc = 0.15
+diameter_nm = 100.0
+
+[[stack]]
+[stack.layer]
+thickness_nm = 200.0
+fragment_nm = [400.0, 400.0]
+binder_index = 1.5
+[[stack.pigment]]
+name = "blue"
+material = { builtin = "blue" }
+pvc = 0.15
+diameter_nm = 100.0
+
+[grid]
+cell_nm = 50.0
+z_cell_nm = 50.0
+
+[illumination]
+wavelengths_nm = [450.0, 600.0]
+polar_deg = [0.0]
+
+[appearance]
+outputs = ["tile"]
+
+[output]
+name = "stack"
+"""
+
+
+def test_stack(binary, tmp_path):
+    cfg = tmp_path / "stack.toml"
+    cfg.write_text(STACK_SCENE, encoding="utf-8")
+    r = inksim.run(cfg, tmp_path / "out").open()
+    st = r.stack
+    assert st is not None and "stack" in repr(r)
+    assert st.sizes["layer"] == 2 and st.sizes["wavelength_nm"] == 2
+    assert st["r_down"].dims == ("layer", "wavelength_nm", "node", "node_in")
+    assert list(st["layer_pigments"].values) == ["yellow", "blue"]
+    # Each layer's columns: what is reflected and transmitted is at most
+    # what arrived (the rest is absorbed).
+    out = (st["r_down"] + st["t_down"]).sum("node")
+    assert float(out.max()) <= 1.0 + 1e-6 and float(out.min()) > 0.0
+    # The stack in air conserves energy.
+    total = st["reflectance"] + st["transmittance"] + st["absorption"]
+    np.testing.assert_allclose(total.values, 1.0, atol=1e-12)
+    assert st["reflectance"].attrs["units"] == "1"
+    # Its colours are where a single layer's are.
+    assert r.appearance["natural"].dims == ("wavelength_nm", "viewing_deg")

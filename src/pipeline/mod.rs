@@ -66,6 +66,26 @@ pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};
 pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps, ENERGY_BALANCE_LIMIT};
 
+/// The progress of a run of `total` solves, its plan's lines logged first;
+/// hidden when `quiet` (a study's variants report through its own bar).
+fn started(
+    scene: &Scene,
+    total: u64,
+    quiet: bool,
+    lines: &[String],
+) -> crate::output::progress::Progress {
+    use crate::output::progress::Progress;
+    let progress = if quiet {
+        Progress::hidden(total, &scene.output.name)
+    } else {
+        Progress::new(total, &scene.output.name)
+    };
+    for l in lines {
+        progress.log(l);
+    }
+    progress
+}
+
 /// Sub-samples per voxel edge for partially filled voxels.
 pub const SUPERSAMPLE: usize = 4;
 

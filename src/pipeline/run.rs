@@ -12,7 +12,6 @@ use crate::optics::farfield::{Side, SolveEntry};
 use crate::output::atomic;
 use crate::output::h5::RealisationStop;
 use crate::output::merl;
-use crate::output::progress::Progress;
 use crate::output::render;
 use crate::raster::{self, structure, Raster};
 
@@ -22,7 +21,9 @@ use super::layer;
 use super::memory::{self, MemoryLimit};
 use super::plan::{plan_text, RunPlan};
 use super::result::{ResultParts, RunReport};
-use super::{check_output_dir, check_output_files, result_paths, PipelineError, SUPERSAMPLE};
+use super::{
+    check_output_dir, check_output_files, result_paths, started, PipelineError, SUPERSAMPLE,
+};
 
 /// Run a scene end to end and write its result files, with a progress bar
 /// (terminal) or log lines, held to the machine's available memory.
@@ -57,14 +58,7 @@ pub fn run_with(
     let mut plan = RunPlan::of(scene);
     super::disk::preflight(&scene.output.dir, super::disk::estimate_bytes(scene, &plan))?;
     let total = plan.solves(scene) as u64;
-    let progress = if quiet {
-        Progress::hidden(total, &scene.output.name)
-    } else {
-        Progress::new(total, &scene.output.name)
-    };
-    for l in &plan.lines {
-        progress.log(l);
-    }
+    let progress = started(scene, total, quiet, &plan.lines);
     let layer = layer::solve(scene, &plan, &progress)?;
     if let Some(stop) = layer.stop {
         let line = realisations_done_line(plan.realisations, layer.realisations.len(), stop);

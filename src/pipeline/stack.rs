@@ -20,7 +20,6 @@ use crate::optics::colour::Observer;
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab};
 use crate::output::h5::{LayerMatrices, StackTables};
-use crate::output::progress::Progress;
 use crate::solver::airy;
 
 use super::appearance::fine_grid;
@@ -30,7 +29,7 @@ use super::layer::{self, SolvedLayer};
 use super::memory::{self, MemoryLimit};
 use super::plan::{node_deg, plan_text, stack_air_angles, stack_ordinates, stack_plan, RunPlan};
 use super::result::{ResultParts, RunReport};
-use super::{check_output_dir, check_output_files, result_paths, PipelineError};
+use super::{check_output_dir, check_output_files, result_paths, started, PipelineError};
 
 /// Run an incoherent stack end to end and write its result file.
 pub fn run(
@@ -57,14 +56,7 @@ pub fn run(
             .sum(),
     )?;
     let total = plan.solves(scene) as u64;
-    let progress = if quiet {
-        Progress::hidden(total, &scene.output.name)
-    } else {
-        Progress::new(total, &scene.output.name)
-    };
-    for l in &plan.lines {
-        progress.log(l);
-    }
+    let progress = started(scene, total, quiet, &plan.lines);
     let mut solved: Vec<SolvedLayer> = Vec::with_capacity(scenes.len());
     let mut entries = Vec::new();
     for (i, (ls, p)) in scenes.iter().zip(&plan.layers).enumerate() {

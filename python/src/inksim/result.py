@@ -138,6 +138,7 @@ class Result:
     - ``colours``: CIELAB and sRGB8 of the tile and under natural light;
     - ``geometry``, ``statistics``, ``realisations`` (and ``seeds``);
     - ``tile_png``, ``picture_png``: the stored PNG bytes.
+    - ``stack``: ``/stack`` of a stack combined layer by layer, else None.
     """
 
     def __init__(self, path: "os.PathLike[str] | str"):
@@ -154,6 +155,7 @@ class Result:
                 _read_statistics(f) if "geometry/statistics" in f else None
             )
             self.realisations = _read_realisations(f) if "realisations" in f else None
+            self.stack = _read_stack(f) if "stack" in f else None
             self.picture_png: Optional[bytes] = (
                 f["picture_png"][()].tobytes() if "picture_png" in f else None
             )
@@ -277,7 +279,7 @@ class Result:
         root.attrs["config"] = self.config or ""
         root.attrs["plan"] = self.plan or ""
         parts = {"/": root, "/solves": self.solves, "/orders": self.orders}
-        for name in ("appearance", "geometry", "statistics", "realisations"):
+        for name in ("appearance", "geometry", "statistics", "realisations", "stack"):
             v = getattr(self, name)
             if v is not None:
                 parts["/" + name] = v
@@ -292,6 +294,8 @@ class Result:
             lines.append("  appearance: " + ", ".join(f"{k} {v}" for k, v in self.appearance.sizes.items()))
         if self.geometry is not None:
             lines.append("  geometry: " + ", ".join(f"{k} {v}" for k, v in self.geometry.sizes.items()))
+        if self.stack is not None:
+            lines.append("  stack: " + ", ".join(f"{k} {v}" for k, v in self.stack.sizes.items()))
         return "\n".join(lines)
 
 
@@ -446,6 +450,36 @@ def _read_appearance(f: h5py.File) -> xr.Dataset:
         if u is not None:
             ds.attrs[k + "_units"] = u
     return ds
+
+
+def _read_stack(f: h5py.File) -> xr.Dataset:
+    """``/stack`` of a stack combined layer by layer (docs/FORMAT.md): the
+    adding method's directions, the stack's R, T, A in air, and each layer's
+    flux matrices with a leading ``layer`` axis (``r_down``, ``t_down``,
+    ``r_up``, ``t_up``: layer x wavelength x node (out) x node_in)."""
+    g = f["stack"]
+    coords = {
+        "layer": _var("stack/layer_thickness_nm", g["layer_thickness_nm"], ("layer",)),
+        "node": _var("stack/binder_polar_deg", g["binder_polar_deg"], ("node",)),
+        "wavelength_nm": _var("stack/wavelengths_nm", g["wavelengths_nm"], ("wavelength_nm",)),
+        "above_deg": _var("stack/above_deg", g["above_deg"], ("above_deg",)),
+    }
+    data: Dict[str, xr.Variable] = {}
+    for name in g.keys():
+        ds = g[name]
+        if isinstance(ds, h5py.Dataset) and name not in (
+            "layer_thickness_nm", "binder_polar_deg", "wavelengths_nm", "above_deg"
+        ):
+            data[name] = _var("stack/" + name, ds)
+    layers = sorted((k for k in g.keys() if k.startswith("layer") and isinstance(g[k], h5py.Group)),
+                    key=lambda k: int(k[len("layer"):]))
+    for m in ("r_down", "t_down", "r_up", "t_up"):
+        parts = [g[k][m] for k in layers]
+        if parts:
+            first = _var(f"stack/{layers[0]}/{m}", parts[0])
+            stacked = np.stack([p[()] for p in parts])
+            data[m] = xr.Variable(("layer",) + first.dims, stacked, attrs=first.attrs)
+    return xr.Dataset(data, coords=coords, attrs=_attrs(g))
 
 
 def _read_geometry(f: h5py.File) -> xr.Dataset:

@@ -384,3 +384,77 @@ fn a_study_sweeps_stacks_and_merges_them() {
     }
     assert!(dir.path().join("out/summary.h5").exists());
 }
+
+#[test]
+fn the_adding_doubling_baseline_of_a_stack_adds_its_layers() {
+    use inksim::config::{Baseline, Measurement};
+    use inksim::optics::baseline;
+    use inksim::optics::colour::Observer;
+    // One layer 600 nm thick is the same radiative-transfer medium as two
+    // layers of 300 nm of the same pigment stacked: adding the halves must
+    // give the whole.
+    let dir = tempfile::tempdir().unwrap();
+    let whole = layer(
+        PigmentToml::builtin("red").pvc(0.2).diameter_nm(200.0),
+        600.0,
+    )
+    .wavelengths_nm(&[450.0, 550.0, 650.0])
+    .scene(dir.path());
+    let input = inksim::pipeline::baseline_input(&whole).unwrap().unwrap();
+    let half = baseline::BaselineInput {
+        thickness_nm: 300.0,
+        ..input.clone()
+    };
+    let obs = Observer::standard(whole.appearance.illuminant, whole.appearance.observer);
+    let m = [Measurement::FortyFiveZero, Measurement::DiffuseEightSci];
+    for model in [Baseline::AddingDoubling, Baseline::AddingDoublingContact] {
+        let one = baseline::baseline_colours(model, &input, &m, &|_| None, &obs).unwrap();
+        let two = baseline::stack_baseline_colours(
+            model,
+            &[half.clone(), half.clone()],
+            &m,
+            &|_| None,
+            &obs,
+        )
+        .unwrap();
+        for (a, b) in one.iter().zip(&two) {
+            for (x, y) in a.reflectance_factor.iter().zip(&b.reflectance_factor) {
+                assert!((x - y).abs() < 1e-9, "{model:?}: {x} vs {y}");
+            }
+        }
+    }
+    // Kubelka–Munk is a model of one layer.
+    let e = baseline::stack_baseline_colours(Baseline::KubelkaMunk, &[half], &m, &|_| None, &obs)
+        .unwrap_err();
+    assert!(e.to_string().contains("one layer"), "{e}");
+}
+
+#[test]
+fn a_stack_reports_its_adding_doubling_baseline_beside_its_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let layers = [
+        layer(
+            PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0),
+            300.0,
+        ),
+        layer(
+            PigmentToml::builtin("blue").pvc(0.2).diameter_nm(150.0),
+            300.0,
+        ),
+    ];
+    for coupling in ["incoherent", "coherent"] {
+        let r = stack(dir.path(), &layers, coupling, coupling)
+            .raw("appearance.baseline", "\"adding-doubling\"")
+            .run(dir.path());
+        let b = inksim::output::h5::read_baseline(&r.result_path).unwrap();
+        assert_eq!(b.len(), 3, "{coupling}");
+        assert!(b.iter().all(|x| x.de00_to_wave.is_some_and(|d| d > 0.0)));
+    }
+    let km = stack(dir.path(), &layers, "incoherent", "km")
+        .raw("appearance.baseline", "\"kubelka-munk\"");
+    let e = km.parse(&km.write(dir.path())).unwrap_err().to_string();
+    assert!(
+        e.contains("appearance.baseline") && e.contains("one layer"),
+        "{e}"
+    );
+}

@@ -4,8 +4,8 @@
 //! beside the wave solution's measured colours.
 
 use crate::config::{GrainShape, Scene, Substrate};
-use crate::optics::appearance::Appearance;
-use crate::optics::baseline::{self, BaselineInput, BaselineSpecies};
+use crate::optics::appearance::{Appearance, MeasuredColour};
+use crate::optics::baseline::{self, BaselineColour, BaselineInput, BaselineSpecies};
 use crate::optics::colour::Observer;
 
 use super::appearance::fine_grid;
@@ -62,24 +62,53 @@ pub fn add_baseline(
     appearance: &mut Appearance,
     observer: &Observer,
 ) -> Result<(), PipelineError> {
+    appearance.baseline = baseline_colours(scene, &appearance.measured, observer)?;
+    Ok(())
+}
+
+/// The scene's baseline colours beside its wave colours `measured` (each
+/// model's, in the order the scene lists them; none without paper or when
+/// it asks for none). A stack's are the adding–doubling of its layers.
+pub fn baseline_colours(
+    scene: &Scene,
+    measured: &[MeasuredColour],
+    observer: &Observer,
+) -> Result<Vec<BaselineColour>, PipelineError> {
     if scene.appearance.baseline.is_empty() {
-        return Ok(());
+        return Ok(Vec::new());
     }
-    let Some(input) = baseline_input(scene)? else {
-        return Ok(());
+    let layers: Vec<Scene> = match &scene.stack {
+        Some(st) => (0..st.layers.len())
+            .filter_map(|i| scene.stack_layer(i))
+            .collect(),
+        None => vec![scene.clone()],
     };
-    let measured = &appearance.measured;
+    let mut inputs = Vec::with_capacity(layers.len());
+    for l in &layers {
+        match baseline_input(l)? {
+            Some(input) => inputs.push(input),
+            None => return Ok(Vec::new()),
+        }
+    }
     let wave = |m| measured.iter().find(|c| c.geometry == m).map(|c| c.lab);
     let mut colours = Vec::new();
     for &model in &scene.appearance.baseline {
-        colours.extend(baseline::baseline_colours(
-            model,
-            &input,
-            &scene.appearance.measurements,
-            &wave,
-            observer,
-        )?);
+        colours.extend(match scene.stack {
+            Some(_) => baseline::stack_baseline_colours(
+                model,
+                &inputs,
+                &scene.appearance.measurements,
+                &wave,
+                observer,
+            )?,
+            None => baseline::baseline_colours(
+                model,
+                &inputs[0],
+                &scene.appearance.measurements,
+                &wave,
+                observer,
+            )?,
+        });
     }
-    appearance.baseline = colours;
-    Ok(())
+    Ok(colours)
 }

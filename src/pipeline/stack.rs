@@ -231,6 +231,7 @@ fn combine(
             &observer,
         )?);
     }
+    let baseline = super::baseline::baseline_colours(scene, &measured, &observer)?;
     let pick = |c: usize| appearance::reduce(&rta.iter().map(|x| x[c].clone()).collect::<Vec<_>>());
     Ok(StackTables {
         coupling: "incoherent".to_string(),
@@ -270,6 +271,7 @@ fn combine(
         viewing_deg: viewing.clone(),
         natural: appearance::reduce(&natural),
         measured,
+        baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
     })
 }

@@ -5,7 +5,7 @@
 use super::{Checker, REL_EPS};
 use crate::config::raw::{RawConfig, RawStacking};
 use crate::config::{
-    ConfigError, GridSpec, Layer, Species, Stack, StackCoupling, StackLayer, Surface,
+    Baseline, ConfigError, GridSpec, Layer, Species, Stack, StackCoupling, StackLayer, Surface,
     DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS, MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
 };
 
@@ -227,10 +227,18 @@ impl Checker<'_> {
         appearance: &crate::config::Appearance,
         target: bool,
     ) -> Result<(), ConfigError> {
-        if !appearance.baseline.is_empty() {
+        if let Some(b) = appearance
+            .baseline
+            .iter()
+            .find(|b| matches!(b, Baseline::KubelkaMunk | Baseline::KubelkaMunkScene))
+        {
             return Err(self.invalid(
                 "appearance.baseline",
-                "the classical baselines are computed for one layer: remove it for a stack",
+                format!(
+                    "{} is a model of one layer: a stack takes \"adding-doubling\" or \
+                     \"adding-doubling-contact\", which add the layers' radiative-transfer slabs",
+                    b.name()
+                ),
             ));
         }
         if stack.coupling == StackCoupling::Coherent {

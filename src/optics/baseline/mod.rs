@@ -94,6 +94,8 @@ pub enum BaselineError {
     Singular,
     #[error("baseline: the quadrature has no node in the air direction {0}°")]
     NoDirection(f64),
+    #[error("baseline: {0} is a model of one layer; a stack takes adding-doubling or adding-doubling-contact")]
+    StackModel(&'static str),
     #[error("baseline: colour: {0}")]
     Colour(#[from] ColourError),
 }
@@ -331,6 +333,32 @@ pub fn reflectance_factors(
             transfer::reflectance_factors(input, transfer::Boundary::Contact, measurements, params)?
         }
     })
+}
+
+/// The colours of a stack of layers (top first, one binder and grid) by the
+/// adding–doubling models, which add the layers' radiative-transfer slabs
+/// under the surface; the Kubelka–Munk models are for one layer
+/// ([`BaselineError::StackModel`]). `wave` as for [`baseline_colours`].
+pub fn stack_baseline_colours(
+    model: Baseline,
+    inputs: &[BaselineInput],
+    measurements: &[Measurement],
+    wave: &dyn Fn(Measurement) -> Option<[f64; 3]>,
+    observer: &Observer,
+) -> Result<Vec<BaselineColour>, BaselineError> {
+    let boundary = match model {
+        Baseline::AddingDoubling => transfer::Boundary::Scene,
+        Baseline::AddingDoublingContact => transfer::Boundary::Contact,
+        Baseline::KubelkaMunk | Baseline::KubelkaMunkScene => {
+            return Err(BaselineError::StackModel(model.name()))
+        }
+    };
+    let Some(top) = inputs.first() else {
+        return Ok(Vec::new());
+    };
+    let params = ordinates::OrdinateParams::default();
+    let factors = transfer::stack_reflectance_factors(inputs, boundary, measurements, params)?;
+    Ok(colours(model, top, measurements, factors, wave, observer)?)
 }
 
 /// The colours of `model` in every geometry in `measurements`; `wave` gives

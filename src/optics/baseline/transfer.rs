@@ -126,7 +126,21 @@ pub fn stack(
     albedo: f64,
     boundary: Boundary,
 ) -> Result<StackReflection, BaselineError> {
-    let layer = doubling::homogeneous(&ords, medium, thickness_nm)?;
+    stack_of_layers(ords, &[(medium, thickness_nm)], albedo, boundary)
+}
+
+/// The same for several layers of one binder, top first, each a medium and
+/// its thickness: their slabs added in order under the binder's surface.
+pub fn stack_of_layers(
+    ords: Ordinates,
+    layers: &[(&Medium, f64)],
+    albedo: f64,
+    boundary: Boundary,
+) -> Result<StackReflection, BaselineError> {
+    let mut body = Slab::transparent(ords.len());
+    for &(medium, thickness_nm) in layers {
+        body = adding::add(&body, &doubling::homogeneous(&ords, medium, thickness_nm)?)?;
+    }
     let backing = match boundary {
         Boundary::Scene => adding::on_backing(
             &adding::surface_binder_over_air(&ords),
@@ -134,24 +148,28 @@ pub fn stack(
         )?,
         Boundary::Contact => adding::lambertian_in_binder(&ords, albedo),
     };
-    let under_surface = adding::on_backing(&layer, &backing)?;
+    let under_surface = adding::on_backing(&body, &backing)?;
     let r = adding::on_backing(&adding::surface_air_over_binder(&ords), &under_surface)?;
-    let specular = mirror_reflectance(&ords, medium, thickness_nm, boundary);
+    let specular = mirror_reflectance(&ords, layers, boundary);
     Ok(StackReflection { ords, r, specular })
 }
 
 /// The unscattered light's reflectance per bin: the surface's Fresnel
 /// reflection `r_t` plus the direct beam's (transmittance `t` through the
-/// layer, δ-M extinction) returns from the lower surface (`r_b`, 0 in
+/// layers, δ-M extinction) returns from the lower surface (`r_b`, 0 in
 /// optical contact): `r_t + (1 − r_t)² t² r_b / (1 − r_t r_b t²)`.
 pub fn mirror_reflectance(
     ords: &Ordinates,
-    medium: &Medium,
-    thickness_nm: f64,
+    layers: &[(&Medium, f64)],
     boundary: Boundary,
 ) -> Vec<f64> {
-    let (mu_s, _) = medium.delta_m(2 * ords.len());
-    let direct = doubling::direct(ords, medium.mu_a + mu_s, thickness_nm);
+    let direct: Vec<Slab> = layers
+        .iter()
+        .map(|&(medium, thickness_nm)| {
+            let (mu_s, _) = medium.delta_m(2 * ords.len());
+            doubling::direct(ords, medium.mu_a + mu_s, thickness_nm)
+        })
+        .collect();
     (0..ords.len())
         .map(|i| {
             let Some(mu_a) = ords.mu_air[i] else {
@@ -162,7 +180,7 @@ pub fn mirror_reflectance(
                 Boundary::Scene => rt,
                 Boundary::Contact => 0.0,
             };
-            let t2 = direct.t_down[(i, i)].powi(2);
+            let t2: f64 = direct.iter().map(|d| d.t_down[(i, i)].powi(2)).product();
             rt + (1.0 - rt).powi(2) * t2 * rb / (1.0 - rt * rb * t2)
         })
         .collect()
@@ -176,17 +194,30 @@ pub fn reflectance_factors(
     measurements: &[Measurement],
     params: OrdinateParams,
 ) -> Result<Vec<Vec<f64>>, BaselineError> {
-    let ords = Ordinates::new(input.binder_index, params, &AIR_DIRECTIONS_DEG)?;
-    let mut out = vec![Vec::with_capacity(input.wavelengths_nm.len()); measurements.len()];
-    for l in 0..input.wavelengths_nm.len() {
-        let m = medium(input, l);
-        let s = stack(
-            ords.clone(),
-            &m,
-            input.thickness_nm,
-            input.paper_albedo,
-            boundary,
-        )?;
+    stack_reflectance_factors(std::slice::from_ref(input), boundary, measurements, params)
+}
+
+/// The same for a stack of layers (top first) of one binder on one grid:
+/// the binder, the paper and the grid are the top layer's.
+pub fn stack_reflectance_factors(
+    inputs: &[BaselineInput],
+    boundary: Boundary,
+    measurements: &[Measurement],
+    params: OrdinateParams,
+) -> Result<Vec<Vec<f64>>, BaselineError> {
+    let Some(top) = inputs.first() else {
+        return Ok(vec![Vec::new(); measurements.len()]);
+    };
+    let ords = Ordinates::new(top.binder_index, params, &AIR_DIRECTIONS_DEG)?;
+    let mut out = vec![Vec::with_capacity(top.wavelengths_nm.len()); measurements.len()];
+    for l in 0..top.wavelengths_nm.len() {
+        let media: Vec<Medium> = inputs.iter().map(|i| medium(i, l)).collect();
+        let layers: Vec<(&Medium, f64)> = media
+            .iter()
+            .zip(inputs)
+            .map(|(m, i)| (m, i.thickness_nm))
+            .collect();
+        let s = stack_of_layers(ords.clone(), &layers, top.paper_albedo, boundary)?;
         for (g, &geometry) in measurements.iter().enumerate() {
             out[g].push(s.factor(geometry)?);
         }

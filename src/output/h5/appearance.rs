@@ -227,24 +227,7 @@ pub(super) fn write_appearance(
             write_measured(s, &mg, m)?;
         }
     }
-    if !a.baseline.is_empty() {
-        let bg = g.create_group("baseline")?;
-        let mut models: Vec<Baseline> = Vec::new();
-        for b in &a.baseline {
-            if !models.contains(&b.model) {
-                models.push(b.model);
-            }
-        }
-        let names: Vec<&str> = models.iter().map(|m| m.name()).collect();
-        write_str_attr(&bg, "models", &names.join(","))?;
-        for model in models {
-            let mg = bg.create_group(model.name())?;
-            write_str_attr(&mg, "model", model.name())?;
-            for b in a.baseline.iter().filter(|b| b.model == model) {
-                write_baseline(s, &mg, b)?;
-            }
-        }
-    }
+    write_baselines(s, &g, &a.baseline)?;
     if let Some(png) = tile_png {
         let description = "the tile picture as a PNG file (encoded bytes, no units); byte";
         s.write(&g, "tile_png", png, about("", description, &[dim::BYTE]))?;
@@ -382,6 +365,35 @@ pub(super) fn write_measured(
         )?;
         let description = "standard error of the colour in ΔE00 (one value)";
         vector("de00_se", &[de], "1", description, dim::VALUE)?;
+    }
+    Ok(())
+}
+
+/// `/appearance/baseline`: every baseline model's colours, one group per
+/// model in the order first met (nothing when there are none).
+pub(super) fn write_baselines(
+    s: &mut Scales,
+    g: &hdf5::Group,
+    baseline: &[BaselineColour],
+) -> hdf5::Result<()> {
+    if baseline.is_empty() {
+        return Ok(());
+    }
+    let bg = g.create_group("baseline")?;
+    let mut models: Vec<Baseline> = Vec::new();
+    for b in baseline {
+        if !models.contains(&b.model) {
+            models.push(b.model);
+        }
+    }
+    let names: Vec<&str> = models.iter().map(|m| m.name()).collect();
+    write_str_attr(&bg, "models", &names.join(","))?;
+    for model in models {
+        let mg = bg.create_group(model.name())?;
+        write_str_attr(&mg, "model", model.name())?;
+        for b in baseline.iter().filter(|b| b.model == model) {
+            write_baseline(s, &mg, b)?;
+        }
     }
     Ok(())
 }

@@ -6,10 +6,11 @@
 
 use ndarray::{Array3, Ix2};
 
-use super::appearance::{write_estimate, write_measured};
+use super::appearance::{write_baselines, write_estimate, write_measured};
 use super::attrs::{write_scalar_attr, write_str_attr};
 use super::described::{about, dim, Scales};
 use crate::optics::appearance::{Estimate, MeasuredColour};
+use crate::optics::baseline::BaselineColour;
 use crate::optics::colour::{Illuminant, StandardObserver};
 
 /// Dimension names of the stack's tables.
@@ -51,6 +52,8 @@ pub struct StackTables {
     /// Radiance factor under a white sky, on the paper, (wavelength, viewing).
     pub natural: Estimate<Ix2>,
     pub measured: Vec<MeasuredColour>,
+    /// The classical baselines' colours (adding–doubling of the stack).
+    pub baseline: Vec<BaselineColour>,
     pub conditions: (Illuminant, StandardObserver),
 }
 
@@ -202,7 +205,7 @@ pub(super) fn write_stack(file: &hdf5::File, t: &StackTables, s: &mut Scales) ->
             write_measured(s, &mg, m)?;
         }
     }
-    Ok(())
+    write_baselines(s, &a, &t.baseline)
 }
 
 /// The mean reflectance, transmittance and absorption of a stack solved

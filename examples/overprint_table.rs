@@ -7,10 +7,14 @@
 //!   inksim run configs/study-overprint.toml
 //!   cargo run --release --example overprint_table -- runs/study-overprint
 //!
-//! Prints a Markdown table (docs/STACKS.md quotes it). Given two result
+//! Prints a Markdown table (docs/STACKS.md quotes it), then the classical
+//! baseline beside them: adding–doubling of the same stack (each variant's
+//! stored config) in 45°/0° and its ΔE00 to each coupling. Given two result
 //! files instead (`-- a.h5 b.h5`), prints their ΔE00 per geometry.
 
-use inksim::optics::colour::{delta_e2000, delta_e2000_se};
+use inksim::config::{parse_scene, Baseline, Measurement};
+use inksim::optics::baseline::stack_baseline_colours;
+use inksim::optics::colour::{delta_e2000, delta_e2000_se, Observer};
 use inksim::output::h5::{read_measured, MeasuredRecord};
 use std::path::Path;
 
@@ -80,6 +84,56 @@ fn main() {
                     lab(b)
                 );
             }
+        }
+    }
+    println!();
+    println!("| binder | inks | adding–doubling 45/0 L*, a*, b* | ΔE00 to incoherent | ΔE00 to coherent |");
+    println!("|---|---|---|---|---|");
+    for binder in ["n1.5", "n1.0"] {
+        for inks in ["yellow", "blue", "yellow-over-blue", "blue-over-yellow"] {
+            let name = format!("{inks}_coherent_{binder}");
+            let path = dir.join("variants").join(format!("{name}.h5"));
+            let text = hdf5::File::open(&path)
+                .and_then(|f| {
+                    f.dataset("config")?
+                        .read_scalar::<hdf5::types::VarLenUnicode>()
+                })
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .to_string();
+            let scene = parse_scene(&path, &text).expect("the stored config");
+            let st = scene.stack.as_ref().expect("a stack");
+            let inputs: Vec<_> = (0..st.layers.len())
+                .map(|i| {
+                    let layer = scene.stack_layer(i).expect("a layer");
+                    inksim::pipeline::baseline_input(&layer)
+                        .expect("baseline input")
+                        .expect("paper")
+                })
+                .collect();
+            let obs = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
+            let ad = stack_baseline_colours(
+                Baseline::AddingDoubling,
+                &inputs,
+                &[Measurement::FortyFiveZero],
+                &|_| None,
+                &obs,
+            )
+            .expect("adding-doubling");
+            let lab = ad[0].lab;
+            let to = |coupling: &str| {
+                let m = measured(dir, &format!("{inks}_{coupling}_{binder}"));
+                m.iter()
+                    .find(|c| c.geometry == "45/0")
+                    .map_or(f64::NAN, |c| delta_e2000(lab, c.lab))
+            };
+            println!(
+                "| {binder} | {inks} | {:.1}, {:.1}, {:.1} | {:.2} | {:.2} |",
+                lab[0],
+                lab[1],
+                lab[2],
+                to("incoherent"),
+                to("coherent")
+            );
         }
     }
 }

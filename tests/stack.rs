@@ -18,6 +18,13 @@ fn layer(pigment: PigmentToml, thickness_nm: f64) -> SceneToml {
         .pigment(pigment)
 }
 
+/// Yellow spheres (150 nm, 20 %) 300 nm thick over blue ones `blue_nm`
+/// thick.
+fn yellow_over_blue(blue_nm: f64) -> [SceneToml; 2] {
+    let ink = |name| PigmentToml::builtin(name).pvc(0.2).diameter_nm(150.0);
+    [layer(ink("yellow"), 300.0), layer(ink("blue"), blue_nm)]
+}
+
 /// The stack's settings around `layers`: 50 nm cells, three wavelengths,
 /// colours in the three geometries.
 fn stack(dir: &Path, layers: &[SceneToml], coupling: &str, name: &str) -> SceneToml {
@@ -169,16 +176,7 @@ fn a_stack_that_absorbs_nothing_conserves_energy() {
 #[test]
 fn both_couplings_solve_the_same_fragments() {
     let dir = tempfile::tempdir().unwrap();
-    let layers = [
-        layer(
-            PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0),
-            300.0,
-        ),
-        layer(
-            PigmentToml::builtin("blue").pvc(0.2).diameter_nm(150.0),
-            200.0,
-        ),
-    ];
+    let layers = yellow_over_blue(200.0);
     let apart = stack(dir.path(), &layers, "incoherent", "apart").run(dir.path());
     let together = stack(dir.path(), &layers, "coherent", "together").run(dir.path());
     let centres = |p: &Path| read(p, "geometry/centers_nm");
@@ -432,16 +430,7 @@ fn the_adding_doubling_baseline_of_a_stack_adds_its_layers() {
 #[test]
 fn a_stack_reports_its_adding_doubling_baseline_beside_its_colours() {
     let dir = tempfile::tempdir().unwrap();
-    let layers = [
-        layer(
-            PigmentToml::builtin("yellow").pvc(0.2).diameter_nm(150.0),
-            300.0,
-        ),
-        layer(
-            PigmentToml::builtin("blue").pvc(0.2).diameter_nm(150.0),
-            300.0,
-        ),
-    ];
+    let layers = yellow_over_blue(300.0);
     for coupling in ["incoherent", "coherent"] {
         let r = stack(dir.path(), &layers, coupling, coupling)
             .raw("appearance.baseline", "\"adding-doubling\"")

@@ -191,32 +191,26 @@ def test_datatree(tiny):
     assert t.attrs["seed"] == 3
 
 
+def _stack_layer(pigment):
+    return f"""[[stack]]
+[stack.layer]
+thickness_nm = 200.0
+fragment_nm = [400.0, 400.0]
+binder_index = 1.5
+[[stack.pigment]]
+name = "{pigment}"
+material = {{ builtin = "{pigment}" }}
+pvc = 0.15
+diameter_nm = 100.0
+
+"""
+
+
 STACK_SCENE = """\
 seed = 3
 realisations = 2
 
-[[stack]]
-[stack.layer]
-thickness_nm = 200.0
-fragment_nm = [400.0, 400.0]
-binder_index = 1.5
-[[stack.pigment]]
-name = "yellow"
-material = { builtin = "yellow" }
-pvc = 0.15
-diameter_nm = 100.0
-
-[[stack]]
-[stack.layer]
-thickness_nm = 200.0
-fragment_nm = [400.0, 400.0]
-binder_index = 1.5
-[[stack.pigment]]
-name = "blue"
-material = { builtin = "blue" }
-pvc = 0.15
-diameter_nm = 100.0
-
+""" + _stack_layer("yellow") + _stack_layer("blue") + """\
 [grid]
 cell_nm = 50.0
 z_cell_nm = 50.0

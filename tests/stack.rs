@@ -179,6 +179,13 @@ fn both_couplings_solve_the_same_fragments() {
     let layers = yellow_over_blue(200.0);
     let apart = stack(dir.path(), &layers, "incoherent", "apart").run(dir.path());
     let together = stack(dir.path(), &layers, "coherent", "together").run(dir.path());
+    // The whole stack's grid: 12 × 12 across, 6 + 4 cells of 50 nm.
+    for p in [&apart.result_path, &together.result_path] {
+        let g: Vec<u64> = hdf5::File::open(p)
+            .and_then(|f| f.attr("grid")?.read_raw())
+            .unwrap();
+        assert_eq!(g, [12, 12, 10], "{}", p.display());
+    }
     let centres = |p: &Path| read(p, "geometry/centers_nm");
     let (a, b) = (centres(&apart.result_path), centres(&together.result_path));
     assert!(!a.is_empty());

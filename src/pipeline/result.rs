@@ -111,7 +111,7 @@ impl ResultParts<'_> {
         let min_gap = geometry.map(|g| g.stats.min_gap_nm);
         let grid = match raster {
             Some(r) => [r.grid.nx, r.grid.ny, r.grid.nz],
-            None if scene.structure.is_some() => {
+            None if scene.structure.is_some() || scene.stack.is_some() => {
                 let g = grid_of(scene);
                 [g.nx, g.ny, g.nz]
             }

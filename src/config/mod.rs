@@ -22,8 +22,8 @@ pub use colour::{Illuminant, Measurement, StandardObserver};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
 pub use stack::{
-    stack_layer_seed, Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS,
-    DEFAULT_TRAPPED_DIRECTIONS, MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
+    Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS,
+    MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
 };
 
 /// Largest total pigment volume concentration a scene may ask for: what the

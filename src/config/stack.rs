@@ -55,21 +55,11 @@ pub struct Stack {
     pub escape_directions: usize,
 }
 
-/// The seed of stack layer `index` of a scene seeded `seed`: its fragments
-/// are that seed's realisations, the same under either coupling.
-pub fn stack_layer_seed(seed: u64, index: usize) -> u64 {
-    // SplitMix64 of the seed offset by the layer (as realisations are).
-    let mut z = (seed ^ 0x5354_4143_4b00_0000)
-        .wrapping_add((index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
 impl Scene {
-    /// Stack layer `index` as a scene of its own: its slab, pigments, grid
-    /// and seed, with everything else (light, solver, appearance, output)
-    /// the stack's. None for a scene without a stack.
+    /// Stack layer `index` as a scene of its own: its slab, pigments and
+    /// grid, with everything else (light, solver, appearance, output, seed)
+    /// the stack's; the pipeline seeds each layer's fragments. None for a
+    /// scene without a stack.
     pub fn stack_layer(&self, index: usize) -> Option<Scene> {
         let st = self.stack.as_ref()?;
         let l = st.layers.get(index)?;
@@ -78,7 +68,6 @@ impl Scene {
         scene.layer = l.layer.clone();
         scene.species = l.species.clone();
         scene.grid = l.grid;
-        scene.seed = stack_layer_seed(self.seed, index);
         Some(scene)
     }
 }

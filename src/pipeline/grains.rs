@@ -5,7 +5,7 @@
 
 use std::fmt;
 
-use crate::config::{stack_layer_seed, GrainOrientation, GrainShape, GrainSize, Scene};
+use crate::config::{GrainOrientation, GrainShape, GrainSize, Scene};
 use crate::geometry::{
     self, DynParams, DynSpecies, Geometry, Orientation, PackParams, Shape, SizeDistribution,
     SpeciesOptions, SpeciesParams, StackPart,
@@ -101,6 +101,26 @@ pub fn largest_grain_nm(scene: &Scene) -> f64 {
         .iter()
         .map(|s| s.size.max_diameter(s.diameter_nm))
         .fold(0.0, f64::max)
+}
+
+/// The seed of stack layer `index` from a realisation's seed `seed`: its
+/// own stream, [`realisation_seed`] of the seed marked for stacks, so the
+/// layer's fragment is the same under either coupling.
+pub fn stack_layer_seed(seed: u64, index: usize) -> u64 {
+    realisation_seed(seed ^ 0x5354_4143_4b00_0000, index + 1)
+}
+
+/// Seed of realisation `r`: the scene's seed for r = 0 (so a
+/// one-realisation run equals the plain scene), else SplitMix64 of
+/// `seed + r · 0x9E3779B97F4A7C15` — fixed by (seed, r), never by scheduling.
+pub fn realisation_seed(seed: u64, r: usize) -> u64 {
+    if r == 0 {
+        return seed;
+    }
+    let mut z = seed.wrapping_add((r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 /// Build the particle set of a scene (realisation 0) with the packer it needs.

@@ -60,8 +60,10 @@ use crate::solver;
 pub use appearance::{appearance_spec, PROXY_STEP_NM};
 pub use baseline::{add_baseline, baseline_input};
 pub use eps::fraction_eps;
-pub use grains::{build_geometry, build_geometry_seeded, grid_of, Packer, RSA_MAX_PVC};
-pub use plan::{plan_text, planned_solves, realisation_seed, RunPlan};
+pub use grains::{
+    build_geometry, build_geometry_seeded, grid_of, realisation_seed, Packer, RSA_MAX_PVC,
+};
+pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};
 pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps, ENERGY_BALANCE_LIMIT};

@@ -5,9 +5,7 @@
 //! which appearance products. Every decision is one line of the plan that is
 //! logged and stored with the results.
 
-use crate::config::{
-    stack_layer_seed, GrainShape, Incidence, Scene, StackCoupling, Structure, Substrate, Surface,
-};
+use crate::config::{GrainShape, Incidence, Scene, StackCoupling, Structure, Substrate, Surface};
 use crate::optics::baseline::ordinates::{OrdinateParams, Ordinates};
 use crate::optics::effective_medium::{self, GrainClass, WorstError};
 use crate::optics::farfield::table::TableSpec;
@@ -15,21 +13,8 @@ use crate::optics::farfield::{Side, SolveEntry};
 use crate::optics::substrate::Hemisphere;
 
 use super::eps::species_eps;
-use super::grains::{largest_grain_nm, Packer, RSA_MAX_PVC};
+use super::grains::{largest_grain_nm, realisation_seed, stack_layer_seed, Packer, RSA_MAX_PVC};
 use super::surface::surface_line;
-
-/// Seed of realisation `r`: the scene's seed for r = 0 (so a
-/// one-realisation run equals the plain scene), else SplitMix64 of
-/// `seed + r · 0x9E3779B97F4A7C15` — fixed by (seed, r), never by scheduling.
-pub fn realisation_seed(seed: u64, r: usize) -> u64 {
-    if r == 0 {
-        return seed;
-    }
-    let mut z = seed.wrapping_add((r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
 
 /// What a run computes and what it skips, derived from what the scene asks
 /// for: only the effects a scene calls for.

@@ -12,12 +12,12 @@ use num_complex::Complex64 as C64;
 
 use crate::config::{Scene, Substrate};
 use crate::geometry::{self, Geometry, StackPart};
-use crate::optics::appearance::{self, AppearanceError, MeasuredColour};
+use crate::optics::appearance::{self, MeasuredColour};
 use crate::optics::baseline::adding::Slab;
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::colour::Observer;
-use crate::optics::farfield::{Side, SolveEntry};
+use crate::optics::farfield::Side;
 use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab};
 use crate::output::h5::{LayerMatrices, StackTables};
 use crate::solver::airy;
@@ -175,14 +175,10 @@ fn combine(
             for (i, s) in solved.iter().enumerate() {
                 let n = s.realisations.len().max(1);
                 let find = |side: Side, j: usize| {
-                    find_solve(&s.entries, side, r % n, w, nodes[j]).map(|e| &e.efficiencies)
+                    appearance::find_entry(&s.entries, side, r % n, w, nodes[j])
+                        .map(|e| &e.efficiencies)
                 };
-                let slab = stack::layer_slab(&q, k, &find).ok_or(AppearanceError::Missing {
-                    side: Side::Above,
-                    realisation: r % n,
-                    wavelength_nm: w,
-                    polar_deg: nodes[0],
-                })?;
+                let slab = stack::layer_slab(&q, k, &find)?;
                 let t = &slab.total;
                 for (acc, m) in means[i]
                     .iter_mut()
@@ -273,22 +269,6 @@ fn combine(
         measured,
         baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
-    })
-}
-
-/// The solve of `entries` from `side` at `polar` for realisation `r` at `wl`.
-fn find_solve(
-    entries: &[SolveEntry],
-    side: Side,
-    r: usize,
-    wl: f64,
-    polar: f64,
-) -> Option<&SolveEntry> {
-    entries.iter().find(|e| {
-        e.side == side
-            && e.realisation == r
-            && e.wavelength_nm == wl
-            && e.incidence.polar_deg == polar
     })
 }
 

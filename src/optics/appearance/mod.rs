@@ -163,7 +163,7 @@ pub fn reduce<D: Dimension>(samples: &[Array<f64, D>]) -> Estimate<D> {
 
 /// The solve of realisation `r` at wavelength `wl` and polar angle `polar`
 /// from `side`.
-pub(super) fn find_entry(
+pub fn find_entry(
     entries: &[SolveEntry],
     side: Side,
     r: usize,

@@ -150,14 +150,6 @@ impl BinQuadrature {
     }
 }
 
-/// The power of the specular (0, 0) order: reflected and transmitted.
-fn specular(eff: &Efficiencies) -> (f64, f64) {
-    eff.orders
-        .iter()
-        .find(|o| o.m == 0 && o.n == 0)
-        .map_or((0.0, 0.0), |o| (o.reflectance, o.transmittance))
-}
-
 /// A layer's flux matrices: all of its scattering, and its specular part
 /// alone (the unscattered light, diagonal).
 #[derive(Debug, Clone)]
@@ -167,12 +159,13 @@ pub struct LayerSlab {
 }
 
 /// The layer of one realisation at one wavelength from its solves:
-/// `solve(side, j)` is the solve lit from `side` at node `j`'s angle.
-pub fn layer_slab<'e>(
+/// `solve(side, j)` is the solve lit from `side` at node `j`'s angle, or
+/// why there is none.
+pub fn layer_slab<'e, E>(
     q: &BinQuadrature,
     k: usize,
-    solve: &dyn Fn(Side, usize) -> Option<&'e Efficiencies>,
-) -> Option<LayerSlab> {
+    solve: &dyn Fn(Side, usize) -> Result<&'e Efficiencies, E>,
+) -> Result<LayerSlab, E> {
     let mut total = Slab::transparent(k);
     let mut spec = Slab::transparent(k);
     for (side, r, t, rs, ts) in [
@@ -195,7 +188,9 @@ pub fn layer_slab<'e>(
         *ts = Matrix::zeros(k);
         for j in 0..k {
             let eff = solve(side, j)?;
-            let (r00, t00) = specular(eff);
+            // The specular (0, 0) order's power, |r00|² and |t00|² (the
+            // same medium above and below).
+            let (r00, t00) = (eff.r00.norm_sqr(), eff.t00.norm_sqr());
             let cr = q.diffuse_column(eff, Part::DiffuseReflection);
             let ct = q.diffuse_column(eff, Part::DiffuseTransmission);
             for i in 0..k {
@@ -208,7 +203,7 @@ pub fn layer_slab<'e>(
             ts[(j, j)] = t00;
         }
     }
-    Some(LayerSlab {
+    Ok(LayerSlab {
         total,
         specular: spec,
     })

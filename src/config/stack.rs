@@ -56,6 +56,14 @@ pub struct Stack {
 }
 
 impl Scene {
+    /// Whether the scene is a stack solved layer by layer (incoherent
+    /// coupling), which runs, plans and writes its own way.
+    pub fn is_incoherent_stack(&self) -> bool {
+        self.stack
+            .as_ref()
+            .is_some_and(|s| s.coupling == StackCoupling::Incoherent)
+    }
+
     /// Stack layer `index` as a scene of its own: its slab, pigments and
     /// grid, with everything else (light, solver, appearance, output, seed)
     /// the stack's; the pipeline seeds each layer's fragments. None for a

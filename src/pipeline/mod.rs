@@ -151,11 +151,7 @@ pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
     let orders = p.brdf || p.btdf;
     let mut files = vec![h5];
     // A stack solved layer by layer writes its colours in the result alone.
-    if scene
-        .stack
-        .as_ref()
-        .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent)
-    {
+    if scene.is_incoherent_stack() {
         return files;
     }
     if p.tile || orders {

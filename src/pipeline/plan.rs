@@ -5,7 +5,7 @@
 //! which appearance products. Every decision is one line of the plan that is
 //! logged and stored with the results.
 
-use crate::config::{GrainShape, Incidence, Scene, StackCoupling, Structure, Substrate, Surface};
+use crate::config::{GrainShape, Incidence, Scene, Structure, Substrate, Surface};
 use crate::optics::baseline::ordinates::{OrdinateParams, Ordinates};
 use crate::optics::effective_medium::{self, GrainClass, WorstError};
 use crate::optics::farfield::table::TableSpec;
@@ -46,11 +46,7 @@ pub struct RunPlan {
 impl RunPlan {
     /// Derive the plan of a scene.
     pub fn of(scene: &Scene) -> RunPlan {
-        if scene
-            .stack
-            .as_ref()
-            .is_some_and(|s| s.coupling == StackCoupling::Incoherent)
-        {
+        if scene.is_incoherent_stack() {
             return stack_plan(scene);
         }
         let explicit = scene.structure.is_some();
@@ -552,7 +548,6 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
     let st = scene.stack.as_ref().expect("a stack");
     let ords = stack_ordinates(scene);
     let nodes = node_deg(&ords);
-    let mut scenes = Vec::with_capacity(st.layers.len());
     let mut plans = Vec::with_capacity(st.layers.len());
     let mut lines = vec![format!(
         "stack: {} layer{} from the top ({}), coupled incoherently: each solved on its own \
@@ -622,16 +617,16 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
             2 * nodes.len(),
             if p.analytic { ", in closed form" } else { "" }
         ));
-        scenes.push(ls);
         plans.push(p);
     }
     let realisations = plans.iter().map(|p| p.realisations).max().unwrap_or(1);
-    let cell = scenes
+    let cell = st
+        .layers
         .iter()
-        .map(|ls| {
+        .map(|l| {
             TableSpec::default_cell(
                 scene.wavelengths_nm.last().copied().unwrap_or(1.0) / scene.layer.binder_index,
-                [ls.layer.fragment_x_nm, ls.layer.fragment_y_nm],
+                [l.layer.fragment_x_nm, l.layer.fragment_y_nm],
             )
         })
         .fold(0.0, f64::max);
@@ -639,7 +634,7 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
         "stack tables: each solve's orders spread on a table of cell {cell:.4} in sin θ (binder) \
          and integrated over each direction's bin"
     ));
-    let plan = RunPlan {
+    RunPlan {
         analytic: plans.iter().all(|p| p.analytic),
         realisations,
         seeds: (0..realisations)
@@ -651,6 +646,5 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
         lines,
         embedded: true,
         layers: plans,
-    };
-    plan
+    }
 }

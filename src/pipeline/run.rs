@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::config::{Scene, StackCoupling, Structure};
+use crate::config::{Scene, Structure};
 use crate::geometry::{self, Geometry, StatsParams};
 use crate::optics::appearance::{self, Appearance};
 use crate::optics::colour::Observer;
@@ -40,11 +40,7 @@ pub fn run_with(
     quiet: bool,
     limit: Option<MemoryLimit>,
 ) -> Result<RunReport, PipelineError> {
-    if scene
-        .stack
-        .as_ref()
-        .is_some_and(|s| s.coupling == StackCoupling::Incoherent)
-    {
+    if scene.is_incoherent_stack() {
         return super::stack::run(scene, quiet, limit);
     }
     let (result_path, picture_path) = result_paths(scene);

@@ -56,6 +56,32 @@ impl TableSpec {
     pub fn coord(&self, i: usize) -> f64 {
         (i as f64 - self.half as f64) * self.cell
     }
+
+    /// Bilinear cell and weights of `s`: lower node indices and fractions
+    /// (None outside the table).
+    pub fn locate(&self, sx: f64, sy: f64) -> Option<(usize, usize, f64, f64)> {
+        let h = self.half as f64;
+        let (x, y) = (sx / self.cell + h, sy / self.cell + h);
+        let max = (self.n() - 1) as f64;
+        if !(x >= 0.0 && y >= 0.0 && x <= max && y <= max) {
+            return None;
+        }
+        let (i, j) = (
+            (x.floor() as usize).min(self.n() - 2),
+            (y.floor() as usize).min(self.n() - 2),
+        );
+        Some((i, j, x - i as f64, y - j as f64))
+    }
+
+    /// Node values `v` (row-major `[j][i]`) read bilinearly in the cell
+    /// [`Self::locate`] gave.
+    pub fn bilinear(&self, v: &[f64], (i, j, fx, fy): (usize, usize, f64, f64)) -> f64 {
+        let n = self.n();
+        v[j * n + i] * (1.0 - fx) * (1.0 - fy)
+            + v[j * n + i + 1] * fx * (1.0 - fy)
+            + v[(j + 1) * n + i] * (1.0 - fx) * fy
+            + v[(j + 1) * n + i + 1] * fx * fy
+    }
 }
 
 /// A density table `D(s)`, row-major `[j][i]` (j along s_y).
@@ -73,26 +99,11 @@ impl AngularTable {
         }
     }
 
-    /// Bilinear cell and weights of `s`: lower node indices and fractions.
-    fn locate(&self, sx: f64, sy: f64) -> Option<(usize, usize, f64, f64)> {
-        let h = self.spec.half as f64;
-        let (x, y) = (sx / self.spec.cell + h, sy / self.spec.cell + h);
-        let max = (self.spec.n() - 1) as f64;
-        if !(x >= 0.0 && y >= 0.0 && x <= max && y <= max) {
-            return None;
-        }
-        let (i, j) = (
-            (x.floor() as usize).min(self.spec.n() - 2),
-            (y.floor() as usize).min(self.spec.n() - 2),
-        );
-        Some((i, j, x - i as f64, y - j as f64))
-    }
-
     /// Spread power `p` arriving at direction `s` onto the four nearest nodes.
     pub fn deposit(&mut self, sx: f64, sy: f64, p: f64) {
         let n = self.spec.n();
         let area = self.spec.cell * self.spec.cell;
-        let Some((i, j, fx, fy)) = self.locate(sx, sy) else {
+        let Some((i, j, fx, fy)) = self.spec.locate(sx, sy) else {
             // |s| ≤ 1 always lies inside the table.
             debug_assert!(false, "direction outside the table");
             return;
@@ -111,17 +122,9 @@ impl AngularTable {
 
     /// `D(s)` by bilinear interpolation (0 outside the table).
     pub fn density_at(&self, sx: f64, sy: f64) -> f64 {
-        let n = self.spec.n();
-        match self.locate(sx, sy) {
-            None => 0.0,
-            Some((i, j, fx, fy)) => {
-                let d = &self.density;
-                d[j * n + i] * (1.0 - fx) * (1.0 - fy)
-                    + d[j * n + i + 1] * fx * (1.0 - fy)
-                    + d[(j + 1) * n + i] * (1.0 - fx) * fy
-                    + d[(j + 1) * n + i + 1] * fx * fy
-            }
-        }
+        self.spec
+            .locate(sx, sy)
+            .map_or(0.0, |at| self.spec.bilinear(&self.density, at))
     }
 
     /// The scattering function `f = D / C` (1/sr) in direction `(θ, φ)`,
@@ -129,7 +132,7 @@ impl AngularTable {
     pub fn value_at(&self, theta_deg: f64, phi_deg: f64) -> f64 {
         let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
         let (sx, sy) = (t.sin() * p.cos(), t.sin() * p.sin());
-        let Some((i, j, fx, fy)) = self.locate(sx, sy) else {
+        let Some((i, j, fx, fy)) = self.spec.locate(sx, sy) else {
             return 0.0;
         };
         let c = |ii: usize, jj: usize| node_coverage(self.spec, ii, jj);

@@ -29,13 +29,12 @@ const RADIAL_POINTS: usize = 4;
 /// Azimuthal points of the annulus quadrature.
 const AZIMUTH_POINTS: usize = 64;
 
-/// One quadrature point of a bin: the table cell it lies in, its bilinear
-/// fractions, its weight (projected solid angle) and the coverage there.
+/// One quadrature point of a bin: the table cell it lies in with its
+/// bilinear fractions ([`TableSpec::locate`]), its weight (projected solid
+/// angle) and the coverage there.
 #[derive(Debug, Clone, Copy)]
 struct Point {
-    cell: usize,
-    fx: f64,
-    fy: f64,
+    at: (usize, usize, f64, f64),
     weight: f64,
     coverage: f64,
 }
@@ -72,24 +71,14 @@ impl BinQuadrature {
                 let w_rho = 0.5 * (s_hi - s_lo) * wr * rho * dphi;
                 for a in 0..AZIMUTH_POINTS {
                     let phi = (a as f64 + 0.5) * dphi;
-                    let (sx, sy) = (rho * phi.cos(), rho * phi.sin());
-                    let h = spec.half as f64;
-                    let (gx, gy) = (sx / spec.cell + h, sy / spec.cell + h);
-                    let (i, j) = (
-                        (gx.floor() as usize).min(n - 2),
-                        (gy.floor() as usize).min(n - 2),
-                    );
-                    let (fx, fy) = (gx - i as f64, gy - j as f64);
-                    let cov = coverage[j * n + i] * (1.0 - fx) * (1.0 - fy)
-                        + coverage[j * n + i + 1] * fx * (1.0 - fy)
-                        + coverage[(j + 1) * n + i] * (1.0 - fx) * fy
-                        + coverage[(j + 1) * n + i + 1] * fx * fy;
+                    // |s| ≤ 1 always lies inside the table.
+                    let Some(at) = spec.locate(rho * phi.cos(), rho * phi.sin()) else {
+                        continue;
+                    };
                     points.push(Point {
-                        cell: j * n + i,
-                        fx,
-                        fy,
+                        at,
                         weight: w_rho,
-                        coverage: cov,
+                        coverage: spec.bilinear(&coverage, at),
                     });
                 }
             }
@@ -106,22 +95,13 @@ impl BinQuadrature {
     /// The flux of `t` in each bin: `∫ f d²s` over the bin's annulus, with
     /// `f = D / C` the table's scattering function.
     pub fn bin_fluxes(&self, t: &AngularTable) -> Vec<f64> {
-        let n = self.spec.n();
-        let d = &t.density;
         self.bins
             .iter()
             .map(|points| {
                 points
                     .iter()
                     .filter(|p| p.coverage > 0.0)
-                    .map(|p| {
-                        let (c, fx, fy) = (p.cell, p.fx, p.fy);
-                        let v = d[c] * (1.0 - fx) * (1.0 - fy)
-                            + d[c + 1] * fx * (1.0 - fy)
-                            + d[c + n] * (1.0 - fx) * fy
-                            + d[c + n + 1] * fx * fy;
-                        p.weight * v / p.coverage
-                    })
+                    .map(|p| p.weight * self.spec.bilinear(&t.density, p.at) / p.coverage)
                     .sum()
             })
             .collect()

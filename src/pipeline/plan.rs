@@ -97,6 +97,17 @@ impl RunPlan {
         self.above_deg.len() + self.below.as_ref().map_or(0, |h| h.mu.len())
     }
 
+    /// Permittivity of the medium above and below the layer as solved:
+    /// the binder's when `embedded` (then the problem is solved at `λ/n_b`
+    /// with `ε/ε_b`), else vacuum's, 1.
+    pub fn outside_eps(&self, scene: &Scene) -> f64 {
+        if self.embedded {
+            scene.layer.binder_index.powi(2)
+        } else {
+            1.0
+        }
+    }
+
     /// Total solves of a run.
     pub fn solves(&self, scene: &Scene) -> usize {
         let per_layer = |p: &RunPlan| p.realisations * p.solves_per_wavelength();

@@ -82,8 +82,7 @@ pub fn solve_layer(
         LayerEps::Grid(_, g) => g,
     };
     let eps_b = scene.layer.binder_index.powi(2);
-    // Inside the binder: λ/n_b and ε/ε_b (RunPlan::embedded).
-    let outside = if plan.embedded { eps_b } else { 1.0 };
+    let outside = plan.outside_eps(scene);
     let ctl = controls(scene);
     let incs = incidences(scene, plan);
     let mut eps = Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0));
@@ -230,8 +229,7 @@ pub fn solve_analytic(
     let incs = incidences(scene, plan);
     let ctl = controls(scene);
     let eps_b = scene.layer.binder_index.powi(2);
-    // Inside the binder: λ/n_b and ε/ε_b (RunPlan::embedded).
-    let outside = if plan.embedded { eps_b } else { 1.0 };
+    let outside = plan.outside_eps(scene);
     let why = if scene.is_molecular() {
         "molecular mixture"
     } else {

@@ -138,23 +138,13 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
         for i in 0..st.layers.len() {
             let ls = scene.stack_layer(i).expect("a layer of the stack");
             let g = if ls.is_molecular() {
-                geometry::without_grains(
-                    fragment_nm(&ls),
-                    ls.species.iter().map(|s| s.volume_fraction).collect(),
-                )
+                None
             } else {
-                build_geometry_seeded(&ls, stack_layer_seed(seed, i))?
+                Some(build_geometry_seeded(&ls, stack_layer_seed(seed, i))?)
             };
-            layers.push((g, ls.species.len()));
+            layers.push((g, ls));
         }
-        let parts: Vec<StackPart> = layers
-            .iter()
-            .map(|(geometry, species)| StackPart {
-                geometry,
-                species: *species,
-            })
-            .collect();
-        return Ok(geometry::stacked(&parts));
+        return Ok(stacked_geometry(layers));
     }
     let l = &scene.layer;
     let size_nm = fragment_nm(scene);
@@ -206,6 +196,33 @@ pub fn build_geometry_seeded(scene: &Scene, seed: u64) -> Result<Geometry, Pipel
             Ok(geometry::pack_dynamics(&params, seed)?)
         }
     }
+}
+
+/// The fragments of a stack's layers, top first, each with its scene, as
+/// one fragment; a layer without grains (`None`: dissolved pigments, or
+/// the homogeneous slab it was solved as) keeps its species' fractions.
+pub fn stacked_geometry(layers: Vec<(Option<Geometry>, Scene)>) -> Geometry {
+    let (own, scenes): (Vec<Geometry>, Vec<Scene>) = layers
+        .into_iter()
+        .map(|(g, ls)| {
+            let g = g.unwrap_or_else(|| {
+                geometry::without_grains(
+                    fragment_nm(&ls),
+                    ls.species.iter().map(|s| s.volume_fraction).collect(),
+                )
+            });
+            (g, ls)
+        })
+        .unzip();
+    let parts: Vec<StackPart> = own
+        .iter()
+        .zip(&scenes)
+        .map(|(geometry, ls)| StackPart {
+            geometry,
+            species: ls.species.len(),
+        })
+        .collect();
+    geometry::stacked(&parts)
 }
 
 /// The raster grid of a scene: the configured cells over the layer, plus,

@@ -11,7 +11,6 @@ use ndarray::{Array1, Array2, Array3};
 use num_complex::Complex64 as C64;
 
 use crate::config::{Scene, Substrate};
-use crate::geometry::{self, Geometry, StackPart};
 use crate::optics::appearance::{self, MeasuredColour};
 use crate::optics::baseline::adding::Slab;
 use crate::optics::baseline::matrix::Matrix;
@@ -24,7 +23,7 @@ use crate::solver::airy;
 
 use super::appearance::fine_grid;
 use super::eps::mean_eps;
-use super::grains::fragment_nm;
+use super::grains::stacked_geometry;
 use super::layer::{self, SolvedLayer};
 use super::memory::{self, MemoryLimit};
 use super::plan::{node_deg, plan_text, stack_air_angles, stack_ordinates, stack_plan, RunPlan};
@@ -70,7 +69,14 @@ pub fn run(
     }
     progress.finish("all solves done");
     let tables = combine(scene, &plan, &scenes, &solved)?;
-    let geometry = stacked_geometry(&scenes, &solved);
+    // Realisation 0 of every layer as one fragment.
+    let geometry = stacked_geometry(
+        solved
+            .iter()
+            .zip(&scenes)
+            .map(|(s, ls)| (s.geometry.clone(), ls.clone()))
+            .collect(),
+    );
     let thickness = scene.layer.thickness_nm;
     let realisations: Vec<(u64, f64)> = (0..plan.realisations)
         .map(|r| {
@@ -114,31 +120,6 @@ pub fn run(
         entries,
         appearance: None,
     })
-}
-
-/// Realisation 0 of every layer as one fragment.
-fn stacked_geometry(scenes: &[Scene], solved: &[SolvedLayer]) -> Geometry {
-    let own: Vec<Geometry> = scenes
-        .iter()
-        .zip(solved)
-        .map(|(ls, s)| {
-            s.geometry.clone().unwrap_or_else(|| {
-                geometry::without_grains(
-                    fragment_nm(ls),
-                    ls.species.iter().map(|x| x.volume_fraction).collect(),
-                )
-            })
-        })
-        .collect();
-    let parts: Vec<StackPart> = own
-        .iter()
-        .zip(scenes)
-        .map(|(geometry, ls)| StackPart {
-            geometry,
-            species: ls.species.len(),
-        })
-        .collect();
-    geometry::stacked(&parts)
 }
 
 /// The solves of the layers combined: per realisation and wavelength the

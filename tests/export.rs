@@ -263,7 +263,7 @@ fn a_result_with_the_earlier_single_model_layout_still_reads() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("old.h5");
     {
-        let f = hdf5::File::create(&path).unwrap();
+        let f = inksim::output::h5::create(&path).unwrap();
         let g = f.create_group("appearance/baseline").unwrap();
         let text = |s: &str| s.parse::<VarLenUnicode>().unwrap();
         g.new_attr::<VarLenUnicode>()

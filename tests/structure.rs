@@ -183,7 +183,7 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
     }
     let h5 = dir.path().join("eps.h5");
     {
-        let f = hdf5::File::create(&h5).unwrap();
+        let f = inksim::output::h5::create(&h5).unwrap();
         f.new_dataset_builder()
             .with_data(&re)
             .create("eps_re")
@@ -244,7 +244,7 @@ fn check_reads_a_structure_file_as_a_run_would() {
     let g = pipeline::grid_of(&text.scene(dir.path()));
     let grid = |v: f64| ndarray::Array3::<f64>::from_elem((g.nz, g.ny, g.nx), v);
     let write = |sets: &[(&str, ndarray::Array3<f64>)]| {
-        let f = hdf5::File::create(&h5).unwrap();
+        let f = inksim::output::h5::create(&h5).unwrap();
         for (name, a) in sets {
             f.new_dataset_builder().with_data(a).create(*name).unwrap();
         }

@@ -304,7 +304,7 @@ impl Extra {
             path: path.to_path_buf(),
             source,
         };
-        let g = hdf5::File::open(path)
+        let g = crate::output::h5::open(path)
             .and_then(|f| f.group("appearance"))
             .map_err(hdf)?;
         let two = |name: &str| read_optional::<f64, ndarray::Ix2>(&g, name).map_err(hdf);

@@ -59,7 +59,7 @@ pub fn read_appearance(path: &Path) -> Result<Option<AppearanceArrays>, IoError>
         path: path.to_path_buf(),
         source,
     };
-    let file = hdf5::File::open(path).map_err(hdf)?;
+    let file = super::open(path).map_err(hdf)?;
     // A stack solved layer by layer keeps only its colours in /appearance.
     if !file.link_exists("appearance") || !file.link_exists("appearance/wavelengths_nm") {
         return Ok(None);
@@ -106,7 +106,7 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
         path: path.to_path_buf(),
         source,
     };
-    let file = hdf5::File::open(path).map_err(hdf)?;
+    let file = super::open(path).map_err(hdf)?;
     if !file.link_exists("appearance/measured") {
         return Ok(None);
     }
@@ -156,7 +156,7 @@ pub fn read_baseline(path: &Path) -> Result<Vec<BaselineRecord>, IoError> {
         path: path.to_path_buf(),
         source,
     };
-    let file = hdf5::File::open(path).map_err(hdf)?;
+    let file = super::open(path).map_err(hdf)?;
     if !file.link_exists("appearance/baseline") {
         return Ok(Vec::new());
     }

@@ -15,7 +15,9 @@
 //!   readers;
 //! - `attrs`: scalar and string attribute helpers shared by all of them;
 //! - `described`: every dataset's `units`, `description` and axis names,
-//!   written with it; `scales`: the HDF5 dimension scales behind the axes.
+//!   written with it; `scales`: the HDF5 dimension scales behind the axes;
+//! - `file`: [`create`] and [`open`], which every reader and writer uses, so
+//!   that no child process inherits an open file and its lock.
 //!
 //! # Layout
 //!
@@ -29,6 +31,7 @@ mod appearance;
 mod appearance_read;
 mod attrs;
 mod described;
+mod file;
 mod geometry;
 mod result;
 mod scales;
@@ -41,6 +44,7 @@ pub use appearance_read::{
     MeasuredRecord,
 };
 pub(crate) use described::{about, dim, Scales};
+pub use file::{create, open};
 pub use geometry::GeometrySummary;
 pub use result::{write_result, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};

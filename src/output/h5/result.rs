@@ -74,7 +74,7 @@ pub fn write_result(path: &Path, set: &ResultSet) -> Result<(), IoError> {
             path: tmp.to_path_buf(),
             source,
         };
-        let file = hdf5::File::create(tmp).map_err(hdf)?;
+        let file = super::create(tmp).map_err(hdf)?;
         write_contents(&file, set).map_err(hdf)?;
         file.close().map_err(hdf)
     })

@@ -216,7 +216,7 @@ pub fn read_stack_totals(path: &std::path::Path) -> Result<Option<[f64; 3]>, sup
         path: path.to_path_buf(),
         source,
     };
-    let file = hdf5::File::open(path).map_err(hdf)?;
+    let file = super::open(path).map_err(hdf)?;
     if !file.link_exists("stack/reflectance") {
         return Ok(None);
     }

@@ -72,7 +72,7 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
             source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
         });
     }
-    let file = hdf5::File::open(path).map_err(hdf)?;
+    let file = super::open(path).map_err(hdf)?;
     let root: &Location = &file;
     let version = read_str_attr(root, "inksim_version").map_err(hdf)?;
     let input_hash = read_str_attr(root, "input_hash").map_err(hdf)?;

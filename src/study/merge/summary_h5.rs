@@ -27,7 +27,7 @@ pub(super) fn write_summary_h5(
             path: tmp.to_path_buf(),
             source,
         };
-        let f = hdf5::File::create(tmp).map_err(h)?;
+        let f = crate::output::h5::create(tmp).map_err(h)?;
         for (name, v) in [
             ("study", study.name.as_str()),
             ("profile", exp.profile.as_deref().unwrap_or("")),

@@ -150,8 +150,12 @@ pub fn output_files(scene: &Scene) -> Vec<PathBuf> {
     let p = scene.appearance.products;
     let orders = p.brdf || p.btdf;
     let mut files = vec![h5];
-    // A stack solved layer by layer writes its colours in the result alone.
+    // A stack solved layer by layer draws its tile alone (no orders, no
+    // BRDF plots: it carries the plane of incidence only).
     if scene.is_incoherent_stack() {
+        if p.tile {
+            files.push(png);
+        }
         return files;
     }
     if p.tile || orders {

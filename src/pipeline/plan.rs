@@ -594,13 +594,19 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
             Substrate::None => "air".to_string(),
         }
     )];
-    lines.push(
-        "not made for an incoherent stack: the BRDF square, the tile picture and the plots — \
-         the adding carries each layer's azimuthal mean, which gives the measurement \
-         geometries and the white sky exactly, not the BRDF at other azimuths (coupling \
-         \"coherent\" makes them)"
-            .to_string(),
-    );
+    lines.push(if scene.appearance.products.tile {
+        format!(
+            "tile: the BRDF square in the plane of incidence from {} azimuthal Fourier terms of \
+             each layer, added term by term (each layer taken as isotropic in its plane); not \
+             made for an incoherent stack: the orders picture and the BRDF plots, which need \
+             every azimuth (coupling \"coherent\" makes them)",
+            crate::optics::stack::AZIMUTHAL_TERMS
+        )
+    } else {
+        "no tile asked for: the adding carries each layer's azimuthal mean only, which gives \
+         the measurement geometries and the white sky exactly"
+            .to_string()
+    });
     for i in 0..st.layers.len() {
         let ls = scene.stack_layer(i).expect("a layer of the stack");
         let mut p = RunPlan::of(&ls);

@@ -11,7 +11,7 @@ use ndarray::{Array1, Array2, Array3};
 use num_complex::Complex64 as C64;
 
 use crate::config::{Scene, Substrate};
-use crate::optics::appearance::{self, MeasuredColour};
+use crate::optics::appearance::{self, MeasuredColour, TileSpectra};
 use crate::optics::baseline::adding::Slab;
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
@@ -19,6 +19,7 @@ use crate::optics::colour::Observer;
 use crate::optics::farfield::Side;
 use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab};
 use crate::output::h5::{LayerMatrices, StackTables};
+use crate::output::{atomic, render};
 use crate::solver::airy;
 
 use super::appearance::fine_grid;
@@ -36,7 +37,7 @@ pub fn run(
     quiet: bool,
     limit: Option<MemoryLimit>,
 ) -> Result<RunReport, PipelineError> {
-    let (result_path, _) = result_paths(scene);
+    let (result_path, picture_path) = result_paths(scene);
     check_output_files(scene)?;
     check_output_dir(&scene.output.dir)?;
     let mut plan = stack_plan(scene);
@@ -97,6 +98,34 @@ pub fn run(
         plan.realisations,
         if plan.realisations == 1 { "" } else { "s" }
     ));
+    let tile_png = match &tables.colours {
+        Some(c) => Some(render::tile::tile_png(
+            &c.tile_srgb8,
+            &c.tile_lab,
+            &tables.viewing_deg,
+            &tables.illumination_deg,
+            &render::tile::TileCaption {
+                name: &scene.output.name,
+                observer: &Observer::standard(
+                    scene.appearance.illuminant,
+                    scene.appearance.observer,
+                ),
+                paper_albedo: match scene.substrate {
+                    Substrate::Paper { albedo } => Some(albedo),
+                    Substrate::None => None,
+                },
+                azimuth_deg: scene.incidence.first().map_or(0.0, |i| i.azimuth_deg),
+            },
+        )?),
+        None => None,
+    };
+    let picture_path = match &tile_png {
+        Some(png) => {
+            atomic::write_atomic(&picture_path, png)?;
+            Some(picture_path)
+        }
+        None => None,
+    };
     ResultParts {
         scene,
         geometry: Some(&geometry),
@@ -106,14 +135,14 @@ pub fn run(
         realisation_stop: None,
         plan: &plan_text(&plan, &entries),
         orders_png: &[],
-        tile_png: None,
+        tile_png: tile_png.as_deref(),
         appearance: None,
         stack: Some(&tables),
     }
     .write(&result_path)?;
     Ok(RunReport {
         result_path,
-        picture_path: None,
+        picture_path,
         orders_picture_path: None,
         plot_paths: Vec::new(),
         geometry: Some(geometry),
@@ -142,7 +171,13 @@ fn combine(
     let measurements = &scene.appearance.measurements;
     let viewing = &scene.appearance.viewing_deg;
     let above = stack_air_angles(scene);
+    let illumination: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
+    let tile = scene.appearance.products.tile;
+    let terms = if tile { stack::AZIMUTHAL_TERMS } else { 1 };
     let rr = plan.realisations;
+    // The diffuse BRDF in the plane of incidence, 1/sr, (wavelength,
+    // illumination, viewing), per realisation.
+    let mut brdf = vec![Array3::zeros((wl.len(), illumination.len(), viewing.len())); rr];
     let mut factors = vec![vec![Array1::zeros(wl.len()); rr]; measurements.len()];
     let mut natural = vec![Array2::zeros((wl.len(), viewing.len())); rr];
     let mut rta = vec![[(); 3].map(|_| Array2::zeros((wl.len(), above.len()))); rr];
@@ -159,7 +194,7 @@ fn combine(
                     appearance::find_entry(&s.entries, side, r % n, w, nodes[j])
                         .map(|e| &e.efficiencies)
                 };
-                let slab = stack::layer_slab(&q, k, &find)?;
+                let slab = stack::layer_slab(&q, k, terms, &find)?;
                 let t = &slab.total;
                 for (acc, m) in means[i]
                     .iter_mut()
@@ -180,6 +215,12 @@ fn combine(
             for (v, &deg) in viewing.iter().enumerate() {
                 natural[r][[l, v]] = stack::white_sky(&sr, deg)?;
             }
+            if tile {
+                let f = stack::plane_factors(&ords, &slabs, &sr, &illumination, viewing)?;
+                brdf[r]
+                    .index_axis_mut(ndarray::Axis(0), l)
+                    .assign(&(f / std::f64::consts::PI));
+            }
             let free =
                 stack::free_stack(&ords, &slabs.iter().map(|s| &s.total).collect::<Vec<_>>())?;
             for (a, &deg) in above.iter().enumerate() {
@@ -195,10 +236,10 @@ fn combine(
         }
     }
     let observer = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
-    let proxy = proxy_factors(scene, scenes, &ords, below)?;
+    let proxy = proxy_factors(scene, scenes, &ords, below, &illumination)?;
     let mut measured: Vec<MeasuredColour> = Vec::with_capacity(measurements.len());
     for (g, &m) in measurements.iter().enumerate() {
-        let p = proxy.as_ref().map(|(fine, per)| (&fine[..], &per[g][..]));
+        let p = proxy.as_ref().map(|p| (&p.fine[..], &p.factors[g][..]));
         measured.push(appearance::colour_of_samples(
             m,
             wl,
@@ -209,6 +250,25 @@ fn combine(
         )?);
     }
     let baseline = super::baseline::baseline_colours(scene, &measured, &observer)?;
+    let natural_mean = appearance::reduce(&natural);
+    let (brdf_total, colours) = if tile {
+        let mean = appearance::reduce(&brdf);
+        let per: Vec<TileSpectra> = if rr >= 2 {
+            brdf.into_iter().zip(natural).collect()
+        } else {
+            Vec::new()
+        };
+        let c = appearance::tile_colours(
+            wl,
+            (&mean.mean, &natural_mean.mean),
+            &per,
+            &observer,
+            proxy.as_ref().map(|p| (&p.fine[..], &p.brdf, &p.sky)),
+        )?;
+        (Some(mean), Some(c))
+    } else {
+        (None, None)
+    };
     let pick = |c: usize| appearance::reduce(&rta.iter().map(|x| x[c].clone()).collect::<Vec<_>>());
     Ok(StackTables {
         coupling: "incoherent".to_string(),
@@ -246,25 +306,40 @@ fn combine(
         transmittance: pick(1),
         absorption: pick(2),
         viewing_deg: viewing.clone(),
-        natural: appearance::reduce(&natural),
+        natural: natural_mean,
+        illumination_deg: illumination,
+        brdf_total,
+        colours,
         measured,
         baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
     })
 }
 
+/// The spectral proxy of a stack on the fine colour grid: each
+/// measurement's reflectance factor, and the tile's BRDF square (1/sr) and
+/// sky strip.
+struct StackProxy {
+    fine: Vec<f64>,
+    /// Per measurement, per fine wavelength.
+    factors: Vec<Vec<f64>>,
+    /// (fine wavelength, illumination, viewing).
+    brdf: Array3<f64>,
+    /// (fine wavelength, viewing).
+    sky: Array2<f64>,
+}
+
 /// The spectral proxy of the stack: every layer its homogeneous slab (the
 /// volume-averaged ε, in closed form inside the binder), stacked the same
-/// way, on the fine colour grid; the reflectance factor of each
-/// measurement on it. None for one wavelength, without paper, or where a
-/// material has no data on the grid.
-#[allow(clippy::type_complexity)]
+/// way, on the fine colour grid. None for one wavelength, without paper,
+/// or where a material has no data on the grid.
 fn proxy_factors(
     scene: &Scene,
     scenes: &[Scene],
     ords: &Ordinates,
     below: Below,
-) -> Result<Option<(Vec<f64>, Vec<Vec<f64>>)>, PipelineError> {
+    illumination: &[f64],
+) -> Result<Option<StackProxy>, PipelineError> {
     let wl = &scene.wavelengths_nm;
     if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
         return Ok(None);
@@ -273,8 +348,11 @@ fn proxy_factors(
     let nb = scene.layer.binder_index;
     let nodes = node_deg(ords);
     let measurements = &scene.appearance.measurements;
-    let mut per = vec![Vec::with_capacity(fine.len()); measurements.len()];
-    for &w in &fine {
+    let viewing = &scene.appearance.viewing_deg;
+    let mut factors = vec![Vec::with_capacity(fine.len()); measurements.len()];
+    let mut brdf = Array3::zeros((fine.len(), illumination.len(), viewing.len()));
+    let mut sky = Array2::zeros((fine.len(), viewing.len()));
+    for (f, &w) in fine.iter().enumerate() {
         let mut slabs = Vec::with_capacity(scenes.len());
         for ls in scenes {
             let Ok(eps) = mean_eps(ls, w) else {
@@ -291,12 +369,25 @@ fn proxy_factors(
             slabs.push(LayerSlab {
                 specular: slab.clone(),
                 total: slab,
+                azimuthal: Vec::new(),
             });
         }
         let sr = stack::stack_reflection(ords, &slabs, below)?;
         for (g, &m) in measurements.iter().enumerate() {
-            per[g].push(sr.factor(m)?);
+            factors[g].push(sr.factor(m)?);
         }
+        for (v, &deg) in viewing.iter().enumerate() {
+            sky[[f, v]] = stack::white_sky(&sr, deg)?;
+        }
+        // Homogeneous slabs scatter nothing: the mean term is all there is.
+        let plane = stack::plane_factors(ords, &slabs, &sr, illumination, viewing)?;
+        brdf.index_axis_mut(ndarray::Axis(0), f)
+            .assign(&(plane / std::f64::consts::PI));
     }
-    Ok(Some((fine, per)))
+    Ok(Some(StackProxy {
+        fine,
+        factors,
+        brdf,
+        sky,
+    }))
 }

@@ -217,10 +217,10 @@ impl Checker<'_> {
 }
 
 impl Checker<'_> {
-    /// What a stack can report: an incoherent stack's adding carries the
-    /// azimuthal mean of each layer's scattering, which gives the
-    /// measurement geometries and the white sky exactly but not the BRDF
-    /// at other azimuths; baselines are for one layer.
+    /// What a stack can report: an incoherent stack's adding carries a few
+    /// azimuthal Fourier terms of each layer's scattering, which give the
+    /// measurement geometries, the white sky and the plane of incidence
+    /// but not the BRDF at every azimuth; baselines are for one layer.
     pub(super) fn stack_products(
         &self,
         stack: &Stack,
@@ -248,10 +248,10 @@ impl Checker<'_> {
         if p.brdf || p.btdf || p.merl || p.preview {
             return Err(self.invalid(
                 "appearance.outputs",
-                "an incoherent stack reports colours and spectra (\"tile\"): its adding carries \
-                 the azimuthal mean of the scattering, not the BRDF at every azimuth that \
-                 \"brdf\", \"btdf\", \"merl\" and \"preview\" need; use stacking.coupling = \
-                 \"coherent\" for them",
+                "an incoherent stack reports colours, spectra and its tile (\"tile\": the BRDF \
+                 in the plane of incidence): its adding carries a few azimuthal Fourier terms \
+                 of the scattering, not the BRDF at every azimuth that \"brdf\", \"btdf\", \
+                 \"merl\" and \"preview\" need; use stacking.coupling = \"coherent\" for them",
             ));
         }
         if target {

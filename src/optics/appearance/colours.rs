@@ -1,8 +1,8 @@
 //! The tile's colours and their uncertainty, and the layer-on-paper spectra
 //! they are computed from.
 
-use super::proxy::{through_proxy, SpectralProxy};
-use super::{reduce, AppearanceError, AppearanceSpec};
+use super::proxy::through_proxy;
+use super::{reduce, AppearanceError};
 use crate::optics::colour::{self, Observer};
 use ndarray::{Array1, Array2, Array3, Array4};
 use std::f64::consts::PI;
@@ -73,23 +73,49 @@ impl ColourSpread {
     }
 }
 
+/// The spectra a tile is coloured from, at the solved wavelengths: the
+/// diffuse BRDF of layer + substrate `(wavelength, illumination, viewing)`
+/// in 1/sr and the sky strip `(wavelength, viewing)`.
+pub type TileSpectra = (Array3<f64>, Array2<f64>);
+
+/// The same on the spectral proxy's fine grid: its wavelengths, BRDF
+/// square and sky strip ([`SpectralProxy::spectra`]).
+pub type ProxySpectra<'a> = (&'a [f64], &'a Array3<f64>, &'a Array2<f64>);
+
+/// The tile's colours from the ensemble's spectra `mean`, with their
+/// spread over the realisations' own spectra when there are two or more.
+pub fn tile_colours(
+    wavelengths_nm: &[f64],
+    mean: (&Array3<f64>, &Array2<f64>),
+    realisations: &[TileSpectra],
+    obs: &Observer,
+    proxy: Option<ProxySpectra>,
+) -> Result<Colours, AppearanceError> {
+    let mut c = colours_of(wavelengths_nm, mean.0, mean.1, obs, proxy)?;
+    if realisations.len() >= 2 {
+        let labs = realisations
+            .iter()
+            .map(|(f, sky)| Ok(colours_of(wavelengths_nm, f, sky, obs, proxy)?.tile_lab))
+            .collect::<Result<Vec<_>, AppearanceError>>()?;
+        c.spread = Some(ColourSpread::of(&labs, &c.tile_lab));
+    }
+    Ok(c)
+}
+
 /// Tile colours from the BRDF of layer + substrate and the sky strip.
-/// `proxy` is the spectral proxy with its BRDF square and sky strip on its
-/// fine grid ([`SpectralProxy::spectra`]).
-pub(super) fn colours_of(
-    spec: &AppearanceSpec,
+fn colours_of(
+    wl: &[f64],
     total: &Array3<f64>,
     sky: &Array2<f64>,
     obs: &Observer,
-    proxy: Option<(&SpectralProxy, &Array3<f64>, &Array2<f64>)>,
+    proxy: Option<ProxySpectra>,
 ) -> Result<Colours, AppearanceError> {
-    let wl = &spec.wavelengths_nm;
-    let (nv, ni) = (spec.viewing_deg.len(), spec.illumination_deg.len());
+    let (_, ni, nv) = total.dim();
     // XYZ of a spectrum sampled at the solved wavelengths.
     let xyz = |values: Vec<f64>, proxy_fine: Option<Vec<f64>>| match (&proxy, proxy_fine) {
-        (Some((p, _, _)), Some(pf)) => {
-            let fine = through_proxy(wl, &values, &p.wavelengths_nm, &pf);
-            colour::xyz_from_reflectance(obs, &p.wavelengths_nm, &fine)
+        (Some((fine_wl, _, _)), Some(pf)) => {
+            let fine = through_proxy(wl, &values, fine_wl, &pf);
+            colour::xyz_from_reflectance(obs, fine_wl, &fine)
         }
         _ => colour::xyz_from_reflectance(obs, wl, &values),
     };

@@ -27,7 +27,7 @@ mod colours;
 mod measure;
 mod proxy;
 
-pub use colours::{ColourSpread, Colours};
+pub use colours::{tile_colours, ColourSpread, Colours, ProxySpectra, TileSpectra};
 pub use measure::{colour_of_samples, MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
@@ -36,7 +36,7 @@ use crate::optics::colour::{ColourError, Illuminant, Observer, StandardObserver}
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
 use crate::optics::substrate::Hemisphere;
-use colours::{colours_of, layer_on_paper};
+use colours::layer_on_paper;
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
 use num_complex::Complex64 as C64;
 
@@ -341,22 +341,25 @@ pub fn assemble(
             (Some(p), Some(albedo), Some(h)) => Some((p, p.spectra(spec, albedo, h))),
             _ => None,
         };
-        let proxy = proxy.as_ref().map(|(p, (f, sky))| (*p, f, sky));
-        let mut c = colours_of(spec, &total, &sky, observer, proxy)?;
-        if rr >= 2 {
-            let mut labs = Vec::with_capacity(rr);
-            for r in 0..rr {
-                let (total_r, sky_r) = on_paper(
-                    &s_brdf[r],
-                    &s_r[r],
-                    &s_t[r],
-                    Some(&s_rdd[r]),
-                    Some(&s_td[r]),
-                );
-                labs.push(colours_of(spec, &total_r, &sky_r, observer, proxy)?.tile_lab);
-            }
-            c.spread = Some(ColourSpread::of(&labs, &c.tile_lab));
-        }
+        let proxy = proxy
+            .as_ref()
+            .map(|(p, (f, sky))| (&p.wavelengths_nm[..], f, sky));
+        let per: Vec<TileSpectra> = if rr >= 2 {
+            (0..rr)
+                .map(|r| {
+                    on_paper(
+                        &s_brdf[r],
+                        &s_r[r],
+                        &s_t[r],
+                        Some(&s_rdd[r]),
+                        Some(&s_td[r]),
+                    )
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let c = tile_colours(&spec.wavelengths_nm, (&total, &sky), &per, observer, proxy)?;
         colours = Some(c);
         brdf_total = Some(total);
         natural = Some(sky);

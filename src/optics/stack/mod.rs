@@ -14,5 +14,5 @@
 pub mod combine;
 pub mod flux;
 
-pub use combine::{free_stack, stack_reflection, white_sky, Below};
-pub use flux::{layer_slab, BinQuadrature, LayerSlab};
+pub use combine::{free_stack, plane_factors, stack_reflection, white_sky, Below};
+pub use flux::{layer_slab, BinQuadrature, LayerSlab, AZIMUTHAL_TERMS};

@@ -30,7 +30,7 @@ pub(super) fn write_estimate<D: ndarray::Dimension>(
 }
 
 const LA: &[&str] = &[dim::WAVELENGTH, dim::ABOVE];
-const LIV: &[&str] = &[dim::WAVELENGTH, dim::ILLUMINATION, dim::VIEWING];
+pub(super) const LIV: &[&str] = &[dim::WAVELENGTH, dim::ILLUMINATION, dim::VIEWING];
 const LINN: &[&str] = &[dim::WAVELENGTH, dim::ILLUMINATION, dim::SY, dim::SX];
 const TILE: &[&str] = &[dim::VIEWING, dim::TILE_COLUMN];
 
@@ -236,7 +236,7 @@ pub(super) fn write_appearance(
 }
 
 /// The tile's and the white sky's colours, with their spread.
-fn write_colours(s: &Scales, g: &hdf5::Group, c: &Colours) -> hdf5::Result<()> {
+pub(super) fn write_colours(s: &Scales, g: &hdf5::Group, c: &Colours) -> hdf5::Result<()> {
     let cells = "the tile's cells (column 0 under the uniform white sky, then one per \
                  illumination angle)";
     let description = format!("sRGB 8-bit code values of {cells}; viewing × tile column × R, G, B");

@@ -313,7 +313,7 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     if let Some(app) = set.appearance {
         write_appearance(file, app, set.tile_png, s)?;
     } else if let Some(st) = set.stack {
-        write_stack(file, st, s)?;
+        write_stack(file, st, set.tile_png, s)?;
     }
     file.flush()
 }

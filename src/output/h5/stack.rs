@@ -4,12 +4,12 @@
 //! `/appearance` the white sky and the measured colours as a single layer
 //! stores them (docs/FORMAT.md).
 
-use ndarray::{Array3, Ix2};
+use ndarray::{Array3, Ix2, Ix3};
 
-use super::appearance::{write_baselines, write_estimate, write_measured};
+use super::appearance::{write_baselines, write_colours, write_estimate, write_measured, LIV};
 use super::attrs::{write_scalar_attr, write_str_attr};
 use super::described::{about, dim, Scales};
-use crate::optics::appearance::{Estimate, MeasuredColour};
+use crate::optics::appearance::{Colours, Estimate, MeasuredColour};
 use crate::optics::baseline::BaselineColour;
 use crate::optics::colour::{Illuminant, StandardObserver};
 
@@ -51,13 +51,26 @@ pub struct StackTables {
     pub viewing_deg: Vec<f64>,
     /// Radiance factor under a white sky, on the paper, (wavelength, viewing).
     pub natural: Estimate<Ix2>,
+    /// Illumination polar angles of the BRDF square (the tile's columns).
+    pub illumination_deg: Vec<f64>,
+    /// Diffuse BRDF of the stack on its paper in the plane of incidence on
+    /// the specular side, 1/sr, (wavelength, illumination, viewing), when
+    /// the tile was asked for.
+    pub brdf_total: Option<Estimate<Ix3>>,
+    /// The tile's colours, when it was asked for.
+    pub colours: Option<Colours>,
     pub measured: Vec<MeasuredColour>,
     /// The classical baselines' colours (adding–doubling of the stack).
     pub baseline: Vec<BaselineColour>,
     pub conditions: (Illuminant, StandardObserver),
 }
 
-pub(super) fn write_stack(file: &hdf5::File, t: &StackTables, s: &mut Scales) -> hdf5::Result<()> {
+pub(super) fn write_stack(
+    file: &hdf5::File,
+    t: &StackTables,
+    tile_png: Option<&[u8]>,
+    s: &mut Scales,
+) -> hdf5::Result<()> {
     let g = file.create_group("stack")?;
     write_str_attr(&g, "coupling", &t.coupling)?;
     write_scalar_attr(&g, "realisations", t.realisations as u64)?;
@@ -199,13 +212,46 @@ pub(super) fn write_stack(file: &hdf5::File, t: &StackTables, s: &mut Scales) ->
             &[dim::WAVELENGTH, dim::VIEWING],
         ),
     )?;
+    if let Some(brdf) = &t.brdf_total {
+        s.coordinate(
+            &a,
+            "illumination_deg",
+            &t.illumination_deg,
+            about(
+                "deg",
+                "illumination polar angles of the BRDF and the tile; illumination",
+                &[dim::ILLUMINATION],
+            ),
+        )?;
+        write_estimate(
+            s,
+            &a,
+            "brdf_total",
+            brdf,
+            about(
+                "sr-1",
+                "diffuse BRDF of the stack on its substrate in the plane of incidence on the \
+                 specular side (azimuthal Fourier terms of the layers added), ensemble mean; \
+                 wavelength × illumination × viewing",
+                LIV,
+            ),
+        )?;
+    }
+    if let Some(c) = &t.colours {
+        write_colours(s, &a, c)?;
+    }
     if !t.measured.is_empty() {
         let mg = a.create_group("measured")?;
         for m in &t.measured {
             write_measured(s, &mg, m)?;
         }
     }
-    write_baselines(s, &a, &t.baseline)
+    write_baselines(s, &a, &t.baseline)?;
+    if let Some(png) = tile_png {
+        let description = "the tile picture as a PNG file (encoded bytes, no units); byte";
+        s.write(&a, "tile_png", png, about("", description, &[dim::BYTE]))?;
+    }
+    Ok(())
 }
 
 /// The mean reflectance, transmittance and absorption of a stack solved

@@ -114,6 +114,10 @@ fn main() {
             let ad = stack_baseline_colours(
                 Baseline::AddingDoubling,
                 &inputs,
+                (
+                    &st.layers.iter().map(|l| l.coverage).collect::<Vec<_>>(),
+                    st.yule_nielsen_n,
+                ),
                 &[Measurement::FortyFiveZero],
                 &|_| None,
                 &obs,

@@ -266,6 +266,26 @@ fn bad_stacks_are_refused_naming_the_key() {
             "not the BRDF at every azimuth",
         ),
         (
+            stack(dir.path(), &[red(300.0).coverage(0.0)], "incoherent", "f"),
+            "stack[0].coverage",
+            "(0, 1]",
+        ),
+        (
+            stack(
+                dir.path(),
+                &[red(300.0).coverage(0.5), red2(300.0)],
+                "coherent",
+                "g",
+            ),
+            "stack[0].coverage",
+            "far wider than a fragment",
+        ),
+        (
+            stack(dir.path(), &[red(300.0)], "incoherent", "h").set("stacking.yule_nielsen_n", 0.5),
+            "stacking.yule_nielsen_n",
+            "[1, 10]",
+        ),
+        (
             stack(dir.path(), &[red(300.0)], "sideways", "e"),
             "stacking.coupling",
             "\"incoherent\" or \"coherent\"",
@@ -295,6 +315,16 @@ fn bad_stacks_are_refused_naming_the_key() {
             .unwrap_err()
             .to_string();
         assert!(e.contains(key) && e.contains(words), "{key}: {e}");
+    }
+    // Without outputs given, an incoherent stack makes its tile alone (the
+    // single layer's default "brdf" is not made there); a coherent one the
+    // single layer's defaults.
+    for (coupling, brdf) in [("incoherent", false), ("coherent", true)] {
+        let s = stack(dir.path(), &[red(300.0)], coupling, "defaults")
+            .without("appearance.outputs")
+            .scene(dir.path());
+        assert!(s.appearance.products.tile);
+        assert_eq!(s.appearance.products.brdf, brdf, "{coupling}");
     }
     // A different second pigment name fixes the duplicate.
     let ok = stack(
@@ -456,6 +486,7 @@ fn the_adding_doubling_baseline_of_a_stack_adds_its_layers() {
         let two = baseline::stack_baseline_colours(
             model,
             &[half.clone(), half.clone()],
+            (&[1.0, 1.0], 1.0),
             &m,
             &|_| None,
             &obs,
@@ -466,10 +497,33 @@ fn the_adding_doubling_baseline_of_a_stack_adds_its_layers() {
                 assert!((x - y).abs() < 1e-9, "{model:?}: {x} vs {y}");
             }
         }
+        // Printed on 30 % of the area: Murray–Davies with the bare paper.
+        let dots = baseline::stack_baseline_colours(
+            model,
+            std::slice::from_ref(&input),
+            (&[0.3], 1.0),
+            &m,
+            &|_| None,
+            &obs,
+        )
+        .unwrap();
+        for (a, b) in one.iter().zip(&dots) {
+            for (x, y) in a.reflectance_factor.iter().zip(&b.reflectance_factor) {
+                let e = 0.3 * x + 0.7 * input.paper_albedo;
+                assert!((y - e).abs() < 1e-12, "{model:?}: {y} vs {e}");
+            }
+        }
     }
     // Kubelka–Munk is a model of one layer.
-    let e = baseline::stack_baseline_colours(Baseline::KubelkaMunk, &[half], &m, &|_| None, &obs)
-        .unwrap_err();
+    let e = baseline::stack_baseline_colours(
+        Baseline::KubelkaMunk,
+        &[half],
+        (&[1.0], 1.0),
+        &m,
+        &|_| None,
+        &obs,
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("one layer"), "{e}");
 }
 
@@ -525,4 +579,73 @@ fn the_tile_of_a_stack_solved_layer_by_layer_is_reciprocal() {
         }
     }
     assert!(path.with_extension("png").exists());
+}
+
+#[test]
+fn a_halftone_mixes_its_primaries_by_area() {
+    // Two dissolved inks printed at 40 % and 70 % (nothing random: one
+    // realisation is exact). The print is Demichel's four primaries —
+    // paper, yellow alone, blue alone, yellow over blue — each a stack run
+    // on its own, mixed by Yule–Nielsen (n = 2) on the paper and by area in
+    // air.
+    let dir = tempfile::tempdir().unwrap();
+    let yellow = || layer(PigmentToml::builtin("yellow").pvc(0.2).molecular(), 300.0);
+    let blue = || layer(PigmentToml::builtin("blue").pvc(0.1).molecular(), 500.0);
+    let run = |layers: &[SceneToml], name: &str| {
+        stack(dir.path(), layers, "incoherent", name)
+            .realisations(1)
+            .polar_deg(&[0.0, 30.0])
+            .set("stacking.yule_nielsen_n", 2.0)
+            .run(dir.path())
+            .result_path
+    };
+    let print = run(&[yellow().coverage(0.4), blue().coverage(0.7)], "print");
+    let both = run(&[yellow(), blue()], "both");
+    let y = run(&[yellow()], "yellow");
+    let b = run(&[blue()], "blue");
+    let (a1, a2) = (0.4, 0.7);
+    let parts = [
+        ((1.0 - a1) * (1.0 - a2), None),
+        (a1 * (1.0 - a2), Some(&y)),
+        ((1.0 - a1) * a2, Some(&b)),
+        (a1 * a2, Some(&both)),
+    ];
+    let albedo = 0.9;
+    for (name, paper) in [
+        ("appearance/measured/45_0/reflectance_factor", albedo),
+        ("appearance/measured/d8_sci/reflectance_factor", albedo),
+        ("appearance/measured/d8_sce/reflectance_factor", albedo),
+        ("appearance/natural", albedo),
+        ("appearance/brdf_total", albedo / std::f64::consts::PI),
+    ] {
+        let got = read(&print, name);
+        let each: Vec<Vec<f64>> = parts
+            .iter()
+            .map(|(_, p)| p.map_or(vec![paper; got.len()], |p| read(p, name)))
+            .collect();
+        for (k, g) in got.iter().enumerate() {
+            let e = parts
+                .iter()
+                .zip(&each)
+                .map(|((w, _), v)| w * v[k].sqrt())
+                .sum::<f64>()
+                .powi(2);
+            assert!((g - e).abs() < 1e-12 * e, "{name}[{k}]: {g} vs {e}");
+        }
+    }
+    // The totals in air mix by area; the bare paper's share passes it all.
+    for (name, bare) in [
+        ("stack/reflectance", 0.0),
+        ("stack/transmittance", 1.0),
+        ("stack/absorption", 0.0),
+    ] {
+        let got = read(&print, name);
+        for (k, g) in got.iter().enumerate() {
+            let e: f64 = parts
+                .iter()
+                .map(|(w, p)| w * p.map_or(bare, |p| read(p, name)[k]))
+                .sum();
+            assert!((g - e).abs() < 1e-12, "{name}[{k}]: {g} vs {e}");
+        }
+    }
 }

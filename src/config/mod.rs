@@ -23,7 +23,7 @@ pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
 pub use stack::{
     Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS,
-    MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
+    MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS, MAX_YULE_NIELSEN_N,
 };
 
 /// Largest total pigment volume concentration a scene may ask for: what the

@@ -85,6 +85,8 @@ pub struct RawStackLayer {
     pub layer: RawLayer,
     #[serde(default)]
     pub pigment: Vec<RawPigment>,
+    /// Share of the area the layer is printed on (halftone), (0, 1].
+    pub coverage: Option<f64>,
 }
 
 /// `[stacking]`: `coupling = "incoherent" | "coherent"` and the directions
@@ -95,6 +97,8 @@ pub struct RawStacking {
     pub coupling: Option<String>,
     pub trapped_directions: Option<i64>,
     pub escape_directions: Option<i64>,
+    /// Yule–Nielsen's n of a halftone's area mixture, [1, 10].
+    pub yule_nielsen_n: Option<f64>,
 }
 
 /// `[structure]`: the layer given explicitly instead of generated grains.

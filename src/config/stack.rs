@@ -12,6 +12,8 @@ pub const DEFAULT_TRAPPED_DIRECTIONS: usize = 4;
 pub const DEFAULT_ESCAPE_DIRECTIONS: usize = 6;
 /// Largest `stacking.trapped_directions` and `stacking.escape_directions`.
 pub const MAX_STACK_DIRECTIONS: usize = 32;
+/// Largest `stacking.yule_nielsen_n`.
+pub const MAX_YULE_NIELSEN_N: f64 = 10.0;
 
 /// One layer of a stack: its slab, its pigments and its grid.
 #[derive(Debug, Clone)]
@@ -20,6 +22,9 @@ pub struct StackLayer {
     pub species: Vec<Species>,
     /// The grid of this layer alone (its own `nz`).
     pub grid: GridSpec,
+    /// Share of the area the layer is printed on, (0, 1]: below 1 the layer
+    /// is a halftone, its dots much wider than a fragment (docs/STACKS.md).
+    pub coverage: f64,
 }
 
 /// How light couples between the layers of a stack.
@@ -53,6 +58,8 @@ pub struct Stack {
     /// Directions of the adding method (incoherent coupling).
     pub trapped_directions: usize,
     pub escape_directions: usize,
+    /// Yule–Nielsen's n for the halftone's area mixture (1: Murray–Davies).
+    pub yule_nielsen_n: f64,
 }
 
 impl Scene {

@@ -94,9 +94,13 @@ pub fn baseline_colours(
     let mut colours = Vec::new();
     for &model in &scene.appearance.baseline {
         colours.extend(match scene.stack {
-            Some(_) => baseline::stack_baseline_colours(
+            Some(ref st) => baseline::stack_baseline_colours(
                 model,
                 &inputs,
+                (
+                    &st.layers.iter().map(|l| l.coverage).collect::<Vec<_>>(),
+                    st.yule_nielsen_n,
+                ),
                 &scene.appearance.measurements,
                 &wave,
                 observer,

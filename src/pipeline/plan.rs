@@ -570,13 +570,18 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
         st.layers
             .iter()
             .map(|l| format!(
-                "{} nm of {}",
+                "{} nm of {}{}",
                 l.layer.thickness_nm,
                 l.species
                     .iter()
                     .map(|s| s.name.as_str())
                     .collect::<Vec<_>>()
-                    .join(" + ")
+                    .join(" + "),
+                if l.coverage < 1.0 {
+                    format!(" on {}% of the area", 100.0 * l.coverage)
+                } else {
+                    String::new()
+                }
             ))
             .collect::<Vec<_>>()
             .join(", "),
@@ -594,6 +599,39 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
             Substrate::None => "air".to_string(),
         }
     )];
+    if st.layers.iter().any(|l| l.coverage < 1.0) {
+        let primaries = crate::optics::baseline::halftone::primaries(
+            &st.layers.iter().map(|l| l.coverage).collect::<Vec<_>>(),
+        );
+        lines.push(format!(
+            "halftone: {} primaries (Demichel's areas {}), each added from the same layer \
+             solves, mixed by Yule–Nielsen n = {}{} on the paper and by area in air",
+            primaries.len(),
+            primaries
+                .iter()
+                .map(|p| format!(
+                    "{}: {:.3}",
+                    if p.layers.is_empty() {
+                        "paper".to_string()
+                    } else {
+                        p.layers
+                            .iter()
+                            .map(|i| format!("stack[{i}]"))
+                            .collect::<Vec<_>>()
+                            .join("+")
+                    },
+                    p.area
+                ))
+                .collect::<Vec<_>>()
+                .join(", "),
+            st.yule_nielsen_n,
+            if st.yule_nielsen_n == 1.0 {
+                " (Murray–Davies)"
+            } else {
+                ""
+            }
+        ));
+    }
     lines.push(if scene.appearance.products.tile {
         format!(
             "tile: the BRDF square in the plane of incidence from {} azimuthal Fourier terms of \

@@ -17,7 +17,7 @@ use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::colour::Observer;
 use crate::optics::farfield::Side;
-use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab};
+use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab, Views};
 use crate::output::h5::{LayerMatrices, StackTables};
 use crate::output::{atomic, render};
 use crate::solver::airy;
@@ -174,6 +174,13 @@ fn combine(
     let illumination: Vec<f64> = scene.incidence.iter().map(|i| i.polar_deg).collect();
     let tile = scene.appearance.products.tile;
     let terms = if tile { stack::AZIMUTHAL_TERMS } else { 1 };
+    let views = Views {
+        measurements,
+        viewing_deg: viewing,
+        illumination_deg: tile.then_some(&illumination[..]),
+        above_deg: &above,
+    };
+    let (coverage, yn) = halftone_of(scene);
     let rr = plan.realisations;
     // The diffuse BRDF in the plane of incidence, 1/sr, (wavelength,
     // illumination, viewing), per realisation.
@@ -208,30 +215,22 @@ fn combine(
                 }
                 slabs.push(slab);
             }
-            let sr = stack::stack_reflection(&ords, &slabs, below)?;
-            for (g, &m) in measurements.iter().enumerate() {
-                factors[g][r][l] = sr.factor(m)?;
+            let look = stack::halftone(&ords, &slabs, &coverage, yn, below, &views)?;
+            for (g, f) in look.factors.iter().enumerate() {
+                factors[g][r][l] = *f;
             }
-            for (v, &deg) in viewing.iter().enumerate() {
-                natural[r][[l, v]] = stack::white_sky(&sr, deg)?;
+            for (v, f) in look.natural.iter().enumerate() {
+                natural[r][[l, v]] = *f;
             }
-            if tile {
-                let f = stack::plane_factors(&ords, &slabs, &sr, &illumination, viewing)?;
+            if let Some(f) = look.plane {
                 brdf[r]
                     .index_axis_mut(ndarray::Axis(0), l)
                     .assign(&(f / std::f64::consts::PI));
             }
-            let free =
-                stack::free_stack(&ords, &slabs.iter().map(|s| &s.total).collect::<Vec<_>>())?;
-            for (a, &deg) in above.iter().enumerate() {
-                let j = ords
-                    .air_node(deg)
-                    .ok_or(crate::optics::baseline::BaselineError::NoDirection(deg))?;
-                let rs: f64 = (0..k).map(|i| free.r_down[(i, j)]).sum();
-                let ts: f64 = (0..k).map(|i| free.t_down[(i, j)]).sum();
-                rta[r][0][[l, a]] = rs;
-                rta[r][1][[l, a]] = ts;
-                rta[r][2][[l, a]] = 1.0 - rs - ts;
+            for (a, t) in look.totals.iter().enumerate() {
+                for (c, x) in t.iter().enumerate() {
+                    rta[r][c][[l, a]] = *x;
+                }
             }
         }
     }
@@ -273,6 +272,8 @@ fn combine(
     Ok(StackTables {
         coupling: "incoherent".to_string(),
         layer_thickness_nm: scenes.iter().map(|s| s.layer.thickness_nm).collect(),
+        layer_coverage: coverage,
+        yule_nielsen_n: yn,
         layer_pigments: scenes
             .iter()
             .map(|s| {
@@ -314,6 +315,15 @@ fn combine(
         baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
     })
+}
+
+/// Each layer's coverage and Yule–Nielsen's n of the stack of `scene`.
+fn halftone_of(scene: &Scene) -> (Vec<f64>, f64) {
+    let st = scene.stack.as_ref().expect("a stack");
+    (
+        st.layers.iter().map(|l| l.coverage).collect(),
+        st.yule_nielsen_n,
+    )
 }
 
 /// The spectral proxy of a stack on the fine colour grid: each
@@ -369,20 +379,28 @@ fn proxy_factors(
             slabs.push(LayerSlab {
                 specular: slab.clone(),
                 total: slab,
+                // Homogeneous slabs scatter nothing: the mean is all there is.
                 azimuthal: Vec::new(),
             });
         }
-        let sr = stack::stack_reflection(ords, &slabs, below)?;
-        for (g, &m) in measurements.iter().enumerate() {
-            factors[g].push(sr.factor(m)?);
+        let views = Views {
+            measurements,
+            viewing_deg: viewing,
+            illumination_deg: Some(illumination),
+            above_deg: &[],
+        };
+        let (coverage, yn) = halftone_of(scene);
+        let look = stack::halftone(ords, &slabs, &coverage, yn, below, &views)?;
+        for (g, x) in look.factors.into_iter().enumerate() {
+            factors[g].push(x);
         }
-        for (v, &deg) in viewing.iter().enumerate() {
-            sky[[f, v]] = stack::white_sky(&sr, deg)?;
+        for (v, x) in look.natural.into_iter().enumerate() {
+            sky[[f, v]] = x;
         }
-        // Homogeneous slabs scatter nothing: the mean term is all there is.
-        let plane = stack::plane_factors(ords, &slabs, &sr, illumination, viewing)?;
-        brdf.index_axis_mut(ndarray::Axis(0), f)
-            .assign(&(plane / std::f64::consts::PI));
+        if let Some(plane) = look.plane {
+            brdf.index_axis_mut(ndarray::Axis(0), f)
+                .assign(&(plane / std::f64::consts::PI));
+        }
     }
     Ok(Some(StackProxy {
         fine,

@@ -294,12 +294,17 @@ impl SceneToml {
     /// This scene with `layers` (each one's `[layer]` and `[[pigment]]`),
     /// top first, as its `[[stack]]` instead of its own layer, coupled
     /// `coupling` (`"incoherent"` or `"coherent"`).
+    /// As a layer of a stack: printed on this share of the area.
+    pub fn coverage(self, coverage: f64) -> Self {
+        self.set("coverage", coverage)
+    }
+
     pub fn stack_of(mut self, layers: &[SceneToml], coupling: &str) -> Self {
         let stack: Vec<Value> = layers
             .iter()
             .map(|l| {
                 let mut t = Table::new();
-                for key in ["layer", "pigment"] {
+                for key in ["layer", "pigment", "coverage"] {
                     if let Some(v) = l.0.get(key) {
                         t.insert(key.to_string(), v.clone());
                     }

@@ -82,7 +82,20 @@ impl Checker<'_> {
         let incidence = self.incidence(&raw.illumination)?;
         let solver = self.solver(raw.solver.as_ref())?;
         let output = self.output(path, raw.output.as_ref())?;
-        let appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
+        let mut appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
+        // An incoherent stack's default outputs are its tile alone: the
+        // BRDF at every azimuth (the default "brdf") is not made there.
+        if stack
+            .as_ref()
+            .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent)
+            && raw
+                .appearance
+                .as_ref()
+                .and_then(|a| a.outputs.as_ref())
+                .is_none()
+        {
+            appearance.products.brdf = false;
+        }
         if realisation_target.is_some() && !appearance.products.tile {
             return Err(self.invalid(
                 "realisations.target_de00",

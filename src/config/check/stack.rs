@@ -7,6 +7,7 @@ use crate::config::raw::{RawConfig, RawStacking};
 use crate::config::{
     Baseline, ConfigError, GridSpec, Layer, Species, Stack, StackCoupling, StackLayer, Surface,
     DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS, MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS,
+    MAX_YULE_NIELSEN_N,
 };
 
 /// What a stack makes of the scene: the whole stack as one layer, every
@@ -35,6 +36,16 @@ impl Checker<'_> {
         }
         let (coupling, trapped_directions, escape_directions) =
             self.stacking(raw.stacking.as_ref())?;
+        let yule_nielsen_n = match raw.stacking.as_ref().and_then(|s| s.yule_nielsen_n) {
+            None => 1.0,
+            Some(v) if (1.0..=MAX_YULE_NIELSEN_N).contains(&v) => v,
+            Some(v) => {
+                return Err(self.invalid(
+                    "stacking.yule_nielsen_n",
+                    format!("must be in [1, {MAX_YULE_NIELSEN_N}] (1: Murray–Davies), got {v}"),
+                ))
+            }
+        };
         let mut layers: Vec<StackLayer> = Vec::with_capacity(n);
         for (i, rl) in raw.stack.iter().enumerate() {
             let c = Checker {
@@ -73,10 +84,26 @@ impl Checker<'_> {
                 }
             }
             let grid = self.grid(&raw.grid, &layer)?;
+            let coverage = rl.coverage.unwrap_or(1.0);
+            if !(coverage > 0.0 && coverage <= 1.0) {
+                return Err(c.invalid(
+                    "coverage",
+                    format!("must be in (0, 1] (the share of the area printed), got {coverage}"),
+                ));
+            }
+            if coverage < 1.0 && coupling == StackCoupling::Coherent {
+                return Err(c.invalid(
+                    "coverage",
+                    "a halftone's dots (tens of µm) are far wider than a fragment: its areas \
+                     mix whole stacks, which stacking.coupling = \"incoherent\" does; a \
+                     coherent stack covers the whole area (coverage = 1)",
+                ));
+            }
             layers.push(StackLayer {
                 layer,
                 species,
                 grid,
+                coverage,
             });
         }
         let Some(top) = layers.first() else {
@@ -138,6 +165,7 @@ impl Checker<'_> {
                 coupling,
                 trapped_directions,
                 escape_directions,
+                yule_nielsen_n,
             },
         })
     }

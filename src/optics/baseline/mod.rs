@@ -68,6 +68,7 @@
 
 pub mod adding;
 pub mod doubling;
+pub mod halftone;
 pub mod km;
 pub mod matrix;
 pub mod ordinates;
@@ -339,9 +340,13 @@ pub fn reflectance_factors(
 /// adding–doubling models, which add the layers' radiative-transfer slabs
 /// under the surface; the Kubelka–Munk models are for one layer
 /// ([`BaselineError::StackModel`]). `wave` as for [`baseline_colours`].
+/// Layers printed on part of the area (`halftone`: each layer's coverage
+/// and Yule–Nielsen's n) mix their primaries as the wave stack does
+/// ([`halftone`]).
 pub fn stack_baseline_colours(
     model: Baseline,
     inputs: &[BaselineInput],
+    halftone: (&[f64], f64),
     measurements: &[Measurement],
     wave: &dyn Fn(Measurement) -> Option<[f64; 3]>,
     observer: &Observer,
@@ -357,7 +362,28 @@ pub fn stack_baseline_colours(
         return Ok(Vec::new());
     };
     let params = ordinates::OrdinateParams::default();
-    let factors = transfer::stack_reflectance_factors(inputs, boundary, measurements, params)?;
+    let (coverage, n) = halftone;
+    let mut parts = Vec::new();
+    for p in halftone::primaries(coverage) {
+        let factors = if p.layers.is_empty() {
+            // The bare paper: Lambertian, no binder on it.
+            vec![vec![top.paper_albedo; top.wavelengths_nm.len()]; measurements.len()]
+        } else {
+            let printed: Vec<BaselineInput> = p.layers.iter().map(|&i| inputs[i].clone()).collect();
+            transfer::stack_reflectance_factors(&printed, boundary, measurements, params)?
+        };
+        parts.push((p.area, factors));
+    }
+    let factors = (0..measurements.len())
+        .map(|g| {
+            (0..top.wavelengths_nm.len())
+                .map(|l| {
+                    let at: Vec<(f64, f64)> = parts.iter().map(|(w, f)| (*w, f[g][l])).collect();
+                    halftone::yule_nielsen(n, &at)
+                })
+                .collect()
+        })
+        .collect();
     Ok(colours(model, top, measurements, factors, wave, observer)?)
 }
 

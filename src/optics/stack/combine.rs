@@ -46,7 +46,7 @@ pub fn free_stack(ords: &Ordinates, layers: &[&Slab]) -> Result<Slab, BaselineEr
 /// mirror part per bin.
 pub fn stack_reflection(
     ords: &Ordinates,
-    layers: &[LayerSlab],
+    layers: &[&LayerSlab],
     below: Below,
 ) -> Result<StackReflection, BaselineError> {
     let lower = adding::surface_binder_over_air(ords);
@@ -94,7 +94,7 @@ pub fn white_sky(s: &StackReflection, polar_deg: f64) -> Result<f64, BaselineErr
 /// the same number in every layer).
 pub fn plane_factors(
     ords: &Ordinates,
-    layers: &[LayerSlab],
+    layers: &[&LayerSlab],
     sr: &StackReflection,
     illumination_deg: &[f64],
     viewing_deg: &[f64],

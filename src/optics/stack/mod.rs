@@ -13,6 +13,8 @@
 
 pub mod combine;
 pub mod flux;
+pub mod halftone;
 
 pub use combine::{free_stack, plane_factors, stack_reflection, white_sky, Below};
 pub use flux::{layer_slab, BinQuadrature, LayerSlab, AZIMUTHAL_TERMS};
+pub use halftone::{halftone, look, Look, Views};

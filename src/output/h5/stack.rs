@@ -34,6 +34,10 @@ pub struct StackTables {
     pub layer_thickness_nm: Vec<f64>,
     /// The pigments of each layer, comma-separated.
     pub layer_pigments: Vec<String>,
+    /// Share of the area each layer is printed on (1: all of it).
+    pub layer_coverage: Vec<f64>,
+    /// Yule–Nielsen's n of a halftone's area mixture.
+    pub yule_nielsen_n: f64,
     /// The directions: polar angle in the binder, in air (NaN where trapped),
     /// flux weight.
     pub binder_polar_deg: Vec<f64>,
@@ -74,6 +78,7 @@ pub(super) fn write_stack(
     let g = file.create_group("stack")?;
     write_str_attr(&g, "coupling", &t.coupling)?;
     write_scalar_attr(&g, "realisations", t.realisations as u64)?;
+    write_scalar_attr(&g, "yule_nielsen_n", t.yule_nielsen_n)?;
     s.coordinate(
         &g,
         "layer_thickness_nm",
@@ -89,6 +94,17 @@ pub(super) fn write_stack(
         .iter()
         .map(|n| n.parse().unwrap_or_default())
         .collect();
+    s.write(
+        &g,
+        "layer_coverage",
+        &t.layer_coverage[..],
+        about(
+            "1",
+            "share of the area each layer is printed on (below 1: a halftone, its primaries \
+             mixed by area); layer",
+            &[LAYER],
+        ),
+    )?;
     s.write(
         &g,
         "layer_pigments",

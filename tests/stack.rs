@@ -425,9 +425,9 @@ fn a_stack_result_exports_its_solves_and_colours() {
 
 #[test]
 fn a_study_sweeps_stacks_and_merges_them() {
-    // Both couplings of a two-layer stack as a study's axis: each variant
-    // finishes (an incoherent stack draws no tile) and the merge compares
-    // them.
+    // Both couplings of a two-layer stack as a study's axis, then the top
+    // ink's coverage: each variant finishes with its tile and the merge
+    // compares them.
     let dir = tempfile::tempdir().unwrap();
     let layer = |name: &str| {
         format!(
@@ -445,7 +445,7 @@ fn a_study_sweeps_stacks_and_merges_them() {
         layer("yellow"),
         layer("blue")
     );
-    std::fs::write(dir.path().join("stacks.toml"), text).unwrap();
+    std::fs::write(dir.path().join("stacks.toml"), &text).unwrap();
     let run = |args: &[&str]| {
         let (ok, out, err) = common::cli::inksim_in(dir.path(), args);
         assert!(ok, "{args:?}: {out}\n{err}");
@@ -455,8 +455,28 @@ fn a_study_sweeps_stacks_and_merges_them() {
     let summary = std::fs::read_to_string(dir.path().join("out/summary.md")).unwrap();
     for v in ["incoherent", "coherent"] {
         assert!(summary.contains(v), "{summary}");
+        assert!(dir.path().join(format!("out/variants/{v}.png")).exists());
     }
     assert!(dir.path().join("out/summary.h5").exists());
+    let halftone = text
+        .replace("name = \"stacks\"", "name = \"dots\"")
+        .replace("output_dir = \"out\"", "output_dir = \"dots\"")
+        .replace(
+            "name = \"coupling\"\nkey = \"stacking.coupling\"\nvalues = [\"incoherent\", \"coherent\"]",
+            "name = \"cover\"\nkey = \"stack.0.coverage\"\nvalues = [0.5, 1.0]",
+        );
+    std::fs::write(dir.path().join("dots.toml"), halftone).unwrap();
+    run(&["run", "dots.toml"]);
+    run(&["merge", "dots.toml"]);
+    let summary = std::fs::read_to_string(dir.path().join("dots/summary.md")).unwrap();
+    assert!(summary.contains("cover0.5"), "{summary}");
+    let f = hdf5::File::open(dir.path().join("dots/variants/cover0.5.h5")).unwrap();
+    let c: Vec<f64> = f
+        .dataset("stack/layer_coverage")
+        .unwrap()
+        .read_raw()
+        .unwrap();
+    assert_eq!(c, [0.5, 1.0]);
 }
 
 #[test]

@@ -44,6 +44,7 @@ mod result;
 mod run;
 mod solve;
 mod stack;
+mod stack_proxy;
 mod surface;
 
 use std::path::{Path, PathBuf};

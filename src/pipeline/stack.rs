@@ -2,33 +2,28 @@
 //! each layer made and solved on its own, inside its binder, from above and
 //! from below at the directions of the adding method; per realisation and
 //! wavelength the layers' flux matrices combined by adding under the flat
-//! binder surface on the paper (`optics::stack`); colours through the
-//! spectral proxy of the stack of homogeneous slabs. A stack solved as one
+//! binder surface on the paper (`optics::stack`), a halftone's primaries
+//! mixed by area; colours through the spectral proxy of the stack of
+//! homogeneous slabs (`stack_proxy`). A stack solved as one
 //! fragment (`coherent`) is an ordinary run whose geometry is the layers'
 //! fragments on top of each other (`grains::build_geometry_seeded`).
 
 use ndarray::{Array1, Array2, Array3};
-use num_complex::Complex64 as C64;
 
 use crate::config::{Scene, Substrate};
 use crate::optics::appearance::{self, MeasuredColour, TileSpectra};
-use crate::optics::baseline::adding::Slab;
-use crate::optics::baseline::matrix::Matrix;
-use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::colour::Observer;
 use crate::optics::farfield::Side;
-use crate::optics::stack::{self, Below, BinQuadrature, LayerSlab, Views};
+use crate::optics::stack::{self, Below, BinQuadrature, Views};
 use crate::output::h5::{LayerMatrices, StackTables};
 use crate::output::{atomic, render};
-use crate::solver::airy;
 
-use super::appearance::fine_grid;
-use super::eps::mean_eps;
 use super::grains::stacked_geometry;
 use super::layer::{self, SolvedLayer};
 use super::memory::{self, MemoryLimit};
 use super::plan::{node_deg, plan_text, stack_air_angles, stack_ordinates, stack_plan, RunPlan};
 use super::result::{ResultParts, RunReport};
+use super::stack_proxy::{halftone_of, proxy_factors};
 use super::{check_output_dir, check_output_files, result_paths, started, PipelineError};
 
 /// Run an incoherent stack end to end and write its result file.
@@ -315,97 +310,4 @@ fn combine(
         baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
     })
-}
-
-/// Each layer's coverage and Yule–Nielsen's n of the stack of `scene`.
-fn halftone_of(scene: &Scene) -> (Vec<f64>, f64) {
-    let st = scene.stack.as_ref().expect("a stack");
-    (
-        st.layers.iter().map(|l| l.coverage).collect(),
-        st.yule_nielsen_n,
-    )
-}
-
-/// The spectral proxy of a stack on the fine colour grid: each
-/// measurement's reflectance factor, and the tile's BRDF square (1/sr) and
-/// sky strip.
-struct StackProxy {
-    fine: Vec<f64>,
-    /// Per measurement, per fine wavelength.
-    factors: Vec<Vec<f64>>,
-    /// (fine wavelength, illumination, viewing).
-    brdf: Array3<f64>,
-    /// (fine wavelength, viewing).
-    sky: Array2<f64>,
-}
-
-/// The spectral proxy of the stack: every layer its homogeneous slab (the
-/// volume-averaged ε, in closed form inside the binder), stacked the same
-/// way, on the fine colour grid. None for one wavelength, without paper,
-/// or where a material has no data on the grid.
-fn proxy_factors(
-    scene: &Scene,
-    scenes: &[Scene],
-    ords: &Ordinates,
-    below: Below,
-    illumination: &[f64],
-) -> Result<Option<StackProxy>, PipelineError> {
-    let wl = &scene.wavelengths_nm;
-    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
-        return Ok(None);
-    }
-    let fine = fine_grid(wl);
-    let nb = scene.layer.binder_index;
-    let nodes = node_deg(ords);
-    let measurements = &scene.appearance.measurements;
-    let viewing = &scene.appearance.viewing_deg;
-    let mut factors = vec![Vec::with_capacity(fine.len()); measurements.len()];
-    let mut brdf = Array3::zeros((fine.len(), illumination.len(), viewing.len()));
-    let mut sky = Array2::zeros((fine.len(), viewing.len()));
-    for (f, &w) in fine.iter().enumerate() {
-        let mut slabs = Vec::with_capacity(scenes.len());
-        for ls in scenes {
-            let Ok(eps) = mean_eps(ls, w) else {
-                return Ok(None);
-            };
-            let eps_rel: C64 = eps / (nb * nb);
-            let (mut r, mut t) = (vec![0.0; nodes.len()], vec![0.0; nodes.len()]);
-            for (j, &deg) in nodes.iter().enumerate() {
-                let s = airy::slab(eps_rel, ls.layer.thickness_nm, w / nb, deg);
-                r[j] = s.r.norm_sqr();
-                t[j] = s.t.norm_sqr();
-            }
-            let slab = Slab::symmetric(Matrix::diagonal(&r), Matrix::diagonal(&t));
-            slabs.push(LayerSlab {
-                specular: slab.clone(),
-                total: slab,
-                // Homogeneous slabs scatter nothing: the mean is all there is.
-                azimuthal: Vec::new(),
-            });
-        }
-        let views = Views {
-            measurements,
-            viewing_deg: viewing,
-            illumination_deg: Some(illumination),
-            above_deg: &[],
-        };
-        let (coverage, yn) = halftone_of(scene);
-        let look = stack::halftone(ords, &slabs, &coverage, yn, below, &views)?;
-        for (g, x) in look.factors.into_iter().enumerate() {
-            factors[g].push(x);
-        }
-        for (v, x) in look.natural.into_iter().enumerate() {
-            sky[[f, v]] = x;
-        }
-        if let Some(plane) = look.plane {
-            brdf.index_axis_mut(ndarray::Axis(0), f)
-                .assign(&(plane / std::f64::consts::PI));
-        }
-    }
-    Ok(Some(StackProxy {
-        fine,
-        factors,
-        brdf,
-        sky,
-    }))
 }

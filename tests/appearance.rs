@@ -789,6 +789,38 @@ fn measurement_geometries_run_by_default_and_reach_the_result_file() {
         let units: hdf5::types::VarLenUnicode = lab.attr("units").unwrap().read_scalar().unwrap();
         assert_eq!(units.as_str(), "1");
         assert!(g.link_exists(&format!("measured/{slug}/de00_se")));
+        // Each realisation's own colour: its L*, a*, b* spread is the
+        // standard error stored beside the colour (sample s.d. / √R), and
+        // each is the CIELAB of its own XYZ under D50.
+        let rows = |name: &str| -> Vec<f64> {
+            g.dataset(&format!("measured/{slug}/{name}"))
+                .unwrap()
+                .read_raw()
+                .unwrap()
+        };
+        let (labs, xyzs, se) = (
+            rows("lab_realisations"),
+            rows("xyz_realisations"),
+            rows("lab_se"),
+        );
+        assert_eq!(labs.len(), 6, "2 realisations × L*, a*, b*");
+        for c in 0..3 {
+            let (x0, x1) = (labs[c], labs[3 + c]);
+            // Two samples: s.d. = |x0 − x1| / √2, s.e. = s.d. / √2.
+            assert!(((x0 - x1).abs() / 2.0 - se[c]).abs() < 1e-12 * (1.0 + se[c]));
+        }
+        let white = inksim::optics::colour::Observer::standard(
+            Illuminant::D50,
+            StandardObserver::TwoDegree,
+        )
+        .white_xyz();
+        for r in 0..2 {
+            let xyz = [xyzs[3 * r], xyzs[3 * r + 1], xyzs[3 * r + 2]];
+            let lab = inksim::optics::colour::xyz_to_lab(xyz, white);
+            for c in 0..3 {
+                assert!((lab[c] - labs[3 * r + c]).abs() < 1e-12 * 100.0);
+            }
+        }
     }
     assert!(g.link_exists("tile_lab_se") && g.link_exists("tile_de00_se"));
     // Read back as the study grids do: the same colours and errors.

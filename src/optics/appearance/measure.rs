@@ -53,6 +53,10 @@ pub struct MeasuredColour {
     /// Standard errors of L*, a*, b* and of the colour in ΔE00 (R ≥ 2).
     pub lab_se: Option<[f64; 3]>,
     pub de00_se: Option<f64>,
+    /// Each realisation's own XYZ and CIELAB, from its own spectrum through
+    /// the same proxy (R ≥ 2; empty for one).
+    pub realisation_xyz: Vec<[f64; 3]>,
+    pub realisation_lab: Vec<[f64; 3]>,
 }
 
 /// The per-realisation quantities a measurement reads, besides the solves.
@@ -201,15 +205,19 @@ pub fn colour_of_samples(
     let (spectrum_wavelengths_nm, spectrum) = spectrum_of(&reflectance.mean);
     let (xyz, lab) = lab_of(&reflectance.mean)?;
     let (mut lab_se, mut de00_se) = (None, None);
+    let (mut realisation_xyz, mut realisation_lab) = (Vec::new(), Vec::new());
     if samples.len() >= 2 {
-        let labs: Vec<[f64; 3]> = samples
+        (realisation_xyz, realisation_lab) = samples
             .iter()
-            .map(|s| lab_of(s).map(|x| x.1))
-            .collect::<Result<_, _>>()?;
+            .map(lab_of)
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .unzip();
+        let labs = &realisation_lab;
         let as_arrays: Vec<Array1<f64>> = labs.iter().map(|l| Array1::from(l.to_vec())).collect();
         let se = reduce(&as_arrays).se.expect("two or more realisations");
         lab_se = Some([se[0], se[1], se[2]]);
-        de00_se = Some(de00_standard_error(&labs, lab));
+        de00_se = Some(de00_standard_error(labs, lab));
     } else if deterministic {
         // Nothing random in the layer: every realisation is this one.
         lab_se = Some([0.0; 3]);
@@ -225,5 +233,7 @@ pub fn colour_of_samples(
         lch: colour::lab_to_lch(lab),
         lab_se,
         de00_se,
+        realisation_xyz,
+        realisation_lab,
     })
 }

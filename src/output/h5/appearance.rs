@@ -366,6 +366,26 @@ pub(super) fn write_measured(
         let description = "standard error of the colour in ΔE00 (one value)";
         vector("de00_se", &[de], "1", description, dim::VALUE)?;
     }
+    for (name, rows, what, d) in [
+        (
+            "xyz_realisations",
+            &m.realisation_xyz,
+            "CIE XYZ of each realisation's own spectrum, white Y = 100; realisation × X, Y, Z",
+            dim::TRISTIMULUS,
+        ),
+        (
+            "lab_realisations",
+            &m.realisation_lab,
+            "CIELAB of each realisation's own spectrum; realisation × L*, a*, b*",
+            dim::LAB,
+        ),
+    ] {
+        if rows.is_empty() {
+            continue;
+        }
+        let a = ndarray::Array2::from_shape_fn((rows.len(), 3), |(r, c)| rows[r][c]);
+        s.write(&g, name, a.view(), about("1", what, &[dim::REALISATION, d]))?;
+    }
     Ok(())
 }
 

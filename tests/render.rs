@@ -688,3 +688,38 @@ fn geometry_picture_has_axes_scale_bar_and_section() {
     assert!(orange > 100, "{orange}");
     assert!(canvas::text_width("x (µm)") > 20);
 }
+
+#[test]
+fn a_tile_of_one_patch_keeps_its_axis_titles_inside() {
+    // One illumination and one viewing angle: the axis titles must not run
+    // over the sky heading or down into the legend.
+    let obs = Observer::cie1931_d65();
+    let cap = caption(&obs);
+    let (rgb, lab) = tile_input(&obs);
+    let (rgb, lab) = (
+        rgb.slice(ndarray::s![0..1, 0..2, ..]).to_owned(),
+        lab.slice(ndarray::s![0..1, 0..2, ..]).to_owned(),
+    );
+    let img = decode(&tile::tile_png(&rgb, &lab, &[0.0], &[0.0], &cap).unwrap());
+    let l = TileLayout::new(1, 1, &[0.0], &cap);
+    let rows_end = l.rows_y[0] + PATCH_PX;
+    // Left of the row headings, between the patches and the legend: empty.
+    let (rx, _, _, _) = l.row_heads;
+    assert_eq!(
+        inked(&img, (0, rows_end, rx, l.legend_top - rows_end), BG),
+        0,
+        "the viewing-angle title runs into the legend"
+    );
+    // Above the sky column, the square's title stays right of it.
+    let (_, hy, _, _) = l.column_heads;
+    let axis_y = hy - canvas::GLYPH_HEIGHT - 4;
+    assert_eq!(
+        inked(
+            &img,
+            (l.columns_x[0] + PATCH_PX, axis_y, 6, canvas::GLYPH_HEIGHT),
+            BG
+        ),
+        0,
+        "the illumination-angle title runs over the sky heading"
+    );
+}

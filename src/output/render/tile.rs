@@ -92,7 +92,7 @@ fn angle(v: f64) -> String {
 fn legend() -> [&'static str; 3] {
     [
         "On each patch: CIELAB lightness L*, chroma C*ab and hue angle h° of the colour computed.",
-        "Left strip: under a uniform white sky; square: lit from θᵢ, seen from θₒ (BRDF × π).",
+        "Left strip: under a uniform white sky; square: lit from θᵢ (illumination angle), seen from θₒ (viewing angle), BRDF × π.",
         "◥ outside the sRGB gamut: drawn with C*ab reduced at the same L* and h°.",
     ]
 }
@@ -192,7 +192,8 @@ pub fn tile_png(
         TEXT,
         g,
     );
-    img.text_centered(sq_x + sq_w / 2.0, y_axis, "illumination angle θᵢ", TEXT, g);
+    let title = fitting("illumination angle θᵢ", "θᵢ", sq_w, g);
+    img.text_centered(sq_x + sq_w / 2.0, y_axis, title, TEXT, g);
     let y_heads = l.column_heads.1 as f64;
     img.text_centered(
         l.columns_x[0] as f64 + PATCH_PX as f64 / 2.0,
@@ -207,7 +208,7 @@ pub fn tile_png(
     }
     // Row axis: θₒ, written upwards, then one heading per row.
     let (rx, ry, rw, rh) = l.row_heads;
-    let title = "viewing angle θₒ";
+    let title = fitting("viewing angle θₒ", "θₒ", rh as f64, g);
     img.text_up(
         MARGIN as f64,
         ry as f64 + rh as f64 / 2.0 + text_width_px(title, g) / 2.0,
@@ -255,6 +256,16 @@ pub fn tile_png(
         );
     }
     img.encode_png(&format!("{} — {}", lines[0], lines[1]))
+}
+
+/// An axis title: `long` where it fits in `room` pixels at size `g`, else
+/// `short` (a tile of one or two patches; the legend names the angles).
+fn fitting<'a>(long: &'a str, short: &'a str, room: f64, g: f64) -> &'a str {
+    if text_width_px(long, g) <= room {
+        long
+    } else {
+        short
+    }
 }
 
 /// Black on light patches, white on dark ones.

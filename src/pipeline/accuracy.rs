@@ -14,7 +14,10 @@
 //!   quick study's 300 granular variants give a slope of 0.51 in log–log).
 //!   Per variant: s.e. ≈ C √(Σ_s 1/N_s / R), N_s the independent grains
 //!   (clusters, when agglomerated) of species s in one fragment, R the
-//!   realisations, C calibrated on that study (docs/ACCURACY.md,
+//!   realisations. C depends on the spectral step ([`fragment_c`]): a
+//!   fragment's scatter changes from one wavelength to the next, so the
+//!   finer the step the more of it the colour averages away. Calibrated on
+//!   the quick study at 100 nm and measured at 20 nm (docs/ACCURACY.md,
 //!   "Statistics of the fragment").
 
 use crate::config::{GrainShape, Scene};
@@ -44,13 +47,52 @@ const TOLERANCE: [(f64, f64); 5] = [
     (1e-6, 0.0),
     (1e-9, 0.0),
 ];
-/// The fragment's statistical constant C for one pigment and for a
-/// mixture (a mixture's hue also follows the fragment's composition): the
-/// median over the quick study's granular variants of
-/// s.e. / √(Σ 1/N_s / R) with R = 2, divided by 0.674 (the median of a
-/// two-sample estimate's |z|) — docs/ACCURACY.md.
+/// The fragment's statistical constant C at a 100 nm spectral step for
+/// one pigment and for a mixture (at that step a mixture's hue also follows
+/// the fragment's composition): the median over the quick study's granular
+/// variants of s.e. / √(Σ 1/N_s / R) with R = 2, divided by 0.674 (the
+/// median of a two-sample estimate's |z|) — docs/ACCURACY.md.
 pub const FRAGMENT_C_SINGLE: f64 = 7.0;
 pub const FRAGMENT_C_MIXTURE: f64 = 35.0;
+/// The same at a 20 nm step, for one pigment and mixtures alike: the
+/// largest measured there (red at the standard profile, 4.7; a yellow
+/// and two yellow+blue variants with 8–12 realisations each, 2.6–3.1;
+/// docs/ACCURACY.md).
+pub const FRAGMENT_C_FINE: f64 = 4.7;
+/// The spectral steps the constants were measured at, nm.
+const COARSE_STEP_NM: f64 = 100.0;
+const FINE_STEP_NM: f64 = 20.0;
+
+/// The fragment's constant C for a `mixture` (or one pigment) at spectral
+/// step `step_nm`: the measured constants at 100 and 20 nm, interpolated
+/// log–log between them and held beyond them (a finer step is not counted
+/// as better than 20 nm, nor one wavelength as worse than 100 nm).
+pub fn fragment_c(mixture: bool, step_nm: f64) -> f64 {
+    let coarse = if mixture {
+        FRAGMENT_C_MIXTURE
+    } else {
+        FRAGMENT_C_SINGLE
+    };
+    let fine = FRAGMENT_C_FINE.min(coarse);
+    if step_nm.is_nan() || step_nm >= COARSE_STEP_NM {
+        return coarse;
+    }
+    if step_nm <= FINE_STEP_NM {
+        return fine;
+    }
+    let t = (step_nm / FINE_STEP_NM).ln() / (COARSE_STEP_NM / FINE_STEP_NM).ln();
+    fine * (coarse / fine).powf(t)
+}
+
+/// The spectral step of `scene`, nm (infinite for one wavelength).
+fn spectral_step(scene: &Scene) -> f64 {
+    let wl = &scene.wavelengths_nm;
+    if wl.len() > 1 {
+        (wl[wl.len() - 1] - wl[0]) / (wl.len() - 1) as f64
+    } else {
+        f64::INFINITY
+    }
+}
 const QUADRATURE: [(f64, f64); 4] = [(2.0, 1.81), (4.0, 0.84), (6.0, 0.04), (12.0, 0.0)];
 
 /// Interpolate ΔE at `x` in a table ordered coarse → fine (`decreasing`:
@@ -110,11 +152,7 @@ pub fn statistical_de00(scene: &Scene, realisations: usize) -> f64 {
     if n.is_empty() || scene.structure.is_some() {
         return 0.0;
     }
-    let c = if n.len() > 1 {
-        FRAGMENT_C_MIXTURE
-    } else {
-        FRAGMENT_C_SINGLE
-    };
+    let c = fragment_c(n.len() > 1, spectral_step(scene));
     let inv: f64 = n.iter().map(|n| 1.0 / n.max(1e-9)).sum();
     c * (inv / realisations.max(1) as f64).sqrt()
 }
@@ -162,7 +200,7 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
         .collect();
     out.push(format!(
         "expected ΔE00 ≈ {total:.2} (sum of the terms; discretisation measured on a weak \
-         layer, statistics calibrated on the quick study — docs/ACCURACY.md)"
+         layer, statistics measured at 100 and 20 nm steps — docs/ACCURACY.md)"
     ));
     out
 }
@@ -172,12 +210,7 @@ pub fn expected_rows(scene: &Scene) -> Vec<(String, f64)> {
     let l = &scene.layer;
     let cell = (l.fragment_x_nm / scene.grid.nx as f64).max(l.fragment_y_nm / scene.grid.ny as f64);
     let zc = l.thickness_nm / scene.grid.nz as f64;
-    let wl = &scene.wavelengths_nm;
-    let step = if wl.len() > 1 {
-        (wl[wl.len() - 1] - wl[0]) / (wl.len() - 1) as f64
-    } else {
-        f64::INFINITY
-    };
+    let step = spectral_step(scene);
     let mut rows: Vec<(String, f64)> = Vec::new();
     if !scene.is_molecular() {
         rows.push((

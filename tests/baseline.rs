@@ -456,11 +456,13 @@ fn the_molecular_gap_splits_into_medium_coherence_and_quadrature() {
     assert!(de(l_mix, l_coh) > 0.5 && de(l_med, l_mix) < 0.5);
 }
 
-/// Every model on a 61-wavelength grid, the three geometries: milliseconds
-/// per variant (measured on the shared 2-core development machine, 200 and
-/// 450 nm red spheres at 50 % PVC: KM ≈ 1 ms, adding–doubling 70–110 ms).
+/// Every model on a 61-wavelength grid, the three geometries, gives
+/// factors in [0, 1]; the time each takes is printed, not asserted (a
+/// shared machine's clock is no test: measured on the 2-core development
+/// machine, 200 and 450 nm red spheres at 50 % PVC, KM ≈ 1 ms,
+/// adding–doubling 70–110 ms; `--nocapture` shows it).
 #[test]
-fn every_baseline_runs_in_milliseconds() {
+fn every_baseline_gives_bounded_factors_on_a_fine_grid() {
     let dir = tempfile::tempdir().unwrap();
     for d in [200.0, 450.0] {
         let scene = with_baseline(SceneToml::grains())
@@ -481,8 +483,6 @@ fn every_baseline_runs_in_milliseconds() {
                 .iter()
                 .flatten()
                 .all(|v| v.is_finite() && *v >= 0.0 && *v <= 1.0));
-            // A loose bound (a shared machine): a slow change shows.
-            assert!(ms < 2000.0, "{}: {ms} ms", model.name());
         }
     }
 }

@@ -1013,3 +1013,34 @@ fn each_grid_picture_has_a_de00_heat_map_to_its_reference_cell() {
         assert!(md.contains(&format!("(grids/{})", m.file)), "{md}");
     }
 }
+
+#[test]
+fn a_dissolved_variant_under_a_realisation_target_is_finished() {
+    // A homogeneous layer runs one realisation whatever the target asks;
+    // with a target of up to 64, its result is still whole, and the merge
+    // takes it (it used to be counted as unfinished, its solves read as a
+    // fraction of 64 realisations).
+    let dir = tempfile::tempdir().unwrap();
+    let study = sweep()
+        .profile_key(
+            "quick",
+            "realisations",
+            common::keys::value("{ target_de00 = 1000.0, min = 2, max = 64 }"),
+        )
+        .compound_axis(
+            "grain",
+            &[
+                ("spheres", r#"{ "pigment.*.shape" = { kind = "sphere" } }"#),
+                ("dye", r#"{ "pigment.*.shape" = { kind = "molecular" } }"#),
+            ],
+        );
+    let p = write(dir.path(), "sweep.toml", &study.toml());
+    let p = p.to_str().unwrap();
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("8 ran, 0 skipped"), "{out}");
+    let (ok, out, err) = inksim_in(dir.path(), &["--threads", "1", "run", p]);
+    assert!(ok && out.contains("0 ran, 8 skipped"), "{out}\n{err}");
+    let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
+    assert!(ok, "{err}");
+}

@@ -171,15 +171,18 @@ pub fn state(v: &Variant) -> State {
 /// the target's minimum and the most allowed (the run stops when the
 /// colour is certain enough).
 fn complete(scene: &crate::config::Scene, entries: usize) -> bool {
-    let planned = pipeline::planned_solves(scene);
+    let plan = pipeline::RunPlan::of(scene);
+    let planned = plan.solves(scene);
     match scene.realisation_target {
-        None => entries == planned,
-        Some(t) => {
-            let per = planned / scene.realisations.max(1);
+        // A layer the same in every realisation (homogeneous, explicit)
+        // runs one whatever the target: all of its solves.
+        Some(t) if plan.realisations > 1 => {
+            let per = planned / plan.realisations;
             per > 0
                 && entries.is_multiple_of(per)
-                && (t.min.min(scene.realisations)..=scene.realisations).contains(&(entries / per))
+                && (t.min.min(plan.realisations)..=plan.realisations).contains(&(entries / per))
         }
+        _ => entries == planned,
     }
 }
 

@@ -54,10 +54,37 @@ impl PageInput<'_> {
             }),
             None => "no profiles".into(),
         };
-        let mut realisations: Vec<usize> =
-            self.rows.iter().map(|r| r.v.scene.realisations).collect();
-        realisations.sort_unstable();
-        realisations.dedup();
+        // The realisations each variant's result holds (a target stops
+        // early), and the most the profile allowed.
+        let used: Vec<usize> = self
+            .rows
+            .iter()
+            .map(|r| {
+                r.s.entries
+                    .iter()
+                    .map(|e| e.realisation + 1)
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let (lo, hi) = (
+            used.iter().copied().min().unwrap_or(0),
+            used.iter().copied().max().unwrap_or(0),
+        );
+        let target = self.rows.iter().find_map(|r| {
+            r.v.scene
+                .realisation_target
+                .map(|t| (t, r.v.scene.realisations))
+        });
+        let realisations = match (lo == hi, target) {
+            (true, None) => lo.to_string(),
+            (false, None) => format!("{lo}–{hi}"),
+            (_, Some((t, most))) => format!(
+                "{lo}–{hi} (added until the colour's s.e. is {} ΔE00, at most {most}; a \
+                 layer the same in every realisation runs one)",
+                fmt_target(t.de00)
+            ),
+        };
         let colour = self.rows.iter().find_map(|r| r.measured.as_ref()).map_or(
             "no measured colours".into(),
             |m| {
@@ -84,14 +111,7 @@ impl PageInput<'_> {
                     )
                 },
             ),
-            (
-                "realisations per variant".into(),
-                realisations
-                    .iter()
-                    .map(usize::to_string)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            ),
+            ("realisations per variant".into(), realisations),
             ("colour".into(), colour),
             ("inksim version".into(), crate::VERSION.to_string()),
             ("merged".into(), utc_date(self.unix_s)),
@@ -368,6 +388,12 @@ fn variants_html(p: &PageInput) -> String {
         s += &tr(&cells, "td");
     }
     s + "</table>\n"
+}
+
+/// A target uncertainty as written: 0.7, 1.7, 1.
+fn fmt_target(v: f64) -> String {
+    let t = format!("{v:.3}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 #[cfg(test)]

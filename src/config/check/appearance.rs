@@ -18,6 +18,7 @@ impl Checker<'_> {
         &self,
         raw: Option<&RawAppearance>,
         incidence: &[Incidence],
+        default_outputs: &[RawProduct],
     ) -> Result<Appearance, ConfigError> {
         let viewing_deg = match raw.and_then(|a| a.viewing_deg.as_ref()) {
             None => incidence.iter().map(|i| i.polar_deg).collect(),
@@ -33,7 +34,7 @@ impl Checker<'_> {
         let mut products = Products::default();
         let list = raw
             .and_then(|a| a.outputs.clone())
-            .unwrap_or_else(|| vec![RawProduct::Brdf, RawProduct::Tile]);
+            .unwrap_or_else(|| default_outputs.to_vec());
         for p in list {
             match p {
                 RawProduct::Brdf => products.brdf = true,

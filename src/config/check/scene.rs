@@ -2,7 +2,7 @@
 //! against every wavelength, the input hash, and the output folder and name.
 
 use super::Checker;
-use crate::config::raw::{RawConfig, RawOutput, RawRealisations};
+use crate::config::raw::{RawConfig, RawOutput, RawProduct, RawRealisations};
 use crate::config::{
     ConfigError, GrainShape, Material, OutputSpec, Provenance, RealisationTarget, Scene, Structure,
     Substrate, Surface,
@@ -82,20 +82,17 @@ impl Checker<'_> {
         let incidence = self.incidence(&raw.illumination)?;
         let solver = self.solver(raw.solver.as_ref())?;
         let output = self.output(path, raw.output.as_ref())?;
-        let mut appearance = self.appearance(raw.appearance.as_ref(), &incidence)?;
         // An incoherent stack's default outputs are its tile alone: the
         // BRDF at every azimuth (the default "brdf") is not made there.
-        if stack
+        let default_outputs: &[RawProduct] = if stack
             .as_ref()
             .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent)
-            && raw
-                .appearance
-                .as_ref()
-                .and_then(|a| a.outputs.as_ref())
-                .is_none()
         {
-            appearance.products.brdf = false;
-        }
+            &[RawProduct::Tile]
+        } else {
+            &[RawProduct::Brdf, RawProduct::Tile]
+        };
+        let appearance = self.appearance(raw.appearance.as_ref(), &incidence, default_outputs)?;
         if realisation_target.is_some() && !appearance.products.tile {
             return Err(self.invalid(
                 "realisations.target_de00",

@@ -23,7 +23,7 @@ use super::layer::{self, SolvedLayer};
 use super::memory::{self, MemoryLimit};
 use super::plan::{node_deg, plan_text, stack_air_angles, stack_ordinates, stack_plan, RunPlan};
 use super::result::{ResultParts, RunReport};
-use super::stack_proxy::{halftone_of, proxy_factors};
+use super::stack_proxy::proxy_factors;
 use super::{check_output_dir, check_output_files, result_paths, started, PipelineError};
 
 /// Run an incoherent stack end to end and write its result file.
@@ -179,7 +179,10 @@ fn combine(
     let rr = plan.realisations;
     // The diffuse BRDF in the plane of incidence, 1/sr, (wavelength,
     // illumination, viewing), per realisation.
-    let mut brdf = vec![Array3::zeros((wl.len(), illumination.len(), viewing.len())); rr];
+    let mut brdf = vec![
+        Array3::zeros((wl.len(), illumination.len(), viewing.len()));
+        if tile { rr } else { 0 }
+    ];
     let mut factors = vec![vec![Array1::zeros(wl.len()); rr]; measurements.len()];
     let mut natural = vec![Array2::zeros((wl.len(), viewing.len())); rr];
     let mut rta = vec![[(); 3].map(|_| Array2::zeros((wl.len(), above.len()))); rr];
@@ -230,7 +233,7 @@ fn combine(
         }
     }
     let observer = Observer::standard(scene.appearance.illuminant, scene.appearance.observer);
-    let proxy = proxy_factors(scene, scenes, &ords, below, &illumination)?;
+    let proxy = proxy_factors(scene, scenes, &ords, below, &views, (&coverage, yn))?;
     let mut measured: Vec<MeasuredColour> = Vec::with_capacity(measurements.len());
     for (g, &m) in measurements.iter().enumerate() {
         let p = proxy.as_ref().map(|p| (&p.fine[..], &p.factors[g][..]));
@@ -310,4 +313,13 @@ fn combine(
         baseline,
         conditions: (scene.appearance.illuminant, scene.appearance.observer),
     })
+}
+
+/// Each layer's coverage and Yule–Nielsen's n of the stack of `scene`.
+fn halftone_of(scene: &Scene) -> (Vec<f64>, f64) {
+    let st = scene.stack.as_ref().expect("a stack");
+    (
+        st.layers.iter().map(|l| l.coverage).collect(),
+        st.yule_nielsen_n,
+    )
 }

@@ -19,15 +19,6 @@ use super::eps::mean_eps;
 use super::plan::node_deg;
 use super::PipelineError;
 
-/// Each layer's coverage and Yule–Nielsen's n of the stack of `scene`.
-pub(super) fn halftone_of(scene: &Scene) -> (Vec<f64>, f64) {
-    let st = scene.stack.as_ref().expect("a stack");
-    (
-        st.layers.iter().map(|l| l.coverage).collect(),
-        st.yule_nielsen_n,
-    )
-}
-
 /// The spectral proxy of a stack on the fine colour grid: each
 /// measurement's reflectance factor, and the tile's BRDF square (1/sr) and
 /// sky strip.
@@ -35,7 +26,8 @@ pub(super) struct StackProxy {
     pub fine: Vec<f64>,
     /// Per measurement, per fine wavelength.
     pub factors: Vec<Vec<f64>>,
-    /// (fine wavelength, illumination, viewing).
+    /// (fine wavelength, illumination, viewing); no illumination angle
+    /// when the tile is not asked for.
     pub brdf: Array3<f64>,
     /// (fine wavelength, viewing).
     pub sky: Array2<f64>,
@@ -43,14 +35,17 @@ pub(super) struct StackProxy {
 
 /// The spectral proxy of the stack: every layer its homogeneous slab (the
 /// volume-averaged ε, in closed form inside the binder), stacked the same
-/// way, on the fine colour grid. None for one wavelength, without paper,
-/// or where a material has no data on the grid.
+/// way and printed at the same `halftone` (coverages, Yule–Nielsen's n),
+/// on the fine colour grid, seen from `views` (the BRDF square only where
+/// they ask for it). None for one wavelength, without paper, or where a
+/// material has no data on the grid.
 pub(super) fn proxy_factors(
     scene: &Scene,
     scenes: &[Scene],
     ords: &Ordinates,
     below: Below,
-    illumination: &[f64],
+    views: &Views,
+    halftone: (&[f64], f64),
 ) -> Result<Option<StackProxy>, PipelineError> {
     let wl = &scene.wavelengths_nm;
     if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
@@ -59,11 +54,17 @@ pub(super) fn proxy_factors(
     let fine = fine_grid(wl);
     let nb = scene.layer.binder_index;
     let nodes = node_deg(ords);
-    let measurements = &scene.appearance.measurements;
-    let viewing = &scene.appearance.viewing_deg;
-    let mut factors = vec![Vec::with_capacity(fine.len()); measurements.len()];
-    let mut brdf = Array3::zeros((fine.len(), illumination.len(), viewing.len()));
-    let mut sky = Array2::zeros((fine.len(), viewing.len()));
+    // The totals in air are not part of a colour.
+    let views = Views {
+        above_deg: &[],
+        ..*views
+    };
+    let (coverage, yn) = halftone;
+    let ni = views.illumination_deg.map_or(0, |i| i.len());
+    let nv = views.viewing_deg.len();
+    let mut factors = vec![Vec::with_capacity(fine.len()); views.measurements.len()];
+    let mut brdf = Array3::zeros((fine.len(), ni, nv));
+    let mut sky = Array2::zeros((fine.len(), nv));
     for (f, &w) in fine.iter().enumerate() {
         let mut slabs = Vec::with_capacity(scenes.len());
         for ls in scenes {
@@ -85,14 +86,7 @@ pub(super) fn proxy_factors(
                 azimuthal: Vec::new(),
             });
         }
-        let views = Views {
-            measurements,
-            viewing_deg: viewing,
-            illumination_deg: Some(illumination),
-            above_deg: &[],
-        };
-        let (coverage, yn) = halftone_of(scene);
-        let look = stack::halftone(ords, &slabs, &coverage, yn, below, &views)?;
+        let look = stack::halftone(ords, &slabs, coverage, yn, below, &views)?;
         for (g, x) in look.factors.into_iter().enumerate() {
             factors[g].push(x);
         }

@@ -81,17 +81,21 @@ pub fn look(
         Some(ill) => Some(plane_factors(ords, layers, &sr, ill, v.viewing_deg)?),
         None => None,
     };
-    let free = free_stack(ords, &layers.iter().map(|l| &l.total).collect::<Vec<_>>())?;
-    let totals = v
-        .above_deg
-        .iter()
-        .map(|&deg| {
-            let j = ords.air_node(deg).ok_or(BaselineError::NoDirection(deg))?;
-            let r: f64 = (0..ords.len()).map(|i| free.r_down[(i, j)]).sum();
-            let t: f64 = (0..ords.len()).map(|i| free.t_down[(i, j)]).sum();
-            Ok([r, t, 1.0 - r - t])
-        })
-        .collect::<Result<_, BaselineError>>()?;
+    // The stack in air, only when its totals are asked for.
+    let totals = if v.above_deg.is_empty() {
+        Vec::new()
+    } else {
+        let free = free_stack(ords, &layers.iter().map(|l| &l.total).collect::<Vec<_>>())?;
+        v.above_deg
+            .iter()
+            .map(|&deg| {
+                let j = ords.air_node(deg).ok_or(BaselineError::NoDirection(deg))?;
+                let r: f64 = (0..ords.len()).map(|i| free.r_down[(i, j)]).sum();
+                let t: f64 = (0..ords.len()).map(|i| free.t_down[(i, j)]).sum();
+                Ok([r, t, 1.0 - r - t])
+            })
+            .collect::<Result<_, BaselineError>>()?
+    };
     Ok(Look {
         factors,
         natural,

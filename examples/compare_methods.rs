@@ -59,6 +59,7 @@ fn main() -> anyhow::Result<()> {
                 lattice: lat,
                 eps: &eps,
                 eps_binder: eps_b,
+                wave: inksim::solver::Wave::Scalar,
             };
             for method in [
                 Method::Born,

@@ -142,6 +142,7 @@ fn main() {
                         lattice: lat,
                         eps: &eps,
                         eps_binder: eps_b,
+                        wave: inksim::solver::Wave::Scalar,
                     };
                     let sol = solver::solve(&p, Method::Auto, &ctl).expect("solve");
                     let e = efficiencies(&sol);

@@ -53,6 +53,7 @@ fn main() {
         lattice: lat,
         eps: &eps,
         eps_binder: eps_b,
+        wave: inksim::solver::Wave::Scalar,
     };
     println!(
         "hard case: {n_p} spheres of 300 nm, PVC {:.3} (layer {:.3}), grid {}×{}×{}, λ 450 nm, 40°",

@@ -134,6 +134,7 @@ fn run(a: &Args) -> Result<(), String> {
             lattice,
             eps: &eps,
             eps_binder: N_BINDER * N_BINDER,
+            wave: inksim::solver::Wave::Scalar,
         };
         for (name, method) in &a.methods {
             let start = Instant::now();

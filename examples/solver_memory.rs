@@ -70,6 +70,7 @@ fn main() {
         lattice: Problem::lattice([nx, ny, nz], size, 450.0, 40.0, 0.0),
         eps: &eps,
         eps_binder: eb,
+        wave: inksim::solver::Wave::Scalar,
     };
     let ctl = Controls {
         tolerance: 1e-6,

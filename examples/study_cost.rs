@@ -226,6 +226,7 @@ fn child(layer: &str, name: &str) {
                 lattice,
                 eps: &eps,
                 eps_binder: eps_b,
+                wave: inksim::solver::Wave::Scalar,
             };
             let mut sys = System::with_params(&p, path.shift).unwrap();
             let mut scr = sys.scratch();

@@ -85,6 +85,7 @@ fn worst_error(eps_s: C64, polar_deg: f64, l: f64, cells: usize) -> f64 {
             lattice,
             eps: &eps,
             eps_binder: 1.0,
+            wave: inksim::solver::Wave::Scalar,
         },
         Method::Auto,
         &Controls {

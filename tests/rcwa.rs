@@ -235,6 +235,7 @@ fn solve_case(c: &Case, cell: f64) -> (Vec<(i32, f64, f64)>, String) {
         lattice,
         eps: &eps,
         eps_binder: c.eps_binder,
+        wave: inksim::solver::Wave::Scalar,
     };
     let sol = solver::solve(&p, Method::Auto, &CTL)
         .unwrap_or_else(|e| panic!("{} at {cell} nm: {e}", c.name));

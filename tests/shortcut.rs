@@ -229,6 +229,7 @@ fn measured(material: &Material, d: f64, pvc: f64, wl: f64, polar: f64) -> (f64,
         lattice: Problem::lattice([32, 32, 40], size, wl, polar, 0.0),
         eps: &eps,
         eps_binder: eps_b,
+        wave: inksim::solver::Wave::Scalar,
     };
     let ctl = Controls {
         tolerance: 1e-8,

@@ -14,6 +14,7 @@ pub mod materials;
 mod method;
 mod raw;
 mod stack;
+mod wave;
 
 use std::path::{Path, PathBuf};
 
@@ -25,6 +26,7 @@ pub use stack::{
     Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS,
     MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS, MAX_YULE_NIELSEN_N,
 };
+pub use wave::{Equation, Linear, Polarisation};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
 /// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).

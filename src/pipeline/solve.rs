@@ -122,6 +122,7 @@ pub fn solve_layer(
                 lattice,
                 eps: grid_eps,
                 eps_binder: eps_b / outside,
+                wave: crate::solver::Wave::Scalar,
             };
             // A long solve reports where it stands (solver::heartbeat).
             let beat = |b: Beat| {
@@ -248,6 +249,7 @@ pub fn solve_analytic(
                 lattice,
                 eps: &mean,
                 eps_binder: eps_b / outside,
+                wave: crate::solver::Wave::Scalar,
             };
             let mut sol =
                 solver::solve(&p, Method::Airy, &ctl).map_err(|source| PipelineError::Solve {

@@ -47,29 +47,42 @@ pub struct SlabField {
     b: C64,
     gamma: C64,
     thickness: f64,
+    /// p polarisation: (ε, k0, κ) for the electric field.
+    p: Option<(C64, f64, f64)>,
 }
 
 impl SlabField {
     /// The slab of permittivity `eps`, `thickness_nm` thick, in vacuum, lit
     /// from above by a wave of free-space wavenumber `k0` and lateral
-    /// wavenumber `kx` (rad/nm).
+    /// wavenumber `kx` (rad/nm): the scalar wave, which is s polarisation.
     pub fn new(eps: C64, thickness_nm: f64, k0: f64, kx: f64) -> SlabField {
+        Self::polarised(eps, thickness_nm, k0, kx, false)
+    }
+
+    /// As [`SlabField::new`] in s (`p = false`) or p polarisation. In p the
+    /// unknown is the magnetic field H_y (continuous with H_y'/ε), and
+    /// `r` is the reflected E_p amplitude along p̂ = (β ê_x + κ ẑ)/k0,
+    /// which is `−r_H`; `t = t_H`. The absorption integrates
+    /// `|E|² = (|γ|² |H_y'/(iγ)|² + κ² |H_y|²)/(k0² |ε|²)` in closed form.
+    pub fn polarised(eps: C64, thickness_nm: f64, k0: f64, kx: f64, p: bool) -> SlabField {
         let beta = C64::new((k0 * k0 - kx * kx).max(0.0).sqrt(), 0.0);
         let g = sqrt_branch(eps * k0 * k0 - kx * kx);
+        // The derivative rows' inner admittance: γ (s) or γ/ε (p).
+        let y = if p { g / eps } else { g };
         let h = thickness_nm;
         let e1 = (C64::i() * g * h).exp();
         let one = C64::new(1.0, 0.0);
         let zero = C64::new(0.0, 0.0);
-        // Unknowns x = (r, a, b, t); rows: u and u' continuous at z = 0 and z = H.
+        // Unknowns x = (r, a, b, t); rows: u and u'/ε (p) continuous at z = 0 and z = H.
         let mut m = [
             [-one, one, e1, zero, one],
-            [beta, g, -g * e1, zero, beta],
+            [beta, y, -y * e1, zero, beta],
             [zero, e1, one, -one, zero],
-            [zero, g * e1, -g, -beta, zero],
+            [zero, y * e1, -y, -beta, zero],
         ];
         let x = solve4(&mut m);
         let (r, a, b, t) = (x[0], x[1], x[2], x[3]);
-        // ∫₀ᴴ |a e^{iγz} + b e^{iγ(H−z)}|² dz in closed form.
+        // ∫₀ᴴ |a e^{iγz} ± b e^{iγ(H−z)}|² dz in closed form.
         let (gr, gi) = (g.re, g.im);
         let decay = h * phi1(C64::new(-2.0 * gi * h, 0.0)).re;
         let cross = a
@@ -77,20 +90,54 @@ impl SlabField {
             * (C64::new(0.0, -gr * h).exp() * (-gi * h).exp())
             * h
             * phi1(C64::new(0.0, 2.0 * gr * h));
-        let integral = (a.norm_sqr() + b.norm_sqr()) * decay + 2.0 * cross.re;
+        let plus = (a.norm_sqr() + b.norm_sqr()) * decay + 2.0 * cross.re;
+        let integral = if p {
+            let minus = (a.norm_sqr() + b.norm_sqr()) * decay - 2.0 * cross.re;
+            (g.norm_sqr() * minus + kx * kx * plus) / (k0 * k0 * eps.norm_sqr())
+        } else {
+            plus
+        };
         let absorption = k0 * k0 * eps.im * integral / beta.re;
         SlabField {
-            response: SlabResponse { r, t, absorption },
+            response: SlabResponse {
+                r: if p { -r } else { r },
+                t,
+                absorption,
+            },
             a,
             b,
             gamma: g,
             thickness: h,
+            p: p.then_some((eps, k0, kx)),
         }
     }
 
     /// Averages of the field over `nz` equal z cells (both waves decay away
-    /// from the face they are referred to, so nothing overflows).
+    /// from the face they are referred to, so nothing overflows): u, or in
+    /// p polarisation H_y (scaled to a unit incident E).
     pub fn cell_averages(&self, nz: usize) -> Vec<C64> {
+        self.averages(nz, 1.0)
+    }
+
+    /// `(E_κ, E_z)` per z cell of a p-polarised slab (E_κ along the plane of
+    /// incidence); `None` in s.
+    pub fn p_cell_averages(&self, nz: usize) -> Option<(Vec<C64>, Vec<C64>)> {
+        let (eps, k0, kx) = self.p?;
+        let ek = self
+            .averages(nz, -1.0)
+            .into_iter()
+            .map(|v| v * self.gamma / (k0 * eps))
+            .collect();
+        let ez = self
+            .averages(nz, 1.0)
+            .into_iter()
+            .map(|v| -v * kx / (k0 * eps))
+            .collect();
+        Some((ek, ez))
+    }
+
+    /// Cell averages of `a e^{iγz} + sign · b e^{iγ(H−z)}`.
+    fn averages(&self, nz: usize, sign: f64) -> Vec<C64> {
         let dz = self.thickness / nz as f64;
         let i = C64::i();
         let cell = phi1(i * self.gamma * dz);
@@ -98,7 +145,7 @@ impl SlabField {
             .map(|j| {
                 let (top, bottom) = (j as f64 * dz, self.thickness - (j + 1) as f64 * dz);
                 cell * (self.a * (i * self.gamma * top).exp()
-                    + self.b * (i * self.gamma * bottom).exp())
+                    + sign * self.b * (i * self.gamma * bottom).exp())
             })
             .collect()
     }

@@ -56,6 +56,7 @@ pub mod fft;
 pub mod green;
 pub mod heartbeat;
 pub mod lattice;
+pub mod maxwell;
 pub mod methods;
 pub mod operator;
 pub mod shift;
@@ -63,7 +64,7 @@ pub mod simd;
 pub mod storage;
 pub mod system;
 
-use crate::config::{Background, Method, Precision};
+use crate::config::{Background, Linear, Method, Precision};
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
@@ -123,6 +124,23 @@ pub struct Problem<'a> {
     pub eps: &'a Array3<C64>,
     /// Binder permittivity (real: the binder is transparent).
     pub eps_binder: f64,
+    /// The wave equation and, for Maxwell's, the incident polarisation.
+    pub wave: Wave,
+}
+
+/// Which wave equation a problem is solved in (METHOD §4, §9).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Wave {
+    /// The scalar Helmholtz equation; the field is (nz, ny, nx).
+    Scalar,
+    /// Maxwell's equations, lit by a plane wave of one linear polarisation
+    /// (relative to the plane of incidence at `azimuth_deg`, which also
+    /// fixes s and p at normal incidence); the field is (3 nz, ny, nx),
+    /// E_x, E_y, E_z stacked.
+    Vector {
+        polarisation: Linear,
+        azimuth_deg: f64,
+    },
 }
 
 impl Problem<'_> {
@@ -161,15 +179,30 @@ pub struct Controls {
 /// A solved problem: the field and what the far field needs.
 pub struct Solution {
     pub lattice: Lattice,
-    /// Cell-averaged periodic field v, (nz, ny, nx).
+    /// Cell-averaged periodic field v, (nz, ny, nx); for Maxwell
+    /// (3 nz, ny, nx), E_x, E_y, E_z stacked.
     pub field: Array3<C64>,
-    /// Reflection amplitudes r_mn (total, u_mn(0) − δ), spectral layout (nx, ny).
+    /// Reflection amplitudes r_mn (total, u_mn(0) − δ), spectral layout
+    /// (nx, ny); for Maxwell the s amplitude of each order.
     pub r: Array2<C64>,
-    /// Transmission amplitudes t_mn, spectral layout (nx, ny).
+    /// Transmission amplitudes t_mn, spectral layout (nx, ny); for Maxwell
+    /// the s amplitude.
     pub t: Array2<C64>,
     /// Absorbed fraction of the incident power.
     pub absorption: f64,
     pub record: SolveRecord,
+    /// Maxwell's p amplitudes; `None` for the scalar wave.
+    pub vector: Option<VectorAmplitudes>,
+}
+
+/// The p amplitudes of every order of a Maxwell solution (E_p along
+/// p̂ = (β ê_κ ± κ ẑ)/k0 of the outgoing wave), beside the s ones in
+/// [`Solution::r`], [`Solution::t`], and the incident polarisation.
+#[derive(Debug, Clone)]
+pub struct VectorAmplitudes {
+    pub incident: Linear,
+    pub r_p: Array2<C64>,
+    pub t_p: Array2<C64>,
 }
 
 impl Solution {
@@ -177,10 +210,38 @@ impl Solution {
     /// homogeneous slab's answer.
     pub fn slab_response(&self) -> airy::SlabResponse {
         airy::SlabResponse {
-            r: self.r[[0, 0]],
-            t: self.t[[0, 0]],
+            r: self.specular_r(),
+            t: self.specular_t(),
             absorption: self.absorption,
         }
+    }
+
+    /// The specular order's reflection amplitude in the incident
+    /// polarisation (co-polarised for Maxwell).
+    pub fn specular_r(&self) -> C64 {
+        match &self.vector {
+            Some(v) if v.incident == Linear::P => v.r_p[[0, 0]],
+            _ => self.r[[0, 0]],
+        }
+    }
+
+    /// The specular order's co-polarised transmission amplitude.
+    pub fn specular_t(&self) -> C64 {
+        match &self.vector {
+            Some(v) if v.incident == Linear::P => v.t_p[[0, 0]],
+            _ => self.t[[0, 0]],
+        }
+    }
+
+    /// The power of order (ix, iy) in reflection and transmission, before
+    /// the `Re β / β00` factor: `|r|²` (scalar), `|r_s|² + |r_p|²` (Maxwell).
+    pub fn order_power(&self, ix: usize, iy: usize) -> (f64, f64) {
+        let (mut r, mut t) = (self.r[[ix, iy]].norm_sqr(), self.t[[ix, iy]].norm_sqr());
+        if let Some(v) = &self.vector {
+            r += v.r_p[[ix, iy]].norm_sqr();
+            t += v.t_p[[ix, iy]].norm_sqr();
+        }
+        (r, t)
     }
 }
 

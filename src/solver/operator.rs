@@ -306,7 +306,7 @@ impl Operator {
 
 /// `f(ix, row, scratch)` for every spectral row `ix` of `spec` ((nz, nx, ny)),
 /// in parallel over chunks of consecutive rows, one scratch per chunk.
-fn for_each_row<T: Send>(
+pub(super) fn for_each_row<T: Send>(
     spec: &mut Array3<C64>,
     scratch: &mut [T],
     f: impl Fn(usize, &mut ArrayViewMut2<C64>, &mut T) + Sync,

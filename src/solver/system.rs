@@ -16,12 +16,13 @@
 
 use super::green;
 use super::lattice::Lattice;
+use super::maxwell::{VectorOperator, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
-use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
-use super::{Problem, Solution, SolveError, SolveRecord};
-use crate::config::Background;
-use ndarray::{Array2, Array3, Zip};
+use super::storage::{norm_sqr, on_field, Field, Storage};
+use super::{Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
+use crate::config::{Background, Linear};
+use ndarray::{s, Array2, Array3, ArrayView3, ArrayViewMut3, Zip};
 use num_complex::Complex64 as C64;
 
 /// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
@@ -59,26 +60,44 @@ impl ShiftParams {
 /// The discrete equation `u = u_bg + G_b V u` of one problem, in its plain
 /// and its shifted form.
 pub struct System<'a> {
-    op: Operator,
-    /// `G_b`'s tables, built on the first plain residual (Born) and
-    /// released by [`System::release_binder`] when Born is not used.
-    binder: Option<GreenTable>,
+    /// The background Green's operator of the equation solved.
+    op: Equation,
+    lat: Lattice,
     eps: &'a Array3<C64>,
     eps_binder: f64,
     /// k0².
     k2: f64,
-    /// Cell averages of u_bg per z (constant in x, y).
+    /// Cell averages of u_bg per row of the unknowns (z cells; for Maxwell
+    /// the three components' z cells), constant in x, y.
     ubg: Vec<C64>,
-    r_bg: C64,
-    t_bg: C64,
+    /// The background's specular amplitudes: `[s, p]` for Maxwell, `[u, 0]`
+    /// for the scalar wave.
+    r_bg: [C64; 2],
+    t_bg: [C64; 2],
     ubg_norm: f64,
     /// The background of the shifted form, its exact operator and source.
     shift: Shift,
     /// Kept to rebuild the shift for another background.
     params: ShiftParams,
-    /// Top/bottom functionals of G_b for harmonic 00 (never resonant: it propagates).
-    top00: Vec<C64>,
-    bottom00: Vec<C64>,
+}
+
+/// The two wave equations' background operators (METHOD §4, §9): the same
+/// methods iterate on either through [`System`]'s operations.
+enum Equation {
+    /// The scalar Helmholtz equation: the unknowns are (nz, ny, nx).
+    Scalar {
+        op: Operator,
+        /// `G_b`'s tables, built on the first plain residual (Born) and
+        /// released by [`System::release_binder`] when Born is not used.
+        binder: Option<GreenTable>,
+        /// Top/bottom functionals of G_b for harmonic 00 (never resonant:
+        /// it propagates).
+        top00: Vec<C64>,
+        bottom00: Vec<C64>,
+    },
+    /// Maxwell's equations for one incident linear polarisation: the
+    /// unknowns are (3 nz, ny, nx), E_x, E_y, E_z stacked.
+    Vector { op: VectorOperator, pol: Linear },
 }
 
 /// The background of the shifted form `u = u_s + G_s V' u`: permittivity
@@ -92,18 +111,30 @@ struct Shift {
     /// the unpreconditioned mean background.
     cbs: Option<(f64, f64)>,
     c: C64,
-    table: ShiftTable,
+    /// The scalar equation's tables (the vector operator needs none).
+    table: Option<ShiftTable>,
+    /// u_s per row of the unknowns.
     us: Vec<C64>,
     us_norm: f64,
+    /// Boundary amplitudes of `G_b u_s` (harmonic 00): `[s, p]` (Maxwell)
+    /// or `[u, 0]`.
+    us_top: [C64; 2],
+    us_bottom: [C64; 2],
 }
 
 /// Working memory of a [`System`]'s operations, sized for its lattice.
 pub struct Scratch {
     /// The operator's own scratch (spectra, FFT and sweep buffers).
-    op: Workspace,
+    op: OpWorkspace,
     /// The f64 field every operator application works on (V u or V' u in,
     /// G of it out); the methods' own fields may be f32.
     field: Array3<C64>,
+}
+
+/// The scratch of either operator.
+enum OpWorkspace {
+    Scalar(Workspace),
+    Vector(VectorWorkspace),
 }
 
 /// Real centre and radius of the permittivity values: (ε_r, max|ε − ε_r|).
@@ -159,25 +190,47 @@ impl<'a> System<'a> {
                 "permittivity must be finite with Im ε ≥ 0 (passive)".into(),
             ));
         }
-        let op = Operator::new(lat);
         let k2 = lat.k0 * lat.k0;
-        let mut ubg = vec![C64::new(0.0, 0.0); lat.nz];
-        let g2 = C64::new(k2 * p.eps_binder - lat.q[0].powi(2) - lat.q[1].powi(2), 0.0);
-        let (r_bg, t_bg) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
+        let (op, ubg, r_bg, t_bg) = match p.wave {
+            Wave::Scalar => {
+                let op = Operator::new(lat);
+                let mut ubg = vec![C64::new(0.0, 0.0); lat.nz];
+                let g2 = C64::new(k2 * p.eps_binder - lat.q[0].powi(2) - lat.q[1].powi(2), 0.0);
+                let (r, t) = green::background_response(&lat.slab(), g2, lat.beta(0, 0), &mut ubg);
+                let c00 = green::coef_from(&lat.slab(), g2, lat.beta(0, 0));
+                let top00 = (0..lat.nz).map(|k| c00.top_weight(lat.nz, k)).collect();
+                let bottom00 = (0..lat.nz).map(|k| c00.bottom_weight(lat.nz, k)).collect();
+                let zero = C64::new(0.0, 0.0);
+                let op = Equation::Scalar {
+                    op,
+                    binder: None,
+                    top00,
+                    bottom00,
+                };
+                (op, ubg, [r, zero], [t, zero])
+            }
+            Wave::Vector {
+                polarisation,
+                azimuth_deg,
+            } => {
+                let op = VectorOperator::new(lat, p.eps_binder, azimuth_deg);
+                let bg = op.background(polarisation);
+                let op = Equation::Vector {
+                    op,
+                    pol: polarisation,
+                };
+                (op, bg.rows, bg.r, bg.t)
+            }
+        };
         let ubg_norm =
             (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
-        let shift = Shift::new(&lat, p.eps, p.eps_binder, &ubg, params);
-        let c00 = green::coef_from(&lat.slab(), g2, lat.beta(0, 0));
-        let top00 = (0..lat.nz).map(|k| c00.top_weight(lat.nz, k)).collect();
-        let bottom00 = (0..lat.nz).map(|k| c00.bottom_weight(lat.nz, k)).collect();
+        let shift = Shift::new(&op, &lat, p.eps, p.eps_binder, &ubg, params);
         Ok(System {
             shift,
             params,
             k2,
-            top00,
-            bottom00,
             op,
-            binder: None,
+            lat,
             eps: p.eps,
             eps_binder: p.eps_binder,
             ubg,
@@ -187,13 +240,32 @@ impl<'a> System<'a> {
         })
     }
 
+    /// The shape of the unknowns: (nz, ny, nx) for the scalar wave, (3 nz,
+    /// ny, nx) for Maxwell's three components.
+    pub fn unknown_dim(&self) -> (usize, usize, usize) {
+        let (nz, ny, nx) = self.eps.dim();
+        match self.op {
+            Equation::Scalar { .. } => (nz, ny, nx),
+            Equation::Vector { .. } => (3 * nz, ny, nx),
+        }
+    }
+
+    /// Number of field components (1 or 3).
+    fn components(&self) -> usize {
+        match self.op {
+            Equation::Scalar { .. } => 1,
+            Equation::Vector { .. } => 3,
+        }
+    }
+
     /// Rebuild the shifted form on background `bg` (time-marching needs the
     /// CBS shift); nothing happens if it is already the one in use.
     pub fn use_background(&mut self, bg: Background) {
         if self.shift.kind != bg {
             self.params.background = bg;
             self.shift = Shift::new(
-                &self.op.lat,
+                &self.op,
+                &self.lat,
                 self.eps,
                 self.eps_binder,
                 &self.ubg,
@@ -204,14 +276,18 @@ impl<'a> System<'a> {
 
     /// Fresh working memory for this system's operations.
     pub fn scratch(&self) -> Scratch {
+        let op = match &self.op {
+            Equation::Scalar { op, .. } => OpWorkspace::Scalar(op.workspace()),
+            Equation::Vector { op, .. } => OpWorkspace::Vector(op.workspace()),
+        };
         Scratch {
-            op: self.op.workspace(),
-            field: Array3::zeros(self.eps.dim()),
+            op,
+            field: Array3::zeros(self.unknown_dim()),
         }
     }
 
     pub fn lattice(&self) -> &Lattice {
-        &self.op.lat
+        &self.lat
     }
 
     /// Total permittivity per voxel, (nz, ny, nx).
@@ -271,10 +347,44 @@ impl<'a> System<'a> {
     /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)`.
     fn load_scaled<S: Storage>(&self, scr: &mut Scratch, x: &Array3<S>, shift: C64) {
         let (k2, eb) = (self.k2, self.eps_binder);
-        Zip::from(&mut scr.field)
-            .and(x)
-            .and(self.eps)
-            .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
+        let nz = self.eps.dim().0;
+        for c in 0..self.components() {
+            let block = s![c * nz..(c + 1) * nz, .., ..];
+            Zip::from(scr.field.slice_mut(block))
+                .and(x.slice(block))
+                .and(self.eps)
+                .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
+        }
+    }
+
+    /// `f(block of x, eps)` for each component's block of the unknowns.
+    fn blocks_mut<S: Storage>(
+        &self,
+        x: &mut Array3<S>,
+        f: impl Fn(ArrayViewMut3<S>, &Array3<C64>),
+    ) {
+        let nz = self.eps.dim().0;
+        for c in 0..self.components() {
+            f(x.slice_mut(s![c * nz..(c + 1) * nz, .., ..]), self.eps);
+        }
+    }
+
+    /// Σ f(x, ε) over every unknown, per component block.
+    fn sum_blocks<S: Storage>(&self, x: &Array3<S>, f: impl Fn(&S, &C64) -> f64 + Sync) -> f64 {
+        use rayon::prelude::*;
+        let nz = self.eps.dim().0;
+        (0..self.components())
+            .map(|c| {
+                let b: ArrayView3<S> = x.slice(s![c * nz..(c + 1) * nz, .., ..]);
+                let parts: Vec<f64> = b
+                    .outer_iter()
+                    .into_par_iter()
+                    .zip(self.eps.outer_iter().into_par_iter())
+                    .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| f(x, y)).sum())
+                    .collect();
+                parts.iter().sum::<f64>()
+            })
+            .sum()
     }
 
     /// `out ← base_j + scr.field − u` per z-slice j.
@@ -307,18 +417,46 @@ impl<'a> System<'a> {
         out: &mut Array3<S>,
     ) -> f64 {
         self.load_scaled(scr, u, C64::new(0.0, 0.0));
-        let lat = self.op.lat;
-        let binder = self
-            .binder
-            .get_or_insert_with(|| GreenTable::new(&lat, C64::new(self.eps_binder, 0.0)));
-        self.op.apply(binder, &mut scr.field, &mut scr.op);
+        let lat = self.lat;
+        let eb = self.eps_binder;
+        match (&mut self.op, &mut scr.op) {
+            (
+                Equation::Scalar {
+                    op, binder: table, ..
+                },
+                OpWorkspace::Scalar(ws),
+            ) => {
+                let table = table.get_or_insert_with(|| GreenTable::new(&lat, C64::new(eb, 0.0)));
+                op.apply(table, &mut scr.field, ws);
+            }
+            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+                op.apply(C64::new(0.0, 0.0), &mut scr.field, ws)
+            }
+            _ => unreachable!("a system's scratch is made by the system"),
+        }
         self.finish_residual(scr, &self.ubg, u, out);
         self.norm(out)
     }
 
     /// Drop `G_b`'s tables (as large as a field) once Born is ruled out.
     pub fn release_binder(&mut self) {
-        self.binder = None;
+        if let Equation::Scalar { binder, .. } = &mut self.op {
+            *binder = None;
+        }
+    }
+
+    /// `scr.field ← G_s scr.field`, the shifted operator of the equation.
+    fn apply_shifted(&self, scr: &mut Scratch) {
+        match (&self.op, &mut scr.op) {
+            (Equation::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
+                let table = self.shift.table.as_ref().expect("scalar shift table");
+                op.apply_shifted_green(table, &mut scr.field, ws)
+            }
+            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+                op.apply(self.shift.c, &mut scr.field, ws)
+            }
+            _ => unreachable!("a system's scratch is made by the system"),
+        }
     }
 
     /// `out ← u_s + G_s V' u − u`, the residual of the same equation in its
@@ -332,8 +470,7 @@ impl<'a> System<'a> {
         out: &mut Array3<S>,
     ) -> f64 {
         self.load_scaled(scr, u, self.shift.c);
-        self.op
-            .apply_shifted_green(&self.shift.table, &mut scr.field, &mut scr.op);
+        self.apply_shifted(scr);
         self.finish_residual(scr, &self.shift.us, u, out);
         self.norm(out) * self.ubg_norm / self.shift.us_norm
     }
@@ -346,8 +483,7 @@ impl<'a> System<'a> {
         out: &mut Array3<S>,
     ) {
         self.load_scaled(scr, x, self.shift.c);
-        self.op
-            .apply_shifted_green(&self.shift.table, &mut scr.field, &mut scr.op);
+        self.apply_shifted(scr);
         Zip::from(&mut *out)
             .and(x)
             .and(&scr.field)
@@ -360,9 +496,11 @@ impl<'a> System<'a> {
         let Some((er, es)) = self.shift.cbs else {
             return;
         };
-        Zip::from(x)
-            .and(self.eps)
-            .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)));
+        self.blocks_mut(x, |b, eps| {
+            Zip::from(b)
+                .and(eps)
+                .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)))
+        });
     }
 
     /// ‖x‖ / ‖u_bg‖.
@@ -383,47 +521,61 @@ impl<'a> System<'a> {
         record: SolveRecord,
     ) -> Solution {
         let (r, t, absorption) = self.outputs(&mut scr, &u);
-        let lattice = self.op.lat;
+        let lattice = self.lat;
+        let vector = match self.op {
+            Equation::Scalar { .. } => None,
+            Equation::Vector { pol, .. } => Some(pol),
+        };
         drop(scr);
         drop(self);
+        let [r_s, r_p] = r;
+        let [t_s, t_p] = t;
         Solution {
             lattice,
             field: u.mapv(S::load),
-            r,
-            t,
+            r: r_s,
+            t: t_s,
             absorption,
             record,
+            vector: vector.map(|incident| VectorAmplitudes { incident, r_p, t_p }),
         }
     }
 
-    /// Far-field amplitudes and absorption of a field.
+    /// Far-field amplitudes (`[s, p]`; `[u, 0]` for the scalar wave) and
+    /// the absorption of a field.
+    #[allow(clippy::type_complexity)]
     fn outputs<S: Storage>(
         &self,
         scr: &mut Scratch,
         u: &Array3<S>,
-    ) -> (Array2<C64>, Array2<C64>, f64) {
-        let lat = self.op.lat;
-        let mut r = Array2::zeros((lat.nx, lat.ny));
-        let mut t = Array2::zeros((lat.nx, lat.ny));
+    ) -> ([Array2<C64>; 2], [Array2<C64>; 2], f64) {
+        let lat = self.lat;
+        let z = || Array2::zeros((lat.nx, lat.ny));
+        let mut r = [z(), z()];
+        let mut t = [z(), z()];
         // G_b V u = G_b(V' u + c u) = w + c G_b(u − G_s V' u), and at the
         // solution u − G_s V' u = u_s (harmonic 00 only): boundary values of
-        // w from the shifted sweep, of G_b u_s from the 00 functionals.
+        // w from the shifted sweep, of G_b u_s precomputed with the shift.
         self.load_scaled(scr, u, self.shift.c);
-        self.op.shifted_boundary(
-            &self.shift.table,
-            &mut scr.field,
-            &mut scr.op,
-            &mut r,
-            &mut t,
-        );
+        match (&self.op, &mut scr.op) {
+            (Equation::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
+                let table = self.shift.table.as_ref().expect("scalar shift table");
+                let [r0, _] = &mut r;
+                let [t0, _] = &mut t;
+                op.shifted_boundary(table, &mut scr.field, ws, r0, t0);
+            }
+            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+                op.boundary_amplitudes(self.shift.c, &mut scr.field, ws, &mut r, &mut t);
+            }
+            _ => unreachable!("a system's scratch is made by the system"),
+        }
         let c = self.shift.c;
-        let us = &self.shift.us;
-        let us_top: C64 = self.top00.iter().zip(us).map(|(w, u)| w * u).sum();
-        let us_bottom: C64 = self.bottom00.iter().zip(us).map(|(w, u)| w * u).sum();
-        r[[0, 0]] += self.r_bg + c * us_top;
-        t[[0, 0]] += self.t_bg + c * us_bottom;
+        for k in 0..2 {
+            r[k][[0, 0]] += self.r_bg[k] + c * self.shift.us_top[k];
+            t[k][[0, 0]] += self.t_bg[k] + c * self.shift.us_bottom[k];
+        }
         let dz = lat.size_nm[2] / lat.nz as f64;
-        let s = sum_slices(u, |u: &S, e: &C64| e.im * u.load().norm_sqr(), self.eps);
+        let s = self.sum_blocks(u, |u: &S, e: &C64| e.im * u.load().norm_sqr());
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
@@ -437,6 +589,7 @@ pub fn mean_eps(eps: &Array3<C64>) -> C64 {
 
 impl Shift {
     fn new(
+        op: &Equation,
         lat: &Lattice,
         eps: &Array3<C64>,
         eps_binder: f64,
@@ -463,11 +616,28 @@ impl Shift {
         };
         let k2 = lat.k0 * lat.k0;
         let c = k2 * (bg - eps_binder);
-        let table = ShiftTable::new(lat, eps_binder, c);
-        let mut scr = BandScratch::new(lat.nz);
-        scr.column().copy_from_slice(ubg);
-        table.solve_column(0, &mut scr);
-        let us = scr.column().to_vec();
+        let zero = C64::new(0.0, 0.0);
+        let (table, us, us_top, us_bottom) = match op {
+            Equation::Scalar {
+                top00, bottom00, ..
+            } => {
+                let table = ShiftTable::new(lat, eps_binder, c);
+                let mut scr = BandScratch::new(lat.nz);
+                scr.column().copy_from_slice(ubg);
+                table.solve_column(0, &mut scr);
+                let us = scr.column().to_vec();
+                let top: C64 = top00.iter().zip(&us).map(|(w, u)| w * u).sum();
+                let bottom: C64 = bottom00.iter().zip(&us).map(|(w, u)| w * u).sum();
+                (Some(table), us, [top, zero], [bottom, zero])
+            }
+            Equation::Vector { op, .. } => {
+                // u_s = (I − c G_b)⁻¹ u_bg = u_bg + c G_s u_bg.
+                let (gs, _, _) = op.harmonic00(c, ubg);
+                let us: Vec<C64> = ubg.iter().zip(&gs).map(|(u, g)| u + c * g).collect();
+                let (_, top, bottom) = op.harmonic00(zero, &us);
+                (None, us, top, bottom)
+            }
+        };
         let us_norm =
             (us.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
         Shift {
@@ -478,6 +648,8 @@ impl Shift {
             table,
             us,
             us_norm,
+            us_top,
+            us_bottom,
         }
     }
 }

@@ -161,6 +161,7 @@ fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
         lattice,
         eps: &eps,
         eps_binder: eb,
+        wave: crate::solver::Wave::Scalar,
     };
     let mut setups = vec![];
     let mut applies = vec![];

@@ -31,6 +31,24 @@ pub fn airy(k0: f64, eps: C64, kap: f64, h: f64) -> (C64, C64) {
     )
 }
 
+/// Exact Airy amplitudes of the same slab in p polarisation, for the
+/// magnetic field H_y (continuous with H_y'/ε): the same formula with the
+/// inside admittance γ/ε in place of γ. `(r_H, t_H)`; powers `|r_H|²`,
+/// `|t_H|²` (vacuum on both sides).
+#[allow(dead_code)]
+pub fn airy_p(k0: f64, eps: C64, kap: f64, h: f64) -> (C64, C64) {
+    let g = kz(k0 * k0 * eps - kap * kap);
+    let y = g / eps;
+    let b = kz(C64::new(k0 * k0 - kap * kap, 0.0));
+    let rho = (y - b) / (y + b);
+    let e = (2.0 * C64::i() * g * h).exp();
+    let a = 2.0 * b / ((y + b) * (1.0 - rho * rho * e));
+    (
+        a * (1.0 + rho * e) - 1.0,
+        a * (C64::i() * g * h).exp() * (1.0 + rho),
+    )
+}
+
 /// Airy power coefficients `(|r|², |t|²)` of the same slab.
 pub fn airy_power(k0: f64, eps: C64, kap: f64, h: f64) -> (f64, f64) {
     let (r, t) = airy(k0, eps, kap, h);

@@ -16,6 +16,7 @@ pub fn in_binder(lattice: Lattice, eps: &Array3<C64>) -> Problem<'_> {
         lattice,
         eps,
         eps_binder: EPS_B,
+        wave: inksim::solver::Wave::Scalar,
     }
 }
 

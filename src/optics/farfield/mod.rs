@@ -103,8 +103,8 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
                 continue;
             }
             let [kx, ky] = lat.kappa(ix, iy);
-            let rr = sol.r[[ix, iy]].norm_sqr() * beta.re / beta00;
-            let t = sol.t[[ix, iy]].norm_sqr() * beta.re / beta00;
+            let (pr, pt) = sol.order_power(ix, iy);
+            let (rr, t) = (pr * beta.re / beta00, pt * beta.re / beta00);
             tr += rr;
             tt += t;
             let s = (kx.hypot(ky) / lat.k0).min(1.0);
@@ -121,8 +121,8 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
     orders.sort_by_key(|o| (o.m, o.n));
     Efficiencies {
         orders,
-        r00: sol.r[[0, 0]],
-        t00: sol.t[[0, 0]],
+        r00: sol.specular_r(),
+        t00: sol.specular_t(),
         total_reflectance: tr,
         total_transmittance: tt,
         absorption: sol.absorption,

@@ -46,7 +46,7 @@ impl Born {
     /// The contraction estimate behind [`Solver::validity`], with fields
     /// stored as `S`.
     fn estimate<S: Storage>(&self, sys: &mut System, scr: &mut Scratch) -> Validity {
-        let dim = sys.eps().dim();
+        let dim = sys.unknown_dim();
         let (mut u, mut r) = (Array3::<S>::default(dim), Array3::<S>::default(dim));
         sys.set_background(&mut u);
         let mut prev = f64::NAN;

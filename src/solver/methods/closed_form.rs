@@ -6,10 +6,10 @@
 //! effective-medium shortcut; scenes cannot ask for it.
 
 use super::{Solver, Validity};
-use crate::config::{Method, Precision};
+use crate::config::{Linear, Method, Precision};
 use crate::solver::airy::{self, SlabField};
 use crate::solver::system::{Scratch, System};
-use crate::solver::{Controls, Problem, Solution, SolveError, SolveRecord};
+use crate::solver::{Controls, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 use std::time::Instant;
@@ -61,20 +61,72 @@ impl Solver for Airy {
                 p.eps.dim()
             )));
         }
-        let slab = SlabField::new(eps, lat.size_nm[2], lat.k0, lat.q[0].hypot(lat.q[1]));
+        let kappa = lat.q[0].hypot(lat.q[1]);
+        let (p_pol, azimuth) = match p.wave {
+            Wave::Scalar => (false, 0.0),
+            Wave::Vector {
+                polarisation,
+                azimuth_deg,
+            } => (polarisation == Linear::P, azimuth_deg),
+        };
+        let slab = SlabField::polarised(eps, lat.size_nm[2], lat.k0, kappa, p_pol);
         let airy::SlabResponse { r, t, absorption } = slab.response;
-        let cells = slab.cell_averages(lat.nz);
-        let field = Array3::from_shape_fn(p.eps.dim(), |(k, _, _)| cells[k]);
+        let nz = lat.nz;
         let specular = |amplitude| {
             let mut a = Array2::zeros((lat.nx, lat.ny));
             a[[0, 0]] = amplitude;
             a
         };
+        let zero = C64::new(0.0, 0.0);
+        let (field, r_s, t_s, vector) = match p.wave {
+            Wave::Scalar => {
+                let cells = slab.cell_averages(nz);
+                let field = Array3::from_shape_fn(p.eps.dim(), |(k, _, _)| cells[k]);
+                (field, r, t, None)
+            }
+            Wave::Vector { polarisation, .. } => {
+                // ê_κ along q (the azimuth at normal incidence), ê_s = ẑ × ê_κ.
+                let [ux, uy] = if kappa > 0.0 {
+                    [lat.q[0] / kappa, lat.q[1] / kappa]
+                } else {
+                    let a = azimuth.to_radians();
+                    [a.cos(), a.sin()]
+                };
+                let mut rows = vec![zero; 3 * nz];
+                match slab.p_cell_averages(nz) {
+                    Some((ek, ez)) => {
+                        for j in 0..nz {
+                            rows[j] = ux * ek[j];
+                            rows[nz + j] = uy * ek[j];
+                            rows[2 * nz + j] = ez[j];
+                        }
+                    }
+                    None => {
+                        for (j, es) in slab.cell_averages(nz).into_iter().enumerate() {
+                            rows[j] = -uy * es;
+                            rows[nz + j] = ux * es;
+                        }
+                    }
+                }
+                let field = Array3::from_shape_fn((3 * nz, lat.ny, lat.nx), |(k, _, _)| rows[k]);
+                let (rs, ts, rp, tp) = match polarisation {
+                    Linear::S => (r, t, zero, zero),
+                    Linear::P => (zero, zero, r, t),
+                };
+                let v = VectorAmplitudes {
+                    incident: polarisation,
+                    r_p: specular(rp),
+                    t_p: specular(tp),
+                };
+                (field, rs, ts, Some(v))
+            }
+        };
         Ok(Solution {
             lattice: lat,
             field,
-            r: specular(r),
-            t: specular(t),
+            r: specular(r_s),
+            t: specular(t_s),
+            vector,
             absorption,
             record: SolveRecord {
                 method: Method::Airy,
@@ -83,8 +135,14 @@ impl Solver for Airy {
                 residual: 0.0,
                 seconds: start.elapsed().as_secs_f64(),
                 note: format!(
-                    "homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form",
-                    eps.re, eps.im
+                    "homogeneous slab, ⟨ε⟩ = {:.5}{:+.5}i, closed form{}",
+                    eps.re,
+                    eps.im,
+                    match p.wave {
+                        Wave::Scalar => String::new(),
+                        Wave::Vector { polarisation, .. } =>
+                            format!(", Maxwell, {} polarised", polarisation.name()),
+                    }
                 ),
             },
         })
@@ -113,6 +171,7 @@ mod tests {
             lattice: lat,
             eps: &grid,
             eps_binder: 2.4,
+            wave: crate::solver::Wave::Scalar,
         };
         let sol = solve(&p, Method::Airy, &ctl).unwrap();
         let want = airy::slab(eps, 700.0, 450.0, 40.0);
@@ -128,6 +187,7 @@ mod tests {
                 lattice: thin,
                 eps: &column,
                 eps_binder: 2.4,
+                wave: crate::solver::Wave::Scalar,
             },
             Method::Airy,
             &ctl,
@@ -140,6 +200,7 @@ mod tests {
             lattice: lat,
             eps: &grid,
             eps_binder: 2.4,
+            wave: crate::solver::Wave::Scalar,
         };
         assert!(matches!(
             solve(&p, Method::Airy, &ctl),

@@ -121,7 +121,7 @@ pub trait Solver: Sync {
         let start = Instant::now();
         let mut sys = System::new(p, ctl.background)?;
         let mut scr = sys.scratch();
-        let mut u = Field::zeros(ctl.precision, p.eps.dim());
+        let mut u = Field::zeros(ctl.precision, sys.unknown_dim());
         if self.method() == Method::Born {
             // Born iterates the plain equation, from u_bg on any background.
             sys.set_background_field(&mut u);

@@ -1,0 +1,95 @@
+//! Which wave equation a scene is solved with, and the incident light's
+//! polarisation: what `[solver] equation` and `[illumination] polarisation`
+//! may name (METHOD §9). The solver stage gives them their meaning; this
+//! stage only knows the names, so that an unknown one is refused as the
+//! scene is read.
+
+use std::fmt;
+
+/// The wave equation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Equation {
+    /// The scalar Helmholtz equation: every flat surface reflects like
+    /// s-polarised light; the fast approximation.
+    #[default]
+    Helmholtz,
+    /// Maxwell's equations (the vector field, s and p polarisations).
+    Maxwell,
+}
+
+impl Equation {
+    pub const ALL: [Equation; 2] = [Equation::Helmholtz, Equation::Maxwell];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Equation::Helmholtz => "helmholtz",
+            Equation::Maxwell => "maxwell",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Equation> {
+        Self::ALL.into_iter().find(|e| e.name() == s)
+    }
+}
+
+impl fmt::Display for Equation {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// One linear polarisation of the incident plane wave, relative to its
+/// plane of incidence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Linear {
+    /// E perpendicular to the plane of incidence (TE).
+    S,
+    /// E in the plane of incidence (TM).
+    P,
+}
+
+impl Linear {
+    pub fn name(self) -> &'static str {
+        match self {
+            Linear::S => "s",
+            Linear::P => "p",
+        }
+    }
+}
+
+/// The incident light's polarisation as a scene asks for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Polarisation {
+    /// Natural light: the incoherent mean of s and p (powers, not
+    /// amplitudes); two solves per incidence.
+    #[default]
+    Unpolarised,
+    S,
+    P,
+}
+
+impl Polarisation {
+    pub const ALL: [Polarisation; 3] =
+        [Polarisation::Unpolarised, Polarisation::S, Polarisation::P];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Polarisation::Unpolarised => "unpolarised",
+            Polarisation::S => "s",
+            Polarisation::P => "p",
+        }
+    }
+
+    pub fn parse(s: &str) -> Option<Polarisation> {
+        Self::ALL.into_iter().find(|e| e.name() == s)
+    }
+
+    /// The linear polarisations to solve for.
+    pub fn components(self) -> &'static [Linear] {
+        match self {
+            Polarisation::Unpolarised => &[Linear::S, Linear::P],
+            Polarisation::S => &[Linear::S],
+            Polarisation::P => &[Linear::P],
+        }
+    }
+}

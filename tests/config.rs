@@ -807,3 +807,34 @@ fn a_material_may_be_given_as_its_complex_permittivity() {
         assert!(msg.contains(want), "{eps}: {msg}");
     }
 }
+
+/// `solver.equation` and `illumination.polarisation` are read; a
+/// polarisation needs Maxwell's equation; what Maxwell mode cannot honour
+/// yet (stacks, the radiative-transfer baselines) is refused, naming the key.
+#[test]
+fn equation_and_polarisation_are_checked() {
+    use inksim::config::{Equation, Polarisation};
+    let s = parse(&base()).unwrap();
+    assert_eq!(s.solver.equation, Equation::Helmholtz);
+    assert_eq!(s.solver.polarisation, Polarisation::Unpolarised);
+    let s = parse(
+        &base()
+            .set("solver.equation", "maxwell")
+            .set("illumination.polarisation", "p"),
+    )
+    .unwrap();
+    assert_eq!(s.solver.equation, Equation::Maxwell);
+    assert_eq!(s.solver.polarisation, Polarisation::P);
+    let (key, msg) = invalid(&base().set("illumination.polarisation", "s"));
+    assert_eq!(key, "illumination.polarisation");
+    assert!(msg.contains("maxwell"), "{msg}");
+    let err = parse(&base().set("solver.equation", "vector")).unwrap_err();
+    assert!(err.to_string().contains("helmholtz"), "{err}");
+    let (key, msg) = invalid(
+        &base()
+            .set("solver.equation", "maxwell")
+            .set("appearance.baseline", "kubelka-munk"),
+    );
+    assert_eq!(key, "appearance.baseline");
+    assert!(msg.contains("scalar"), "{msg}");
+}

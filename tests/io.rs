@@ -59,6 +59,7 @@ fn entries() -> Vec<SolveEntry> {
                 seconds: 0.25,
                 note: "born: estimated contraction 0.61 — OK".into(),
             },
+            polarised: Vec::new(),
         },
         SolveEntry {
             wavelength_nm: 632.8,
@@ -86,6 +87,7 @@ fn entries() -> Vec<SolveEntry> {
                 seconds: 12.5,
                 note: String::new(),
             },
+            polarised: Vec::new(),
         },
         SolveEntry {
             wavelength_nm: 700.000_000_000_1,
@@ -113,6 +115,7 @@ fn entries() -> Vec<SolveEntry> {
                 seconds: 0.0,
                 note: "fallback after Born diverged\nsecond line".into(),
             },
+            polarised: Vec::new(),
         },
     ]
 }

@@ -87,6 +87,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
             seconds: 0.0,
             note: String::new(),
         },
+        polarised: Vec::new(),
     }
 }
 

@@ -284,6 +284,12 @@ impl std::fmt::Display for Background {
 /// Solver settings.
 #[derive(Debug, Clone, Copy)]
 pub struct SolverSpec {
+    /// The wave equation: scalar Helmholtz (the fast approximation) or
+    /// Maxwell's.
+    pub equation: Equation,
+    /// The incident light's polarisation (Maxwell only; the scalar wave is
+    /// always `Unpolarised`, which it treats as s).
+    pub polarisation: Polarisation,
     pub method: Method,
     /// Target relative residual.
     pub tolerance: f64,

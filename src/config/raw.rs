@@ -286,6 +286,22 @@ pub struct RawIllumination {
     pub wavelength_range_nm: Option<RawRange>,
     pub polar_deg: Vec<f64>,
     pub azimuth_deg: Option<f64>,
+    pub polarisation: Option<RawPolarisation>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawPolarisation {
+    Unpolarised,
+    S,
+    P,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawEquation {
+    Helmholtz,
+    Maxwell,
 }
 
 #[derive(Debug, Deserialize)]
@@ -299,6 +315,7 @@ pub struct RawRange {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSolver {
+    pub equation: Option<RawEquation>,
     pub method: Option<RawMethod>,
     pub tolerance: Option<f64>,
     pub max_iterations: Option<i64>,

@@ -6,13 +6,13 @@
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 
-use crate::config::{Method, Scene};
-use crate::optics::farfield::{self, Side, SolveEntry};
+use crate::config::{Equation, Incidence, Linear, Method, Scene};
+use crate::optics::farfield::{self, Efficiencies, Side, SolveEntry};
 use crate::output::progress::Progress;
 use crate::raster::structure::EpsGrid;
 use crate::raster::{Grid, Raster};
 use crate::solver::heartbeat::{self, Beat};
-use crate::solver::{self, Controls, Problem};
+use crate::solver::{self, Controls, Problem, SolveRecord, Wave};
 
 use super::eps::{fraction_eps, mean_eps};
 use super::plan::{incidences, RunPlan};
@@ -118,12 +118,7 @@ pub fn solve_layer(
                 (Side::Below, Some(f)) => f,
                 _ => &eps,
             };
-            let p = Problem {
-                lattice,
-                eps: grid_eps,
-                eps_binder: eps_b / outside,
-                wave: crate::solver::Wave::Scalar,
-            };
+            let waves = waves(scene, inc);
             // A long solve reports where it stands (solver::heartbeat).
             let beat = |b: Beat| {
                 progress.log(&format!(
@@ -143,46 +138,57 @@ pub fn solve_layer(
                     b.elapsed_s
                 ))
             };
-            let mut ctl = ctl;
-            // Attempts a tighter solve replaced, and why.
-            let (mut replaced, mut again) = (Vec::new(), String::new());
-            let (efficiencies, mut record) = loop {
-                let sol = heartbeat::scope(heartbeat_interval(), &beat, || {
-                    solver::solve(&p, scene.solver.method, &ctl)
-                })
-                .map_err(|source| PipelineError::Solve {
-                    wavelength_nm: lambda,
-                    polar_deg: inc.polar_deg,
-                    source,
-                })?;
-                let eff = farfield::efficiencies(&sol);
-                let tighter = ctl.tolerance / 10.0;
-                // Held to the energy balance, not only to the residual.
-                if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
-                    || tighter < ctl.precision.select(1e-10, 1e-6)
-                {
-                    break (eff, sol.record);
+            let mut parts = Vec::with_capacity(waves.len());
+            for &wave in &waves {
+                let p = Problem {
+                    lattice,
+                    eps: grid_eps,
+                    eps_binder: eps_b / outside,
+                    wave,
+                };
+                let mut ctl = ctl;
+                // Attempts a tighter solve replaced, and why.
+                let (mut replaced, mut again) = (Vec::new(), String::new());
+                let (efficiencies, mut record) = loop {
+                    let sol = heartbeat::scope(heartbeat_interval(), &beat, || {
+                        solver::solve(&p, scene.solver.method, &ctl)
+                    })
+                    .map_err(|source| PipelineError::Solve {
+                        wavelength_nm: lambda,
+                        polar_deg: inc.polar_deg,
+                        source,
+                    })?;
+                    let eff = farfield::efficiencies(&sol);
+                    let tighter = ctl.tolerance / 10.0;
+                    // Held to the energy balance, not only to the residual.
+                    if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
+                        || tighter < ctl.precision.select(1e-10, 1e-6)
+                    {
+                        break (eff, sol.record);
+                    }
+                    progress.log(&format!(
+                        "[inksim] {lambda} nm, {}° {side}: energy balance {:.1e} above {:.0e} at \
+                         tolerance {:.0e}; solving again to {tighter:.0e}",
+                        (inc.polar_deg * 100.0).round() / 100.0,
+                        eff.energy_balance,
+                        ENERGY_BALANCE_LIMIT,
+                        ctl.tolerance
+                    ));
+                    again.push_str(&format!(
+                        "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",
+                        eff.energy_balance, ctl.tolerance
+                    ));
+                    ctl.tolerance = tighter;
+                    replaced.push(sol.record);
+                };
+                // The cost of the solve includes the attempts it replaced.
+                for r in &replaced {
+                    record.add(r);
                 }
-                progress.log(&format!(
-                    "[inksim] {lambda} nm, {}° {side}: energy balance {:.1e} above {:.0e} at \
-                     tolerance {:.0e}; solving again to {tighter:.0e}",
-                    (inc.polar_deg * 100.0).round() / 100.0,
-                    eff.energy_balance,
-                    ENERGY_BALANCE_LIMIT,
-                    ctl.tolerance
-                ));
-                again.push_str(&format!(
-                    "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",
-                    eff.energy_balance, ctl.tolerance
-                ));
-                ctl.tolerance = tighter;
-                replaced.push(sol.record);
-            };
-            // The cost of the solve includes the attempts it replaced.
-            for r in &replaced {
-                record.add(r);
+                record.note.push_str(&again);
+                parts.push((wave, efficiencies, record));
             }
-            record.note.push_str(&again);
+            let (efficiencies, record, polarised) = combine(parts);
             let entry = SolveEntry {
                 wavelength_nm: lambda,
                 incidence: *inc,
@@ -191,6 +197,7 @@ pub fn solve_layer(
                 layer: 0,
                 efficiencies,
                 record,
+                polarised,
             };
             log_solve(progress, &entry);
             entries.push(entry);
@@ -207,6 +214,62 @@ pub fn heartbeat_interval() -> std::time::Duration {
         .and_then(|v| v.trim().parse::<f64>().ok())
         .filter(|s| s.is_finite() && *s >= 0.0 && *s < 1e9)
         .map_or(heartbeat::INTERVAL, std::time::Duration::from_secs_f64)
+}
+
+/// The problems one incidence is solved as: the scalar wave, or Maxwell's
+/// for each linear polarisation the scene asks for (unpolarised: s and p).
+fn waves(scene: &Scene, inc: &Incidence) -> Vec<Wave> {
+    match scene.solver.equation {
+        Equation::Helmholtz => vec![Wave::Scalar],
+        Equation::Maxwell => scene
+            .solver
+            .polarisation
+            .components()
+            .iter()
+            .map(|&polarisation| Wave::Vector {
+                polarisation,
+                azimuth_deg: inc.azimuth_deg,
+            })
+            .collect(),
+    }
+}
+
+/// One incidence's answer from its solves: the scalar solve as it is; for
+/// Maxwell the incoherent mean over the polarisations solved (powers, not
+/// amplitudes), the records added up, and each polarisation's own
+/// efficiencies kept.
+#[allow(clippy::type_complexity)]
+fn combine(
+    parts: Vec<(Wave, Efficiencies, SolveRecord)>,
+) -> (Efficiencies, SolveRecord, Vec<(Linear, Efficiencies)>) {
+    let mut record: Option<SolveRecord> = None;
+    let mut polarised = Vec::new();
+    let mut notes = Vec::new();
+    let mut scalar = None;
+    for (wave, eff, rec) in parts {
+        match wave {
+            Wave::Scalar => scalar = Some(eff),
+            Wave::Vector { polarisation, .. } => {
+                notes.push(format!("{}: {}", polarisation.name(), rec.note));
+                polarised.push((polarisation, eff));
+            }
+        }
+        match record.as_mut() {
+            None => record = Some(rec),
+            Some(r) => {
+                r.add(&rec);
+                r.residual = r.residual.max(rec.residual);
+            }
+        }
+    }
+    let mut record = record.expect("at least one solve per incidence");
+    match scalar {
+        Some(eff) => (eff, record, polarised),
+        None => {
+            record.note = format!("Maxwell, {}", notes.join("; "));
+            (farfield::polarisation_mean(&polarised), record, polarised)
+        }
+    }
 }
 
 /// The solver's iteration controls of a scene.
@@ -245,27 +308,35 @@ pub fn solve_analytic(
             let size = [1.0, 1.0, scene.layer.thickness_nm];
             let lattice =
                 Problem::lattice([1, 1, 1], size, lambda / outside.sqrt(), inc.polar_deg, 0.0);
-            let p = Problem {
-                lattice,
-                eps: &mean,
-                eps_binder: eps_b / outside,
-                wave: crate::solver::Wave::Scalar,
-            };
-            let mut sol =
-                solver::solve(&p, Method::Airy, &ctl).map_err(|source| PipelineError::Solve {
-                    wavelength_nm: lambda,
-                    polar_deg: inc.polar_deg,
-                    source,
+            let mut parts = Vec::new();
+            for wave in waves(scene, inc) {
+                let p = Problem {
+                    lattice,
+                    eps: &mean,
+                    eps_binder: eps_b / outside,
+                    wave,
+                };
+                let mut sol = solver::solve(&p, Method::Airy, &ctl).map_err(|source| {
+                    PipelineError::Solve {
+                        wavelength_nm: lambda,
+                        polar_deg: inc.polar_deg,
+                        source,
+                    }
                 })?;
-            sol.record.note = format!("{why}: {}", sol.record.note);
+                sol.record.note = format!("{why}: {}", sol.record.note);
+                let eff = farfield::slab_efficiencies(&sol.slab_response(), inc);
+                parts.push((wave, eff, sol.record));
+            }
+            let (efficiencies, record, polarised) = combine(parts);
             let entry = SolveEntry {
                 wavelength_nm: lambda,
                 incidence: *inc,
                 side: *side,
                 realisation: 0,
                 layer: 0,
-                efficiencies: farfield::slab_efficiencies(&sol.slab_response(), inc),
-                record: sol.record,
+                efficiencies,
+                record,
+                polarised,
             };
             log_solve(progress, &entry);
             entries.push(entry);

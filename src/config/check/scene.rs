@@ -80,7 +80,7 @@ impl Checker<'_> {
         };
         let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
         let incidence = self.incidence(&raw.illumination)?;
-        let solver = self.solver(raw.solver.as_ref())?;
+        let solver = self.solver(raw.solver.as_ref(), raw.illumination.polarisation)?;
         let output = self.output(path, raw.output.as_ref())?;
         // An incoherent stack's default outputs are its tile alone: the
         // BRDF at every azimuth (the default "brdf") is not made there.
@@ -102,6 +102,25 @@ impl Checker<'_> {
         let substrate = self.substrate(raw.substrate.as_ref())?;
         if let Some(st) = &stack {
             self.stack_products(st, &appearance, realisation_target.is_some())?;
+        }
+        if solver.equation == crate::config::Equation::Maxwell {
+            // What does not honour both polarisations yet is refused rather
+            // than mixed silently into a Maxwell result.
+            if stack.is_some() {
+                return Err(self.invalid(
+                    "solver.equation",
+                    "\"maxwell\" is not available for [[stack]] scenes yet: their flat \
+                     surfaces and coupling are scalar (s-like); use \"helmholtz\"",
+                ));
+            }
+            if !appearance.baseline.is_empty() {
+                return Err(self.invalid(
+                    "appearance.baseline",
+                    "the radiative-transfer baselines are scalar (s-like Fresnel surfaces, \
+                     scalar Mie grains) and cannot stand beside a Maxwell solve yet: remove \
+                     appearance.baseline or use solver.equation = \"helmholtz\"",
+                ));
+            }
         }
         if !appearance.baseline.is_empty() {
             let why = if structure.is_some() {

@@ -1,9 +1,15 @@
-//! `[solver]`: the method, tolerance, iteration limit, field precision, the
-//! Krylov methods' background and the effective-medium tolerance.
+//! `[solver]`: the wave equation, the method, tolerance, iteration limit,
+//! field precision, the Krylov methods' background and the effective-medium
+//! tolerance; and `[illumination] polarisation`, which only Maxwell's
+//! equation can honour.
 
 use super::Checker;
-use crate::config::raw::{RawBackground, RawMethod, RawPrecision, RawSolver};
-use crate::config::{Background, ConfigError, Method, Precision, SolverSpec};
+use crate::config::raw::{
+    RawBackground, RawEquation, RawMethod, RawPolarisation, RawPrecision, RawSolver,
+};
+use crate::config::{
+    Background, ConfigError, Equation, Method, Polarisation, Precision, SolverSpec,
+};
 
 const DEFAULT_TOLERANCE: f64 = 1e-6;
 const DEFAULT_MAX_ITERATIONS: usize = 5000;
@@ -18,7 +24,30 @@ pub const DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 1e-3;
 pub const MAX_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 0.1;
 
 impl Checker<'_> {
-    pub(super) fn solver(&self, raw: Option<&RawSolver>) -> Result<SolverSpec, ConfigError> {
+    pub(super) fn solver(
+        &self,
+        raw: Option<&RawSolver>,
+        polarisation: Option<RawPolarisation>,
+    ) -> Result<SolverSpec, ConfigError> {
+        let equation = match raw.and_then(|s| s.equation) {
+            Some(RawEquation::Maxwell) => Equation::Maxwell,
+            Some(RawEquation::Helmholtz) | None => Equation::Helmholtz,
+        };
+        let polarisation = match polarisation {
+            None | Some(RawPolarisation::Unpolarised) => Polarisation::Unpolarised,
+            Some(RawPolarisation::S) => Polarisation::S,
+            Some(RawPolarisation::P) => Polarisation::P,
+        };
+        if equation == Equation::Helmholtz && polarisation != Polarisation::Unpolarised {
+            return Err(self.invalid(
+                "illumination.polarisation",
+                format!(
+                    "\"{}\" needs solver.equation = \"maxwell\": the scalar Helmholtz \
+                     equation has no polarisation (every surface reflects like s)",
+                    polarisation.name()
+                ),
+            ));
+        }
         let method = raw
             .and_then(|s| s.method)
             .map_or(Method::Auto, |RawMethod(m)| m);
@@ -67,6 +96,8 @@ impl Checker<'_> {
             "[0, 0.1] (absolute error in R, T, A; 0 never takes the shortcut)",
         )?;
         Ok(SolverSpec {
+            equation,
+            polarisation,
             method,
             tolerance,
             max_iterations,

@@ -85,6 +85,9 @@ pub struct SolveEntry {
     pub layer: usize,
     pub efficiencies: Efficiencies,
     pub record: SolveRecord,
+    /// Maxwell: each incident polarisation's own efficiencies (the mean
+    /// of which is `efficiencies`); empty for the scalar wave.
+    pub polarised: Vec<(crate::config::Linear, Efficiencies)>,
 }
 
 /// Order efficiencies, absorption and the energy balance of a solution.
@@ -127,6 +130,36 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
         total_transmittance: tt,
         absorption: sol.absorption,
         energy_balance: tr + tt + sol.absorption - 1.0,
+    }
+}
+
+/// Natural light from linear polarisations solved apart: the incoherent mean
+/// of their powers, order by order (the same lattice, so the same orders),
+/// and of the totals, absorption and balance. The specular amplitudes are
+/// the first polarisation's (s when both were solved): amplitudes of
+/// different polarisations do not average.
+pub fn polarisation_mean(parts: &[(crate::config::Linear, Efficiencies)]) -> Efficiencies {
+    let n = parts.len() as f64;
+    let first = &parts[0].1;
+    let mean = |f: &dyn Fn(&Efficiencies) -> f64| parts.iter().map(|(_, e)| f(e)).sum::<f64>() / n;
+    let orders = first
+        .orders
+        .iter()
+        .enumerate()
+        .map(|(i, o)| Order {
+            reflectance: mean(&|e| e.orders[i].reflectance),
+            transmittance: mean(&|e| e.orders[i].transmittance),
+            ..o.clone()
+        })
+        .collect();
+    Efficiencies {
+        orders,
+        r00: first.r00,
+        t00: first.t00,
+        total_reflectance: mean(&|e| e.total_reflectance),
+        total_transmittance: mean(&|e| e.total_transmittance),
+        absorption: mean(&|e| e.absorption),
+        energy_balance: mean(&|e| e.energy_balance),
     }
 }
 

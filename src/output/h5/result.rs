@@ -399,5 +399,71 @@ fn write_entry(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> 
             about(units, description, &[dim::ORDER]),
         )?;
     }
+    write_polarised(s, g, e)
+}
+
+/// Maxwell solves: the equation and polarisation as attributes, and each
+/// incident polarisation's totals (attributes `<total>_s`, `<total>_p`) and
+/// order efficiencies (`orders_reflectance_s`, …) beside their mean.
+fn write_polarised(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
+    if e.polarised.is_empty() {
+        write_str_attr(g, "equation", "helmholtz")?;
+        return write_str_attr(
+            g,
+            "polarisation",
+            "none (scalar wave: surfaces reflect as s)",
+        );
+    }
+    write_str_attr(g, "equation", "maxwell")?;
+    let names: Vec<&str> = e.polarised.iter().map(|(p, _)| p.name()).collect();
+    write_str_attr(
+        g,
+        "polarisation",
+        &if names.len() > 1 {
+            format!(
+                "unpolarised: the mean of {} solved apart",
+                names.join(" and ")
+            )
+        } else {
+            names[0].to_string()
+        },
+    )?;
+    for (pol, eff) in &e.polarised {
+        let p = pol.name();
+        for (name, v) in [
+            ("total_reflectance", eff.total_reflectance),
+            ("total_transmittance", eff.total_transmittance),
+            ("absorption", eff.absorption),
+            ("energy_balance", eff.energy_balance),
+        ] {
+            write_scalar_attr(g, &format!("{name}_{p}"), v)?;
+        }
+        for (name, values, what) in [
+            (
+                "orders_reflectance",
+                eff.orders
+                    .iter()
+                    .map(|o| o.reflectance)
+                    .collect::<Vec<f64>>(),
+                "reflected",
+            ),
+            (
+                "orders_transmittance",
+                eff.orders.iter().map(|o| o.transmittance).collect(),
+                "transmitted",
+            ),
+        ] {
+            let description = format!(
+                "share of the incident {p}-polarised power {what} into each order (both \
+                 outgoing polarisations summed); order"
+            );
+            s.write(
+                g,
+                &format!("{name}_{p}"),
+                &values[..],
+                about("1", &description, &[dim::ORDER]),
+            )?;
+        }
+    }
     Ok(())
 }

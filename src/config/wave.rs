@@ -4,8 +4,6 @@
 //! stage only knows the names, so that an unknown one is refused as the
 //! scene is read.
 
-use std::fmt;
-
 /// The wave equation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Equation {
@@ -18,23 +16,11 @@ pub enum Equation {
 }
 
 impl Equation {
-    pub const ALL: [Equation; 2] = [Equation::Helmholtz, Equation::Maxwell];
-
     pub fn name(self) -> &'static str {
         match self {
             Equation::Helmholtz => "helmholtz",
             Equation::Maxwell => "maxwell",
         }
-    }
-
-    pub fn parse(s: &str) -> Option<Equation> {
-        Self::ALL.into_iter().find(|e| e.name() == s)
-    }
-}
-
-impl fmt::Display for Equation {
-    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str(self.name())
     }
 }
 
@@ -69,19 +55,12 @@ pub enum Polarisation {
 }
 
 impl Polarisation {
-    pub const ALL: [Polarisation; 3] =
-        [Polarisation::Unpolarised, Polarisation::S, Polarisation::P];
-
     pub fn name(self) -> &'static str {
         match self {
             Polarisation::Unpolarised => "unpolarised",
             Polarisation::S => "s",
             Polarisation::P => "p",
         }
-    }
-
-    pub fn parse(s: &str) -> Option<Polarisation> {
-        Self::ALL.into_iter().find(|e| e.name() == s)
     }
 
     /// The linear polarisations to solve for.

@@ -146,46 +146,18 @@ pub fn solve_layer(
                     eps_binder: eps_b / outside,
                     wave,
                 };
-                let mut ctl = ctl;
-                // Attempts a tighter solve replaced, and why.
-                let (mut replaced, mut again) = (Vec::new(), String::new());
-                let (efficiencies, mut record) = loop {
-                    let sol = heartbeat::scope(heartbeat_interval(), &beat, || {
-                        solver::solve(&p, scene.solver.method, &ctl)
-                    })
-                    .map_err(|source| PipelineError::Solve {
-                        wavelength_nm: lambda,
-                        polar_deg: inc.polar_deg,
-                        source,
-                    })?;
-                    let eff = farfield::efficiencies(&sol);
-                    let tighter = ctl.tolerance / 10.0;
-                    // Held to the energy balance, not only to the residual.
-                    if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
-                        || tighter < ctl.precision.select(1e-10, 1e-6)
-                    {
-                        break (eff, sol.record);
-                    }
-                    progress.log(&format!(
-                        "[inksim] {lambda} nm, {}° {side}: energy balance {:.1e} above {:.0e} at \
-                         tolerance {:.0e}; solving again to {tighter:.0e}",
-                        (inc.polar_deg * 100.0).round() / 100.0,
-                        eff.energy_balance,
-                        ENERGY_BALANCE_LIMIT,
-                        ctl.tolerance
-                    ));
-                    again.push_str(&format!(
-                        "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",
-                        eff.energy_balance, ctl.tolerance
-                    ));
-                    ctl.tolerance = tighter;
-                    replaced.push(sol.record);
-                };
-                // The cost of the solve includes the attempts it replaced.
-                for r in &replaced {
-                    record.add(r);
-                }
-                record.note.push_str(&again);
+                let label = format!(
+                    "{lambda} nm, {}° {side}",
+                    (inc.polar_deg * 100.0).round() / 100.0
+                );
+                let (efficiencies, record) =
+                    solve_balanced(&p, scene.solver.method, ctl, &beat, progress, &label).map_err(
+                        |source| PipelineError::Solve {
+                            wavelength_nm: lambda,
+                            polar_deg: inc.polar_deg,
+                            source,
+                        },
+                    )?;
                 parts.push((wave, efficiencies, record));
             }
             let (efficiencies, record, polarised) = combine(parts);
@@ -214,6 +186,51 @@ pub fn heartbeat_interval() -> std::time::Duration {
         .and_then(|v| v.trim().parse::<f64>().ok())
         .filter(|s| s.is_finite() && *s >= 0.0 && *s < 1e9)
         .map_or(heartbeat::INTERVAL, std::time::Duration::from_secs_f64)
+}
+
+/// One problem solved and held to the energy balance, not only to the
+/// residual: while `|ΣR + ΣT + A − 1|` exceeds [`ENERGY_BALANCE_LIMIT`] it is
+/// solved again to a tenth of the tolerance (down to 1e-10, or 1e-6 with
+/// f32 storage), saying so in the log (`label` names the solve) and in the
+/// record, whose cost includes the attempts it replaced.
+fn solve_balanced(
+    p: &Problem,
+    method: Method,
+    mut ctl: Controls,
+    beat: &dyn Fn(Beat),
+    progress: &Progress,
+    label: &str,
+) -> Result<(Efficiencies, SolveRecord), solver::SolveError> {
+    // Attempts a tighter solve replaced, and why.
+    let (mut replaced, mut again) = (Vec::new(), String::new());
+    let (efficiencies, mut record) = loop {
+        let sol = heartbeat::scope(heartbeat_interval(), beat, || {
+            solver::solve(p, method, &ctl)
+        })?;
+        let eff = farfield::efficiencies(&sol);
+        let tighter = ctl.tolerance / 10.0;
+        if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
+            || tighter < ctl.precision.select(1e-10, 1e-6)
+        {
+            break (eff, sol.record);
+        }
+        progress.log(&format!(
+            "[inksim] {label}: energy balance {:.1e} above {:.0e} at tolerance {:.0e}; \
+             solving again to {tighter:.0e}",
+            eff.energy_balance, ENERGY_BALANCE_LIMIT, ctl.tolerance
+        ));
+        again.push_str(&format!(
+            "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",
+            eff.energy_balance, ctl.tolerance
+        ));
+        ctl.tolerance = tighter;
+        replaced.push(sol.record);
+    };
+    for r in &replaced {
+        record.add(r);
+    }
+    record.note.push_str(&again);
+    Ok((efficiencies, record))
 }
 
 /// The problems one incidence is solved as: the scalar wave, or Maxwell's

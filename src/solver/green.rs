@@ -200,6 +200,21 @@ pub fn is_small_gamma(slab: &Slab, gamma2: C64) -> bool {
     gamma2.norm().sqrt() * slab.thickness < SMALL_GAMMA_H
 }
 
+/// Weight of each point of [`contour`] in the mean.
+pub const CONTOUR_WEIGHT: f64 = 1.0 / CONTOUR_POINTS as f64;
+
+/// The points in the γ² plane whose mean (each weighted
+/// [`CONTOUR_WEIGHT`]) gives a near-grazing harmonic's operator: a circle
+/// of radius `(CONTOUR_GAMMA_H / H)²` around `gamma2`. Shared by every
+/// operator that is analytic in γ² (the scalar kernel, the vector columns).
+pub fn contour(slab: &Slab, gamma2: C64) -> impl Iterator<Item = C64> {
+    let r = (CONTOUR_GAMMA_H / slab.thickness).powi(2);
+    (0..CONTOUR_POINTS).map(move |p| {
+        let ang = 2.0 * std::f64::consts::PI * (p as f64 + 0.5) / CONTOUR_POINTS as f64;
+        gamma2 + C64::from_polar(r, ang)
+    })
+}
+
 /// Dense Galerkin matrix (row-major N×N, including K dz) and the top/bottom
 /// weights for a harmonic near γ = 0, by the contour average.
 pub fn dense_small_gamma(slab: &Slab, gamma2: C64, beta: C64) -> (Vec<C64>, Vec<C64>, Vec<C64>) {
@@ -207,11 +222,8 @@ pub fn dense_small_gamma(slab: &Slab, gamma2: C64, beta: C64) -> (Vec<C64>, Vec<
     let mut m = vec![C64::new(0.0, 0.0); n * n];
     let mut top = vec![C64::new(0.0, 0.0); n];
     let mut bot = vec![C64::new(0.0, 0.0); n];
-    let r = (CONTOUR_GAMMA_H / slab.thickness).powi(2);
-    let w = 1.0 / CONTOUR_POINTS as f64;
-    for p in 0..CONTOUR_POINTS {
-        let ang = 2.0 * std::f64::consts::PI * (p as f64 + 0.5) / CONTOUR_POINTS as f64;
-        let g2 = gamma2 + C64::from_polar(r, ang);
+    let w = CONTOUR_WEIGHT;
+    for g2 in contour(slab, gamma2) {
         let c = coef_from(slab, g2, beta);
         for j in 0..n {
             for k in 0..n {

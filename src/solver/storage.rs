@@ -12,7 +12,7 @@
 //! back into a call of a generic function.
 
 use crate::config::Precision;
-use ndarray::Array3;
+use ndarray::{Array3, ArrayView3};
 use num_complex::{Complex32 as C32, Complex64 as C64};
 use rayon::prelude::*;
 
@@ -103,9 +103,9 @@ impl Storage for C32 {
 /// Σ f(a, b) over all voxels in f64, parallel over z-slices but summed in a
 /// fixed order, so the result is bit-identical for any thread count.
 pub fn sum_slices<A: Sync, B: Sync>(
-    a: &Array3<A>,
+    a: ArrayView3<A>,
     f: impl Fn(&A, &B) -> f64 + Sync,
-    b: &Array3<B>,
+    b: ArrayView3<B>,
 ) -> f64 {
     let parts: Vec<f64> = a
         .outer_iter()
@@ -135,7 +135,7 @@ pub fn dot<S: Storage>(a: &Array3<S>, b: &Array3<S>) -> C64 {
 
 /// ‖a‖² in f64 (thread-count independent).
 pub fn norm_sqr<S: Storage>(a: &Array3<S>) -> f64 {
-    sum_slices(a, |x: &S, _: &S| x.load().norm_sqr(), a)
+    sum_slices(a.view(), |x: &S, _: &S| x.load().norm_sqr(), a.view())
 }
 
 #[cfg(test)]

@@ -19,10 +19,10 @@ use super::lattice::Lattice;
 use super::maxwell::{VectorOperator, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
-use super::storage::{norm_sqr, on_field, Field, Storage};
+use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
 use super::{Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
 use crate::config::{Background, Linear};
-use ndarray::{s, Array2, Array3, ArrayView3, ArrayViewMut3, Zip};
+use ndarray::{s, Array2, Array3, Ix3, Zip};
 use num_complex::Complex64 as C64;
 
 /// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
@@ -61,7 +61,7 @@ impl ShiftParams {
 /// and its shifted form.
 pub struct System<'a> {
     /// The background Green's operator of the equation solved.
-    op: Equation,
+    op: BackgroundOperator,
     lat: Lattice,
     eps: &'a Array3<C64>,
     eps_binder: f64,
@@ -83,7 +83,7 @@ pub struct System<'a> {
 
 /// The two wave equations' background operators (METHOD §4, §9): the same
 /// methods iterate on either through [`System`]'s operations.
-enum Equation {
+enum BackgroundOperator {
     /// The scalar Helmholtz equation: the unknowns are (nz, ny, nx).
     Scalar {
         op: Operator,
@@ -201,7 +201,7 @@ impl<'a> System<'a> {
                 let top00 = (0..lat.nz).map(|k| c00.top_weight(lat.nz, k)).collect();
                 let bottom00 = (0..lat.nz).map(|k| c00.bottom_weight(lat.nz, k)).collect();
                 let zero = C64::new(0.0, 0.0);
-                let op = Equation::Scalar {
+                let op = BackgroundOperator::Scalar {
                     op,
                     binder: None,
                     top00,
@@ -215,7 +215,7 @@ impl<'a> System<'a> {
             } => {
                 let op = VectorOperator::new(lat, p.eps_binder, azimuth_deg);
                 let bg = op.background(polarisation);
-                let op = Equation::Vector {
+                let op = BackgroundOperator::Vector {
                     op,
                     pol: polarisation,
                 };
@@ -244,17 +244,14 @@ impl<'a> System<'a> {
     /// ny, nx) for Maxwell's three components.
     pub fn unknown_dim(&self) -> (usize, usize, usize) {
         let (nz, ny, nx) = self.eps.dim();
-        match self.op {
-            Equation::Scalar { .. } => (nz, ny, nx),
-            Equation::Vector { .. } => (3 * nz, ny, nx),
-        }
+        (self.components() * nz, ny, nx)
     }
 
     /// Number of field components (1 or 3).
     fn components(&self) -> usize {
         match self.op {
-            Equation::Scalar { .. } => 1,
-            Equation::Vector { .. } => 3,
+            BackgroundOperator::Scalar { .. } => 1,
+            BackgroundOperator::Vector { .. } => 3,
         }
     }
 
@@ -277,8 +274,8 @@ impl<'a> System<'a> {
     /// Fresh working memory for this system's operations.
     pub fn scratch(&self) -> Scratch {
         let op = match &self.op {
-            Equation::Scalar { op, .. } => OpWorkspace::Scalar(op.workspace()),
-            Equation::Vector { op, .. } => OpWorkspace::Vector(op.workspace()),
+            BackgroundOperator::Scalar { op, .. } => OpWorkspace::Scalar(op.workspace()),
+            BackgroundOperator::Vector { op, .. } => OpWorkspace::Vector(op.workspace()),
         };
         Scratch {
             op,
@@ -347,44 +344,19 @@ impl<'a> System<'a> {
     /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)`.
     fn load_scaled<S: Storage>(&self, scr: &mut Scratch, x: &Array3<S>, shift: C64) {
         let (k2, eb) = (self.k2, self.eps_binder);
-        let nz = self.eps.dim().0;
         for c in 0..self.components() {
-            let block = s![c * nz..(c + 1) * nz, .., ..];
-            Zip::from(scr.field.slice_mut(block))
-                .and(x.slice(block))
+            Zip::from(scr.field.slice_mut(self.block(c)))
+                .and(x.slice(self.block(c)))
                 .and(self.eps)
                 .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
         }
     }
 
-    /// `f(block of x, eps)` for each component's block of the unknowns.
-    fn blocks_mut<S: Storage>(
-        &self,
-        x: &mut Array3<S>,
-        f: impl Fn(ArrayViewMut3<S>, &Array3<C64>),
-    ) {
+    /// The unknowns of component `c`: z cells `c nz .. (c + 1) nz`, which
+    /// meet the permittivity grid voxel for voxel.
+    fn block(&self, c: usize) -> ndarray::SliceInfo<[ndarray::SliceInfoElem; 3], Ix3, Ix3> {
         let nz = self.eps.dim().0;
-        for c in 0..self.components() {
-            f(x.slice_mut(s![c * nz..(c + 1) * nz, .., ..]), self.eps);
-        }
-    }
-
-    /// Σ f(x, ε) over every unknown, per component block.
-    fn sum_blocks<S: Storage>(&self, x: &Array3<S>, f: impl Fn(&S, &C64) -> f64 + Sync) -> f64 {
-        use rayon::prelude::*;
-        let nz = self.eps.dim().0;
-        (0..self.components())
-            .map(|c| {
-                let b: ArrayView3<S> = x.slice(s![c * nz..(c + 1) * nz, .., ..]);
-                let parts: Vec<f64> = b
-                    .outer_iter()
-                    .into_par_iter()
-                    .zip(self.eps.outer_iter().into_par_iter())
-                    .map(|(sa, sb)| sa.iter().zip(sb.iter()).map(|(x, y)| f(x, y)).sum())
-                    .collect();
-                parts.iter().sum::<f64>()
-            })
-            .sum()
+        s![c * nz..(c + 1) * nz, .., ..]
     }
 
     /// `out ← base_j + scr.field − u` per z-slice j.
@@ -421,7 +393,7 @@ impl<'a> System<'a> {
         let eb = self.eps_binder;
         match (&mut self.op, &mut scr.op) {
             (
-                Equation::Scalar {
+                BackgroundOperator::Scalar {
                     op, binder: table, ..
                 },
                 OpWorkspace::Scalar(ws),
@@ -429,7 +401,7 @@ impl<'a> System<'a> {
                 let table = table.get_or_insert_with(|| GreenTable::new(&lat, C64::new(eb, 0.0)));
                 op.apply(table, &mut scr.field, ws);
             }
-            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
                 op.apply(C64::new(0.0, 0.0), &mut scr.field, ws)
             }
             _ => unreachable!("a system's scratch is made by the system"),
@@ -440,7 +412,7 @@ impl<'a> System<'a> {
 
     /// Drop `G_b`'s tables (as large as a field) once Born is ruled out.
     pub fn release_binder(&mut self) {
-        if let Equation::Scalar { binder, .. } = &mut self.op {
+        if let BackgroundOperator::Scalar { binder, .. } = &mut self.op {
             *binder = None;
         }
     }
@@ -448,11 +420,11 @@ impl<'a> System<'a> {
     /// `scr.field ← G_s scr.field`, the shifted operator of the equation.
     fn apply_shifted(&self, scr: &mut Scratch) {
         match (&self.op, &mut scr.op) {
-            (Equation::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
+            (BackgroundOperator::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
                 let table = self.shift.table.as_ref().expect("scalar shift table");
                 op.apply_shifted_green(table, &mut scr.field, ws)
             }
-            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
                 op.apply(self.shift.c, &mut scr.field, ws)
             }
             _ => unreachable!("a system's scratch is made by the system"),
@@ -496,11 +468,11 @@ impl<'a> System<'a> {
         let Some((er, es)) = self.shift.cbs else {
             return;
         };
-        self.blocks_mut(x, |b, eps| {
-            Zip::from(b)
-                .and(eps)
-                .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)))
-        });
+        for c in 0..self.components() {
+            Zip::from(x.slice_mut(self.block(c)))
+                .and(self.eps)
+                .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)));
+        }
     }
 
     /// ‖x‖ / ‖u_bg‖.
@@ -523,8 +495,8 @@ impl<'a> System<'a> {
         let (r, t, absorption) = self.outputs(&mut scr, &u);
         let lattice = self.lat;
         let vector = match self.op {
-            Equation::Scalar { .. } => None,
-            Equation::Vector { pol, .. } => Some(pol),
+            BackgroundOperator::Scalar { .. } => None,
+            BackgroundOperator::Vector { pol, .. } => Some(pol),
         };
         drop(scr);
         drop(self);
@@ -558,13 +530,13 @@ impl<'a> System<'a> {
         // w from the shifted sweep, of G_b u_s precomputed with the shift.
         self.load_scaled(scr, u, self.shift.c);
         match (&self.op, &mut scr.op) {
-            (Equation::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
+            (BackgroundOperator::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
                 let table = self.shift.table.as_ref().expect("scalar shift table");
                 let [r0, _] = &mut r;
                 let [t0, _] = &mut t;
                 op.shifted_boundary(table, &mut scr.field, ws, r0, t0);
             }
-            (Equation::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
                 op.boundary_amplitudes(self.shift.c, &mut scr.field, ws, &mut r, &mut t);
             }
             _ => unreachable!("a system's scratch is made by the system"),
@@ -575,7 +547,12 @@ impl<'a> System<'a> {
             t[k][[0, 0]] += self.t_bg[k] + c * self.shift.us_bottom[k];
         }
         let dz = lat.size_nm[2] / lat.nz as f64;
-        let s = self.sum_blocks(u, |u: &S, e: &C64| e.im * u.load().norm_sqr());
+        let s: f64 = (0..self.components())
+            .map(|c| {
+                let f = |u: &S, e: &C64| e.im * u.load().norm_sqr();
+                sum_slices(u.slice(self.block(c)), f, self.eps.view())
+            })
+            .sum();
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
@@ -589,7 +566,7 @@ pub fn mean_eps(eps: &Array3<C64>) -> C64 {
 
 impl Shift {
     fn new(
-        op: &Equation,
+        op: &BackgroundOperator,
         lat: &Lattice,
         eps: &Array3<C64>,
         eps_binder: f64,
@@ -618,7 +595,7 @@ impl Shift {
         let c = k2 * (bg - eps_binder);
         let zero = C64::new(0.0, 0.0);
         let (table, us, us_top, us_bottom) = match op {
-            Equation::Scalar {
+            BackgroundOperator::Scalar {
                 top00, bottom00, ..
             } => {
                 let table = ShiftTable::new(lat, eps_binder, c);
@@ -630,7 +607,7 @@ impl Shift {
                 let bottom: C64 = bottom00.iter().zip(&us).map(|(w, u)| w * u).sum();
                 (Some(table), us, [top, zero], [bottom, zero])
             }
-            Equation::Vector { op, .. } => {
+            BackgroundOperator::Vector { op, .. } => {
                 // u_s = (I − c G_b)⁻¹ u_bg = u_bg + c G_s u_bg.
                 let (gs, _, _) = op.harmonic00(c, ubg);
                 let us: Vec<C64> = ubg.iter().zip(&gs).map(|(u, g)| u + c * g).collect();

@@ -149,7 +149,7 @@ pub fn polarisation_mean(parts: &[(crate::config::Linear, Efficiencies)]) -> Eff
         .map(|(i, o)| Order {
             reflectance: mean(&|e| e.orders[i].reflectance),
             transmittance: mean(&|e| e.orders[i].transmittance),
-            ..o.clone()
+            ..*o
         })
         .collect();
     Efficiencies {

@@ -4,6 +4,7 @@
 //! `/geometry` group through the `geometry` module, the `/appearance` group
 //! through the `appearance` module).
 
+use crate::config::Equation;
 use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
@@ -407,14 +408,14 @@ fn write_entry(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> 
 /// order efficiencies (`orders_reflectance_s`, …) beside their mean.
 fn write_polarised(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
     if e.polarised.is_empty() {
-        write_str_attr(g, "equation", "helmholtz")?;
+        write_str_attr(g, "equation", Equation::Helmholtz.name())?;
         return write_str_attr(
             g,
             "polarisation",
             "none (scalar wave: surfaces reflect as s)",
         );
     }
-    write_str_attr(g, "equation", "maxwell")?;
+    write_str_attr(g, "equation", Equation::Maxwell.name())?;
     let names: Vec<&str> = e.polarised.iter().map(|(p, _)| p.name()).collect();
     write_str_attr(
         g,

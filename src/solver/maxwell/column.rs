@@ -23,10 +23,10 @@
 //! half-width 2 solved by Gaussian elimination with partial pivoting, O(N).
 //!
 //! The representation degenerates as γ → 0 (a harmonic grazing inside the
-//! binder); there the column is the mean over a small circle in γ² around
-//! the true value, as [`green::dense_small_gamma`] does for the scalar
-//! kernel (the answer is analytic in γ², and the nearest guided-mode pole is
-//! far outside the circle).
+//! binder); there the column is the mean over the scalar kernel's circle in
+//! γ² ([`green::is_small_gamma`], [`green::contour`]): the answer is
+//! analytic in γ², and the nearest guided-mode pole is far outside the
+//! circle.
 //!
 //! Takes the harmonic's constants ([`Harmonic`]) and the source columns;
 //! gives the cell averages and the boundary values `F(0)`, `F(H)` of the
@@ -42,12 +42,6 @@ const KL: usize = 2;
 const KU: usize = 2;
 /// Stored diagonals per column: KL below, KU above and KL of fill-in.
 const LD: usize = 2 * KL + KU + 1;
-/// Points on the averaging circle of a near-grazing harmonic.
-const CONTOUR_POINTS: usize = 8;
-/// |γ|·H below which the contour average is used, and the circle's radius
-/// in the same measure (as the scalar kernel's).
-const SMALL_GAMMA_H: f64 = 0.05;
-const CONTOUR_GAMMA_H: f64 = 0.07;
 
 /// Which of the two scalar problems of a harmonic.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,36 +53,19 @@ pub enum Pol {
 /// The constants of one harmonic.
 #[derive(Debug, Clone, Copy)]
 pub struct Harmonic {
-    pub k0: f64,
+    pub slab: Slab,
     /// Background permittivity inside the slab (the binder).
     pub eps_b: C64,
     /// |κ|.
     pub kappa: f64,
     /// β in vacuum (Im ≥ 0).
     pub beta: C64,
-    pub dz: f64,
-    pub nz: usize,
 }
 
 impl Harmonic {
-    pub fn new(slab: &Slab, eps_b: C64, kappa: f64, beta: C64) -> Harmonic {
-        Harmonic {
-            k0: slab.k0,
-            eps_b,
-            kappa,
-            beta,
-            dz: slab.dz(),
-            nz: slab.nz,
-        }
-    }
-
     fn gamma2(&self) -> C64 {
-        self.k0 * self.k0 * self.eps_b - self.kappa * self.kappa
-    }
-
-    /// True when the harmonic needs the contour average.
-    pub fn is_small_gamma(&self) -> bool {
-        self.gamma2().norm().sqrt() * self.dz * self.nz as f64 <= SMALL_GAMMA_H
+        let k0 = self.slab.k0;
+        k0 * k0 * self.eps_b - self.kappa * self.kappa
     }
 }
 
@@ -145,29 +122,19 @@ pub fn solve(
     scr: &mut ColumnScratch,
 ) -> (C64, C64) {
     let g2 = h.gamma2();
-    if !h.is_small_gamma() {
+    if !green::is_small_gamma(&h.slab, g2) {
         return solve_at(h, g2, pol, c, incident, col, scr);
     }
     // Mean over a circle in γ² (the answer is analytic there).
-    let n = h.nz;
-    let radius = (CONTOUR_GAMMA_H / (h.dz * n as f64)).powi(2);
+    let n = h.slab.nz;
     let mut acc_f = std::mem::take(&mut scr.acc_f);
     let mut acc_z = std::mem::take(&mut scr.acc_z);
     acc_f.iter_mut().for_each(|v| *v = ZERO);
     acc_z.iter_mut().for_each(|v| *v = ZERO);
     let (mut top, mut bottom) = (ZERO, ZERO);
-    let w = 1.0 / CONTOUR_POINTS as f64;
-    for k in 0..CONTOUR_POINTS {
-        let ang = 2.0 * std::f64::consts::PI * (k as f64 + 0.5) / CONTOUR_POINTS as f64;
-        let (t, b) = solve_at(
-            h,
-            g2 + C64::from_polar(radius, ang),
-            pol,
-            c,
-            incident,
-            col,
-            scr,
-        );
+    let w = green::CONTOUR_WEIGHT;
+    for point in green::contour(&h.slab, g2) {
+        let (t, b) = solve_at(h, point, pol, c, incident, col, scr);
         top += w * t;
         bottom += w * b;
         for j in 0..n {
@@ -207,10 +174,11 @@ struct Cell {
 
 fn cell(h: &Harmonic, g2: C64, pol: Pol, c: C64, incident: Incident) -> Cell {
     let gamma = green::sqrt_branch(g2);
-    let x = C64::i() * gamma * h.dz;
+    let x = C64::i() * gamma * h.slab.dz();
     let q = x.exp();
     let phi = green::phi1(x);
-    let k2e = h.k0 * h.k0 * h.eps_b;
+    let k0 = h.slab.k0;
+    let k2e = k0 * k0 * h.eps_b;
     match pol {
         Pol::Te => {
             let den = g2 + c;
@@ -248,7 +216,7 @@ fn cell(h: &Harmonic, g2: C64, pol: Pol, c: C64, incident: Incident) -> Cell {
                 zin: h.beta,
                 zout: gamma / h.eps_b,
                 rhs_top: if incident == Incident::Tm {
-                    2.0 * h.beta * gamma / (h.k0 * h.eps_b)
+                    2.0 * h.beta * gamma / (k0 * h.eps_b)
                 } else {
                     ZERO
                 },
@@ -272,7 +240,7 @@ fn solve_at(
     col: &mut Column,
     scr: &mut ColumnScratch,
 ) -> (C64, C64) {
-    let n = h.nz;
+    let n = h.slab.nz;
     let m = 2 * n;
     let k = cell(h, g2, pol, c, incident);
     let tm = pol == Pol::Tm;
@@ -366,8 +334,8 @@ fn band_solve(band: &mut [C64], x: &mut [C64], m: usize) {
     for k in (0..m).rev() {
         let right = (k + KL + KU).min(m - 1);
         let mut s = x[k];
-        for j in k + 1..=right {
-            s -= *at(band, k, j) * x[j];
+        for (j, xj) in x.iter().enumerate().take(right + 1).skip(k + 1) {
+            s -= *at(band, k, j) * xj;
         }
         x[k] = s / *at(band, k, k);
     }
@@ -384,7 +352,7 @@ mod tests {
         b_f: &[C64],
         b_z: &[C64],
     ) -> (Vec<C64>, Vec<C64>, C64, C64) {
-        let n = h.nz;
+        let n = h.slab.nz;
         let (mut w_f, mut w_z) = (vec![ZERO; n], vec![ZERO; n]);
         let mut scr = ColumnScratch::new(n);
         let (top, bottom) = solve(
@@ -432,7 +400,12 @@ mod tests {
         let s = slab();
         let kappa = kappa_rel * s.k0;
         let beta = green::sqrt_branch(C64::new(s.k0.powi(2) - kappa * kappa, 0.0));
-        Harmonic::new(&s, C64::new(1.558f64.powi(2), 0.0), kappa, beta)
+        Harmonic {
+            slab: s,
+            eps_b: C64::new(1.558f64.powi(2), 0.0),
+            kappa,
+            beta,
+        }
     }
 
     /// TE with c = 0 is the scalar Galerkin matrix of the slab kernel
@@ -447,7 +420,7 @@ mod tests {
         for kappa_rel in [0.0, 0.4, 1.3, 2.5, grazing] {
             let h = harmonic(kappa_rel);
             let g2 = h.gamma2();
-            let (m, top_w, bot_w) = if green::is_small_gamma(&s, g2) || h.is_small_gamma() {
+            let (m, top_w, bot_w) = if green::is_small_gamma(&s, g2) {
                 green::dense_small_gamma(&s, g2, h.beta)
             } else {
                 let cf = green::coef_from(&s, g2, h.beta);
@@ -506,7 +479,7 @@ mod tests {
             close(&[m0, m1], &[t0, t1], 1e-10, "boundary values");
             let want: Vec<C64> = b_z
                 .iter()
-                .map(|b| -b / (h.k0 * h.k0 * h.eps_b + c))
+                .map(|b| -b / (h.slab.k0 * h.slab.k0 * h.eps_b + c))
                 .collect();
             close(&ez, &want, 1e-12, "local E_z");
         }

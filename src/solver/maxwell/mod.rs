@@ -103,11 +103,6 @@ impl VectorOperator {
         }
     }
 
-    /// The unknowns' shape, (3 nz, ny, nx).
-    pub fn dim(&self) -> (usize, usize, usize) {
-        (3 * self.lat.nz, self.lat.ny, self.lat.nx)
-    }
-
     pub fn workspace(&self) -> VectorWorkspace {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let tasks = nx.min(4 * rayon::current_num_threads()).max(1);
@@ -127,12 +122,12 @@ impl VectorOperator {
         } else {
             self.reference
         };
-        let h = Harmonic::new(
-            &self.lat.slab(),
-            C64::new(self.eps_b, 0.0),
+        let h = Harmonic {
+            slab: self.lat.slab(),
+            eps_b: C64::new(self.eps_b, 0.0),
             kappa,
-            self.lat.beta(ix, iy),
-        );
+            beta: self.lat.beta(ix, iy),
+        };
         (unit, h)
     }
 
@@ -143,30 +138,30 @@ impl VectorOperator {
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         for_each_row(&mut ws.spec, &mut ws.tasks, |ix, row, scr| {
             for iy in 0..ny {
-                self.column(ix, iy, c, row, iy, scr, norm);
+                self.column(ix, iy, c, row, scr, norm);
             }
         });
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 
-    /// Load one harmonic's column from `row` ((3nz, ny)), solve, store back.
+    /// Load harmonic (ix, iy)'s column from column `iy` of its spectral row
+    /// `row` ((3nz, ny)), solve, store back.
     fn column(
         &self,
         ix: usize,
         iy: usize,
         c: C64,
         row: &mut ArrayViewMut2<C64>,
-        at: usize,
         scr: &mut HarmonicScratch,
         norm: f64,
     ) -> Boundary {
         let nz = self.lat.nz;
         let ([ux, uy], h) = self.harmonic(ix, iy);
         for j in 0..nz {
-            let (ex, ey) = (row[[j, at]], row[[nz + j, at]]);
+            let (ex, ey) = (row[[j, iy]], row[[nz + j, iy]]);
             scr.bk[j] = (ux * ex + uy * ey) * norm;
             scr.bs[j] = (-uy * ex + ux * ey) * norm;
-            scr.bz[j] = row[[2 * nz + j, at]] * norm;
+            scr.bz[j] = row[[2 * nz + j, iy]] * norm;
         }
         let (top_s, bottom_s) = column::solve(
             &h,
@@ -196,9 +191,9 @@ impl VectorOperator {
         );
         for j in 0..nz {
             let (ek, es) = (scr.wk[j], scr.ws[j]);
-            row[[j, at]] = ux * ek - uy * es;
-            row[[nz + j, at]] = uy * ek + ux * es;
-            row[[2 * nz + j, at]] = scr.wz[j];
+            row[[j, iy]] = ux * ek - uy * es;
+            row[[nz + j, iy]] = uy * ek + ux * es;
+            row[[2 * nz + j, iy]] = scr.wz[j];
         }
         Boundary {
             top_s,
@@ -226,7 +221,7 @@ impl VectorOperator {
         for ix in 0..nx {
             let mut row = ws.spec.index_axis_mut(Axis(1), ix);
             for iy in 0..ny {
-                let b = self.column(ix, iy, c, &mut row, iy, scr, norm);
+                let b = self.column(ix, iy, c, &mut row, scr, norm);
                 let p = self.p_factor(ix, iy);
                 r[0][[ix, iy]] = b.top_s;
                 t[0][[ix, iy]] = b.bottom_s;
@@ -301,9 +296,10 @@ impl VectorOperator {
     /// amplitudes of the continuous `G_b(b + c G_s b)` at the boundaries.
     pub fn harmonic00(&self, c: C64, rows: &[C64]) -> (Vec<C64>, [C64; 2], [C64; 2]) {
         let nz = self.lat.nz;
+        // Harmonic 00's spectral row, one column wide.
         let mut row = Array2::from_shape_fn((3 * nz, 1), |(j, _)| rows[j]);
         let mut scr = HarmonicScratch::new(nz);
-        let b = self.column(0, 0, c, &mut row.view_mut(), 0, &mut scr, 1.0);
+        let b = self.column(0, 0, c, &mut row.view_mut(), &mut scr, 1.0);
         let p = self.p_factor(0, 0);
         (
             row.column(0).to_vec(),

@@ -2,7 +2,9 @@
 //! shifted operator `G_s` (what the iterative methods apply; on the CBS
 //! shift and on a pigment layer's mean background) against the
 //! batched 2-D FFTs they contain (forward + inverse over every z-slice). The ratio
-//! operator/FFT is the figure of merit (docs/PERFORMANCE.md).
+//! operator/FFT is the figure of merit (docs/PERFORMANCE.md). Maxwell's
+//! shifted operator (`maxwell_apply_shifted*`, both grids up to 256²)
+//! against the scalar one on the same grid and shift: the goal is ≤ 3.5×.
 //!
 //! `cargo bench --bench operator` (60 × 60 × 50, the standard profile's
 //! grid (1.4 µm fragments, 20 nm z cells), 256 × 256 × 64 and 512 × 512 × 96;
@@ -14,6 +16,7 @@
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use inksim::solver::fft::Fft2;
+use inksim::solver::maxwell::VectorOperator;
 use inksim::solver::operator::{GreenTable, Operator};
 use inksim::solver::shift::ShiftTable;
 use inksim::solver::Problem;
@@ -58,6 +61,26 @@ fn bench<M: Measurement>(c: &mut Criterion<M>, name: &str) {
                 &(),
                 |b, _| b.iter(|| op.apply_shifted_green(&shifted, &mut u, &mut ws)),
             );
+        }
+        // Maxwell's shifted operator on the same grid and shift: three
+        // components, so three times the FFTs (the floor of the ratio).
+        if n <= 256 {
+            drop(u);
+            let vop = VectorOperator::new(lat, 1.558f64.powi(2), 0.0);
+            let mut vws = vop.workspace();
+            let mut e = field(3 * nz, n, n);
+            for (name, bg) in [
+                ("maxwell_apply_shifted", C64::new(2.0, 0.8)),
+                ("maxwell_apply_shifted_mean", C64::new(2.45, 0.05)),
+            ] {
+                let c = lat.k0 * lat.k0 * (bg - 1.558f64.powi(2));
+                let tables = vop.shift_tables(c);
+                g.bench_with_input(
+                    BenchmarkId::new(name, format!("{n}x{n}x{nz}")),
+                    &(),
+                    |b, _| b.iter(|| vop.apply_shifted(&tables, &mut e, &mut vws)),
+                );
+            }
         }
         let fft = Fft2::new(n, n);
         let mut scr = fft.scratch(nz);

@@ -59,6 +59,7 @@ pub mod lattice;
 pub mod maxwell;
 pub mod methods;
 pub mod operator;
+pub mod settle;
 pub mod shift;
 pub mod simd;
 pub mod storage;

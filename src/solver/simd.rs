@@ -29,6 +29,15 @@ impl Cx {
         im: [0.0; W],
     };
 
+    /// Every lane `c`.
+    #[inline(always)]
+    pub fn splat(c: C64) -> Cx {
+        Cx {
+            re: [c.re; W],
+            im: [c.im; W],
+        }
+    }
+
     #[inline(always)]
     pub fn lane(&self, k: usize) -> C64 {
         C64::new(self.re[k], self.im[k])

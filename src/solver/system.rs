@@ -16,7 +16,7 @@
 
 use super::green;
 use super::lattice::Lattice;
-use super::maxwell::{VectorOperator, VectorWorkspace};
+use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
 use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
@@ -97,7 +97,12 @@ enum BackgroundOperator {
     },
     /// Maxwell's equations for one incident linear polarisation: the
     /// unknowns are (3 nz, ny, nx), E_x, E_y, E_z stacked.
-    Vector { op: VectorOperator, pol: Linear },
+    Vector {
+        op: VectorOperator,
+        pol: Linear,
+        /// `G_b`'s row tables (shift 0), made on first use (Born).
+        binder: Option<Box<VectorShift>>,
+    },
 }
 
 /// The background of the shifted form `u = u_s + G_s V' u`: permittivity
@@ -111,8 +116,8 @@ struct Shift {
     /// the unpreconditioned mean background.
     cbs: Option<(f64, f64)>,
     c: C64,
-    /// The scalar equation's tables (the vector operator needs none).
-    table: Option<ShiftTable>,
+    /// The row sweeps' tables of the shifted operator.
+    table: ShiftTables,
     /// u_s per row of the unknowns.
     us: Vec<C64>,
     us_norm: f64,
@@ -120,6 +125,12 @@ struct Shift {
     /// or `[u, 0]`.
     us_top: [C64; 2],
     us_bottom: [C64; 2],
+}
+
+/// The shifted operator's tables of either equation.
+enum ShiftTables {
+    Scalar(ShiftTable),
+    Vector(VectorShift),
 }
 
 /// Working memory of a [`System`]'s operations, sized for its lattice.
@@ -218,6 +229,7 @@ impl<'a> System<'a> {
                 let op = BackgroundOperator::Vector {
                     op,
                     pol: polarisation,
+                    binder: None,
                 };
                 (op, bg.rows, bg.r, bg.t)
             }
@@ -401,8 +413,10 @@ impl<'a> System<'a> {
                 let table = table.get_or_insert_with(|| GreenTable::new(&lat, C64::new(eb, 0.0)));
                 op.apply(table, &mut scr.field, ws);
             }
-            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
-                op.apply(C64::new(0.0, 0.0), &mut scr.field, ws)
+            (BackgroundOperator::Vector { op, binder, .. }, OpWorkspace::Vector(ws)) => {
+                let table =
+                    binder.get_or_insert_with(|| Box::new(op.shift_tables(C64::new(0.0, 0.0))));
+                op.apply_shifted(table, &mut scr.field, ws)
             }
             _ => unreachable!("a system's scratch is made by the system"),
         }
@@ -412,21 +426,25 @@ impl<'a> System<'a> {
 
     /// Drop `G_b`'s tables (as large as a field) once Born is ruled out.
     pub fn release_binder(&mut self) {
-        if let BackgroundOperator::Scalar { binder, .. } = &mut self.op {
-            *binder = None;
+        match &mut self.op {
+            BackgroundOperator::Scalar { binder, .. } => *binder = None,
+            BackgroundOperator::Vector { binder, .. } => *binder = None,
         }
     }
 
     /// `scr.field ← G_s scr.field`, the shifted operator of the equation.
     fn apply_shifted(&self, scr: &mut Scratch) {
-        match (&self.op, &mut scr.op) {
-            (BackgroundOperator::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
-                let table = self.shift.table.as_ref().expect("scalar shift table");
-                op.apply_shifted_green(table, &mut scr.field, ws)
-            }
-            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
-                op.apply(self.shift.c, &mut scr.field, ws)
-            }
+        match (&self.op, &mut scr.op, &self.shift.table) {
+            (
+                BackgroundOperator::Scalar { op, .. },
+                OpWorkspace::Scalar(ws),
+                ShiftTables::Scalar(table),
+            ) => op.apply_shifted_green(table, &mut scr.field, ws),
+            (
+                BackgroundOperator::Vector { op, .. },
+                OpWorkspace::Vector(ws),
+                ShiftTables::Vector(table),
+            ) => op.apply_shifted(table, &mut scr.field, ws),
             _ => unreachable!("a system's scratch is made by the system"),
         }
     }
@@ -529,14 +547,17 @@ impl<'a> System<'a> {
         // solution u − G_s V' u = u_s (harmonic 00 only): boundary values of
         // w from the shifted sweep, of G_b u_s precomputed with the shift.
         self.load_scaled(scr, u, self.shift.c);
-        match (&self.op, &mut scr.op) {
-            (BackgroundOperator::Scalar { op, .. }, OpWorkspace::Scalar(ws)) => {
-                let table = self.shift.table.as_ref().expect("scalar shift table");
+        match (&self.op, &mut scr.op, &self.shift.table) {
+            (
+                BackgroundOperator::Scalar { op, .. },
+                OpWorkspace::Scalar(ws),
+                ShiftTables::Scalar(table),
+            ) => {
                 let [r0, _] = &mut r;
                 let [t0, _] = &mut t;
                 op.shifted_boundary(table, &mut scr.field, ws, r0, t0);
             }
-            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws)) => {
+            (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws), _) => {
                 op.boundary_amplitudes(self.shift.c, &mut scr.field, ws, &mut r, &mut t);
             }
             _ => unreachable!("a system's scratch is made by the system"),
@@ -605,14 +626,14 @@ impl Shift {
                 let us = scr.column().to_vec();
                 let top: C64 = top00.iter().zip(&us).map(|(w, u)| w * u).sum();
                 let bottom: C64 = bottom00.iter().zip(&us).map(|(w, u)| w * u).sum();
-                (Some(table), us, [top, zero], [bottom, zero])
+                (ShiftTables::Scalar(table), us, [top, zero], [bottom, zero])
             }
             BackgroundOperator::Vector { op, .. } => {
                 // u_s = (I − c G_b)⁻¹ u_bg = u_bg + c G_s u_bg.
                 let (gs, _, _) = op.harmonic00(c, ubg);
                 let us: Vec<C64> = ubg.iter().zip(&gs).map(|(u, g)| u + c * g).collect();
                 let (_, top, bottom) = op.harmonic00(zero, &us);
-                (None, us, top, bottom)
+                (ShiftTables::Vector(op.shift_tables(c)), us, top, bottom)
             }
         };
         let us_norm =

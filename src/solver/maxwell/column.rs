@@ -63,7 +63,7 @@ pub struct Harmonic {
 }
 
 impl Harmonic {
-    fn gamma2(&self) -> C64 {
+    pub(super) fn gamma2(&self) -> C64 {
         let k0 = self.slab.k0;
         k0 * k0 * self.eps_b - self.kappa * self.kappa
     }
@@ -153,26 +153,27 @@ pub fn solve(
     (top, bottom)
 }
 
-/// The cell coefficients of a harmonic at one γ² (see the module docs).
-struct Cell {
-    q: C64,
-    phi: C64,
+/// The cell coefficients of a harmonic at one γ² (see the module docs);
+/// the row sweeps of [`tm_sweep`](super::tm_sweep) take TM's from here.
+pub(super) struct Cell {
+    pub(super) q: C64,
+    pub(super) phi: C64,
     /// p_j = ps (a_j + d_j) + pb b_f,j.
-    ps: C64,
-    pb: C64,
+    pub(super) ps: C64,
+    pub(super) pb: C64,
     /// Normalised flux offset f̃_j = kd (a_j − d_j) + kb b_z,j (TM).
-    kd: C64,
-    kb: C64,
+    pub(super) kd: C64,
+    pub(super) kb: C64,
     /// E_z average: w_z = zd (a_j − d_j) + zb b_z,j (TM).
-    zd: C64,
-    zb: C64,
+    pub(super) zd: C64,
+    pub(super) zb: C64,
     /// Boundary rows: zin (flux) + zout F = rhs.
-    zin: C64,
-    zout: C64,
-    rhs_top: C64,
+    pub(super) zin: C64,
+    pub(super) zout: C64,
+    pub(super) rhs_top: C64,
 }
 
-fn cell(h: &Harmonic, g2: C64, pol: Pol, c: C64, incident: Incident) -> Cell {
+pub(super) fn cell(h: &Harmonic, g2: C64, pol: Pol, c: C64, incident: Incident) -> Cell {
     let gamma = green::sqrt_branch(g2);
     let x = C64::i() * gamma * h.slab.dz();
     let q = x.exp();

@@ -18,6 +18,10 @@
 //! background slab's own response to an s or p plane wave.
 
 pub mod column;
+mod shifted;
+mod tm_sweep;
+
+pub use shifted::VectorShift;
 
 use super::fft::{Fft2, FftScratch};
 use super::lattice::Lattice;
@@ -26,6 +30,7 @@ use crate::config::Linear;
 use column::{Column, ColumnScratch, Harmonic, Incident, Pol};
 use ndarray::{Array2, Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64 as C64;
+use shifted::RowPair;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
@@ -43,11 +48,14 @@ pub struct VectorWorkspace {
     spec: Array3<C64>,
     fft: FftScratch,
     tasks: Vec<HarmonicScratch>,
+    /// The near-grazing harmonics' columns of the row path.
+    dense: Vec<C64>,
 }
 
-/// One task's columns: sources and outputs in (s, κ, z).
+/// One task's columns (sources and outputs in (s, κ, z)) and rows.
 struct HarmonicScratch {
     col: ColumnScratch,
+    rows: RowPair,
     bs: Vec<C64>,
     bk: Vec<C64>,
     bz: Vec<C64>,
@@ -57,10 +65,11 @@ struct HarmonicScratch {
 }
 
 impl HarmonicScratch {
-    fn new(nz: usize) -> Self {
+    fn new(nz: usize, ny: usize) -> Self {
         let z = || vec![ZERO; nz];
         HarmonicScratch {
             col: ColumnScratch::new(nz),
+            rows: RowPair::new(nz, ny),
             bs: z(),
             bk: z(),
             bz: z(),
@@ -109,7 +118,8 @@ impl VectorOperator {
         VectorWorkspace {
             spec: Array3::zeros((3 * nz, nx, ny)),
             fft: self.fft.scratch(3 * nz),
-            tasks: (0..tasks).map(|_| HarmonicScratch::new(nz)).collect(),
+            tasks: (0..tasks).map(|_| HarmonicScratch::new(nz, ny)).collect(),
+            dense: Vec::new(),
         }
     }
 
@@ -138,18 +148,20 @@ impl VectorOperator {
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         for_each_row(&mut ws.spec, &mut ws.tasks, |ix, row, scr| {
             for iy in 0..ny {
-                self.column(ix, iy, c, row, scr, norm);
+                self.column(ix, iy, iy, c, row, scr, norm);
             }
         });
         self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 
-    /// Load harmonic (ix, iy)'s column from column `iy` of its spectral row
-    /// `row` ((3nz, ny)), solve, store back.
+    /// Load harmonic (ix, iy)'s column from column `at` of `row` ((3nz, ·),
+    /// its spectral row or a copy of the one column), solve, store back.
+    #[allow(clippy::too_many_arguments)]
     fn column(
         &self,
         ix: usize,
         iy: usize,
+        at: usize,
         c: C64,
         row: &mut ArrayViewMut2<C64>,
         scr: &mut HarmonicScratch,
@@ -158,10 +170,10 @@ impl VectorOperator {
         let nz = self.lat.nz;
         let ([ux, uy], h) = self.harmonic(ix, iy);
         for j in 0..nz {
-            let (ex, ey) = (row[[j, iy]], row[[nz + j, iy]]);
+            let (ex, ey) = (row[[j, at]], row[[nz + j, at]]);
             scr.bk[j] = (ux * ex + uy * ey) * norm;
             scr.bs[j] = (-uy * ex + ux * ey) * norm;
-            scr.bz[j] = row[[2 * nz + j, iy]] * norm;
+            scr.bz[j] = row[[2 * nz + j, at]] * norm;
         }
         let (top_s, bottom_s) = column::solve(
             &h,
@@ -191,9 +203,9 @@ impl VectorOperator {
         );
         for j in 0..nz {
             let (ek, es) = (scr.wk[j], scr.ws[j]);
-            row[[j, iy]] = ux * ek - uy * es;
-            row[[nz + j, iy]] = uy * ek + ux * es;
-            row[[2 * nz + j, iy]] = scr.wz[j];
+            row[[j, at]] = ux * ek - uy * es;
+            row[[nz + j, at]] = uy * ek + ux * es;
+            row[[2 * nz + j, at]] = scr.wz[j];
         }
         Boundary {
             top_s,
@@ -221,7 +233,7 @@ impl VectorOperator {
         for ix in 0..nx {
             let mut row = ws.spec.index_axis_mut(Axis(1), ix);
             for iy in 0..ny {
-                let b = self.column(ix, iy, c, &mut row, scr, norm);
+                let b = self.column(ix, iy, iy, c, &mut row, scr, norm);
                 let p = self.p_factor(ix, iy);
                 r[0][[ix, iy]] = b.top_s;
                 t[0][[ix, iy]] = b.bottom_s;
@@ -298,8 +310,8 @@ impl VectorOperator {
         let nz = self.lat.nz;
         // Harmonic 00's spectral row, one column wide.
         let mut row = Array2::from_shape_fn((3 * nz, 1), |(j, _)| rows[j]);
-        let mut scr = HarmonicScratch::new(nz);
-        let b = self.column(0, 0, c, &mut row.view_mut(), &mut scr, 1.0);
+        let mut scr = HarmonicScratch::new(nz, 1);
+        let b = self.column(0, 0, 0, c, &mut row.view_mut(), &mut scr, 1.0);
         let p = self.p_factor(0, 0);
         (
             row.column(0).to_vec(),

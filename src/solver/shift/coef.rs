@@ -3,12 +3,9 @@
 //! `W` harmonics at a time, and the dense inverses of near-grazing harmonics.
 
 use super::{HarmBlock, HarmConst, HarmonicShift, Step, StepBlock, ZERO};
+use crate::solver::settle;
 use crate::solver::simd::Cx;
 use num_complex::Complex64 as C64;
-
-/// Coefficients of later cells differ from the last stored one by at most
-/// this, relative to its magnitude: rounding.
-const SETTLED: f64 = f64::EPSILON;
 
 impl Step {
     pub(super) const ZERO: Step = Step {
@@ -20,17 +17,8 @@ impl Step {
         wb: ZERO,
     };
 
-    fn fields(&self) -> [C64; 6] {
+    pub(super) fn fields(&self) -> [C64; 6] {
         [self.gt, self.v, self.ua, self.ub, self.wa, self.wb]
-    }
-
-    /// All fields of `other` within `SETTLED` of ours.
-    pub(super) fn settled(&self, other: &Step) -> bool {
-        self.fields()
-            .iter()
-            .zip(other.fields())
-            // Squared moduli: no hypot in the table's hottest loop.
-            .all(|(a, b)| (a - b).norm_sqr() <= SETTLED * SETTLED * a.norm_sqr())
     }
 }
 
@@ -54,9 +42,8 @@ pub(super) fn sweep_coefficients(hs: &HarmonicShift, steps: &mut [Step]) -> ([C6
     let top_u = beta / den;
     let g = gamma2 * phi * inv_gs2;
     // The recursion t → t_next is a contraction (the shifted background is
-    // lossy): once t has reached its fixed point to rounding, every later
-    // cell repeats this one. With r the ratio of successive changes, the
-    // distance left is about |Δt| r / (1 − r).
+    // lossy): once t has reached its fixed point to rounding
+    // (settle::converged), every later cell repeats this one.
     let mut last_change = f64::INFINITY;
     let mut settled_from = steps.len();
     for (j, step) in steps.iter_mut().enumerate() {
@@ -81,22 +68,14 @@ pub(super) fn sweep_coefficients(hs: &HarmonicShift, steps: &mut [Step]) -> ([C6
             wb: (m00 * eb - m10 * ea) * inv,
         };
         let change = (t_next - t).norm_sqr().sqrt();
-        let r = change / last_change;
         t = t_next;
-        let converged = change == 0.0
-            || (last_change.is_finite()
-                && r < 1.0
-                && change * r / (1.0 - r) <= SETTLED * t.norm_sqr().sqrt());
-        if converged {
+        if settle::converged(change, last_change, t.norm_sqr().sqrt()) {
             settled_from = j + 1;
             break;
         }
         last_change = change;
     }
-    if settled_from < steps.len() {
-        let last = steps[settled_from - 1];
-        steps[settled_from..].fill(last);
-    }
+    settle::repeat_from(steps, settled_from);
     // Bottom: outgoing at z = H, d = (−β x' − ca u)/(t ca + cd).
     let ca = gamma * q - beta * q + beta * kappa;
     let cd = -gamma - beta + beta * kappa;

@@ -32,6 +32,7 @@ mod sweep;
 
 use super::green;
 use super::lattice::Lattice;
+use super::settle::{self, Packed};
 use super::simd::{Cx, RowCells, W};
 use coef::{dense_inverse_shift, sweep_coefficients};
 use num_complex::Complex64 as C64;
@@ -111,11 +112,8 @@ pub struct ShiftTable {
     ny: usize,
     /// Blocks of `W` harmonics per spectral row.
     nb: usize,
-    /// Per block of `W` harmonics, layout (ix, block): index of its first
-    /// stored cell in `steps` and the number stored (consecutive cells).
-    block_off: Vec<usize>,
-    block_cells: Vec<usize>,
-    steps: Vec<StepBlock>,
+    /// Per block of `W` harmonics, layout (ix, block): its stored cells.
+    steps: Packed<StepBlock>,
     harm: Vec<HarmBlock>,
 }
 
@@ -193,14 +191,10 @@ impl ShiftTable {
         let cells = n - 1;
         let mut ends = vec![[ZERO; 3]; h.len()];
         let mut harm = vec![HarmBlock::ZERO; nx * nb];
-        let mut block_off = Vec::with_capacity(nx * nb);
-        let mut block_cells = Vec::with_capacity(nx * nb);
-        let mut steps = Vec::new();
+        let mut steps = Packed::new(ny);
         // One row's full columns, layout (iy, j).
         let mut full = vec![Step::ZERO; ny * cells];
-        let mut keep = vec![0; nb];
         for ix in 0..nx {
-            keep.fill(0);
             for iy in 0..ny {
                 let i = ix * ny + iy;
                 let col = &mut full[iy * cells..(iy + 1) * cells];
@@ -211,25 +205,14 @@ impl ShiftTable {
                 let (e, hb) = sweep_coefficients(hs, col);
                 ends[i] = e;
                 harm[ix * nb + iy / W].set(iy % W, &hb, norm);
-                // Cells from `settle` on equal the last cell to rounding.
-                let mut settle = cells;
-                while settle > 0 && col[settle - 1].settled(&col[cells - 1]) {
-                    settle -= 1;
-                }
-                let k = &mut keep[iy / W];
-                *k = (*k).max(settle + 1).min(cells);
             }
-            for (b, &keep) in keep.iter().enumerate() {
-                block_off.push(steps.len());
-                block_cells.push(keep);
-                for j in 0..keep {
-                    let mut sb = StepBlock::ZERO;
-                    for k in 0..W.min(ny - b * W) {
-                        sb.set(k, &full[(b * W + k) * cells + j]);
-                    }
-                    steps.push(sb);
-                }
-            }
+            steps.push_row(
+                &full,
+                cells,
+                |a, b| settle::same(&a.fields(), &b.fields()),
+                StepBlock::ZERO,
+                |b, k, s| b.set(k, s),
+            );
         }
         ShiftTable {
             c,
@@ -239,8 +222,6 @@ impl ShiftTable {
             n,
             ny,
             nb,
-            block_off,
-            block_cells,
             steps,
             harm,
         }
@@ -256,20 +237,14 @@ impl ShiftTable {
     /// Down-sweep cells stored, summed over all harmonics (at most
     /// (N − 1) per harmonic; the rest are reused).
     pub fn stored_cells(&self) -> usize {
-        let (nb, ny) = (self.nb, self.ny);
-        self.block_cells
-            .iter()
-            .enumerate()
-            .map(|(i, &c)| c * W.min(ny - (i % nb) * W))
-            .sum()
+        self.steps.stored_cells()
     }
 
     /// The stored cells of block `b` of row `ix` (the last one stands for
     /// all later cells).
     #[inline(always)]
     fn steps_of(&self, ix: usize, b: usize) -> &[StepBlock] {
-        let i = ix * self.nb + b;
-        &self.steps[self.block_off[i]..][..self.block_cells[i]]
+        self.steps.of(ix, b)
     }
 
     /// Spectral indices of the near-grazing (dense) harmonics.

@@ -1,0 +1,154 @@
+//! Sweep tables that store a cell only until it repeats: shared by the
+//! scalar shift table ([`shift`](super::shift)) and Maxwell's TM table
+//! ([`maxwell`](super::maxwell)).
+//!
+//! A down sweep's right-hand-side-free coefficients follow a Möbius
+//! recursion from the top boundary; where the background is lossy it
+//! converges geometrically, and once it has reached its fixed point to
+//! rounding every later cell repeats the last. Per spectral row and block of
+//! `W` harmonics only the cells until all lanes have settled are stored
+//! ([`Packed`]); a sweep reads cell `min(j, last)`.
+
+use super::simd::W;
+use num_complex::Complex64 as C64;
+
+/// Coefficients of later cells differ from the last stored one by at most
+/// this, relative to its magnitude: rounding.
+pub const SETTLED: f64 = f64::EPSILON;
+
+/// Whether an iterate of size `size` whose last step was `change` (after
+/// `last_change`) has reached its fixed point to rounding: with `r` the
+/// ratio of successive changes, the distance left is about
+/// `change · r / (1 − r)`.
+pub fn converged(change: f64, last_change: f64, size: f64) -> bool {
+    let r = change / last_change;
+    change == 0.0
+        || (last_change.is_finite() && r < 1.0 && change * r / (1.0 - r) <= SETTLED * size)
+}
+
+/// Every value of `a` within [`SETTLED`] of `b`'s (relative to `a`'s).
+pub fn same(a: &[C64], b: &[C64]) -> bool {
+    // Squared moduli: no hypot in a table's hottest loop.
+    a.iter()
+        .zip(b)
+        .all(|(a, b)| (a - b).norm_sqr() <= SETTLED * SETTLED * a.norm_sqr())
+}
+
+/// `steps[from..]` set to `steps[from − 1]` (a recursion stopped at `from`).
+pub fn repeat_from<S: Copy>(steps: &mut [S], from: usize) {
+    if from > 0 && from < steps.len() {
+        let last = steps[from - 1];
+        steps[from..].fill(last);
+    }
+}
+
+/// Per block of `W` harmonics, layout (ix, block), its stored cells.
+pub struct Packed<B> {
+    ny: usize,
+    nb: usize,
+    off: Vec<usize>,
+    cells: Vec<usize>,
+    blocks: Vec<B>,
+}
+
+impl<B: Copy> Packed<B> {
+    /// Empty, for spectral rows of `ny` harmonics.
+    pub fn new(ny: usize) -> Self {
+        Packed {
+            ny,
+            nb: ny.div_ceil(W),
+            off: Vec::new(),
+            cells: Vec::new(),
+            blocks: Vec::new(),
+        }
+    }
+
+    /// Append one spectral row from its full columns `full` (layout
+    /// (iy, cell), `cells` per harmonic): per block, the cells until every
+    /// lane equals its last cell (`same`), lane k of cell j packed by
+    /// `set(block, k, value)` into a copy of `zero`.
+    pub fn push_row<S>(
+        &mut self,
+        full: &[S],
+        cells: usize,
+        same: impl Fn(&S, &S) -> bool,
+        zero: B,
+        set: impl Fn(&mut B, usize, &S),
+    ) {
+        let ny = self.ny;
+        for b in 0..self.nb {
+            let lanes = W.min(ny - b * W);
+            let keep = (0..lanes)
+                .map(|k| {
+                    let col = &full[(b * W + k) * cells..][..cells];
+                    let mut settle = cells;
+                    while settle > 0 && same(&col[settle - 1], &col[cells - 1]) {
+                        settle -= 1;
+                    }
+                    (settle + 1).min(cells)
+                })
+                .max()
+                .unwrap_or(0);
+            self.off.push(self.blocks.len());
+            self.cells.push(keep);
+            for j in 0..keep {
+                let mut block = zero;
+                for k in 0..lanes {
+                    set(&mut block, k, &full[(b * W + k) * cells + j]);
+                }
+                self.blocks.push(block);
+            }
+        }
+    }
+
+    /// The stored cells of block `b` of row `ix` (the last stands for all
+    /// later cells).
+    #[inline(always)]
+    pub fn of(&self, ix: usize, b: usize) -> &[B] {
+        let i = ix * self.nb + b;
+        &self.blocks[self.off[i]..][..self.cells[i]]
+    }
+
+    /// Cells stored, summed over harmonics.
+    pub fn stored_cells(&self) -> usize {
+        let (nb, ny) = (self.nb, self.ny);
+        self.cells
+            .iter()
+            .enumerate()
+            .map(|(i, &c)| c * W.min(ny - (i % nb) * W))
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Blocks keep the cells until their slowest lane settles; a row of
+    /// fewer than `W` harmonics packs partial blocks.
+    #[test]
+    fn blocks_keep_cells_until_every_lane_settles() {
+        let cells = 5;
+        let ny = W + 2;
+        // Harmonic iy settles from cell min(iy, 4) on (values then repeat).
+        let full: Vec<f64> = (0..ny)
+            .flat_map(|iy| (0..cells).map(move |j| j.min(iy.min(cells - 1)) as f64))
+            .collect();
+        let mut p = Packed::new(ny);
+        p.push_row(&full, cells, |a, b| a == b, [0.0; W], |b, k, v| b[k] = *v);
+        // Block 0 holds iy 0..W: the slowest settles at cell 4 → 5 cells.
+        assert_eq!(p.of(0, 0).len(), 5);
+        // Block 1 holds iy W, W+1 (both settle at cell 4).
+        assert_eq!(p.of(0, 1).len(), 5);
+        assert_eq!(p.of(0, 0)[2][1], 1.0);
+        assert_eq!(p.of(0, 0)[2][3], 2.0);
+        let mut q = Packed::new(3);
+        let quick: Vec<f64> = vec![0.0; 3 * cells];
+        q.push_row(&quick, cells, |a, b| a == b, [0.0; W], |b, k, v| b[k] = *v);
+        assert_eq!(q.of(0, 0).len(), 1);
+        assert_eq!(q.stored_cells(), 3);
+        assert!(converged(0.0, 1.0, 1.0));
+        assert!(!converged(0.5, 1.0, 1.0));
+        assert!(converged(1e-18, 1e-17, 1.0));
+    }
+}

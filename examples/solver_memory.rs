@@ -1,7 +1,10 @@
 //! Peak memory of one solve, per method and field precision
 //! (docs/PERFORMANCE.md, "Memory").
 //!
-//! `cargo run --release --example solver_memory -- <method> <f64|f32> <nx> <ny> <nz> [iterations]`
+//! `cargo run --release --example solver_memory -- <method> <f64|f32> <nx> <ny> <nz> [iterations] [helmholtz|maxwell]`
+//!
+//! With `maxwell`, the solve is Maxwell's equations in s polarisation
+//! (three field components per voxel).
 //!
 //! Builds a permittivity grid of the given size (a 10 nm-cell layer of
 //! absorbing blocks in binder; the content does not change the memory),
@@ -36,7 +39,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.len() < 5 {
         eprintln!(
-            "usage: solver_memory <born|time-marching|gmres|bicgstab> <f64|f32> <nx> <ny> <nz> [iterations]"
+            "usage: solver_memory <born|time-marching|gmres|bicgstab> <f64|f32> <nx> <ny> <nz> [iterations] [helmholtz|maxwell]"
         );
         std::process::exit(2);
     }
@@ -52,6 +55,14 @@ fn main() {
         .map(|a| a.parse().expect("size"))
         .collect();
     let iterations: usize = args.get(5).map_or(3, |a| a.parse().expect("iterations"));
+    let wave = match args.get(6).map(String::as_str) {
+        None | Some("helmholtz") => inksim::solver::Wave::Scalar,
+        Some("maxwell") => inksim::solver::Wave::Vector {
+            polarisation: inksim::config::Linear::S,
+            azimuth_deg: 0.0,
+        },
+        Some(e) => panic!("unknown equation {e}"),
+    };
     let (nx, ny, nz) = (n[0], n[1], n[2]);
     let voxels = (nx * ny * nz) as f64;
     let base = peak_rss();
@@ -70,7 +81,7 @@ fn main() {
         lattice: Problem::lattice([nx, ny, nz], size, 450.0, 40.0, 0.0),
         eps: &eps,
         eps_binder: eb,
-        wave: inksim::solver::Wave::Scalar,
+        wave,
     };
     let ctl = Controls {
         tolerance: 1e-6,

@@ -341,7 +341,20 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert!(!ok);
     assert_memory_line(&err);
     assert!(t.elapsed().as_secs_f64() < 10.0, "no work before the check");
-    assert!(!out.join("tiny.h5").exists());
+    assert!(!out.exists(), "a refused run leaves nothing behind");
+    // Maxwell: 3.2× the method's own 165 B per voxel (f64 BiCGStab), named
+    // with the equation and the scalar equation as a way out.
+    let maxwell = huge_scene().equation("maxwell").write(dir.path());
+    let (ok, _, err) = inksim(&["check", maxwell.to_str().unwrap(), "--max-memory", "1G"]);
+    assert!(!ok);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    for needle in [
+        "f64 fields, maxwell",
+        "190.6 GB",
+        "equation = \"helmholtz\"",
+    ] {
+        assert!(err.contains(needle), "`{needle}` missing: {err}");
+    }
     let small = SceneToml::tiny().write(dir.path());
     let (ok, out, _) = inksim(&["check", small.to_str().unwrap(), "--max-memory", "1G"]);
     assert!(ok, "20 × 20 × 20 fits in 1 GB: {out}");

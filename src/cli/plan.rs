@@ -3,7 +3,7 @@
 
 use super::ConfigFile;
 use anyhow::Result;
-use inksim::config::{Method, Precision};
+use inksim::config::{Equation, Method, Precision};
 use inksim::pipeline::accuracy;
 use inksim::pipeline::memory::{self, human_bytes, MemoryLimit};
 use inksim::study::plan::{self, human_time};
@@ -44,7 +44,8 @@ pub fn plan(
     let cal = plan::calibrate(&chosen.variants, &chosen.variants);
     println!(
         "time model (calibrated now on this machine, {nthreads} thread(s)): per solve = setup + \
-         applications × one operator application × {}; applications per solve {:.0} under a \
+         applications × one operator application × {} (Maxwell: per polarisation solved, \
+         two for natural light); applications per solve {:.0} under a \
          flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
          background), × {:.2}: {}",
         plan::KRYLOV_OVERHEAD,
@@ -54,12 +55,13 @@ pub fn plan(
         cal.ratio,
         cal.applications_source
     );
-    for (g, t) in &cal.grids {
+    for ((g, equation), t) in &cal.grids {
         println!(
-            "  grid {}×{}×{}: setup {:.1} ms, one application {:.2} ms{}",
+            "  grid {}×{}×{} ({}): setup {:.1} ms, one application {:.2} ms{}",
             g[0],
             g[1],
             g[2],
+            equation.name(),
             t.setup_s * 1e3,
             t.apply_s * 1e3,
             if t.timed != *g {
@@ -79,16 +81,17 @@ pub fn plan(
             format!(
                 "{} {:.0}/{:.0}",
                 m.name(),
-                memory::bytes_per_voxel(m, Precision::F64),
-                memory::bytes_per_voxel(m, Precision::F32)
+                memory::bytes_per_voxel(m, Precision::F64, Equation::Helmholtz),
+                memory::bytes_per_voxel(m, Precision::F32, Equation::Helmholtz)
             )
         })
         .collect();
     println!(
         "memory model: {} + voxels × (bytes per voxel of the method, f64/f32 storage: {}; \
-         docs/PERFORMANCE.md) + 8 B per voxel and species",
+         Maxwell {}× the method's own share; docs/PERFORMANCE.md) + 8 B per voxel and species",
         human_bytes(memory::BASELINE_BYTES),
-        rates.join(", ")
+        rates.join(", "),
+        memory::MAXWELL_PER_SCALAR
     );
     println!(
         "{:>4}  {:<34} {:>6} {:>14} {:>10} {:>5} {:>6} {:>10} {:>9}  state",

@@ -5,7 +5,7 @@
 //! scene is read.
 
 /// The wave equation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum Equation {
     /// The scalar Helmholtz equation: every flat surface reflects like
     /// s-polarised light; the fast approximation.

@@ -4,7 +4,8 @@
 //! `BASELINE_BYTES + voxels × (B_method + 32 + 8 × species)`, with
 //! `B_method` the solver's own peak per voxel from its registry
 //! (`Solver::bytes_per_voxel`, measured by `examples/solver_memory`,
-//! docs/PERFORMANCE.md "Memory"), 32 B for the pipeline's ε grid and its
+//! docs/PERFORMANCE.md "Memory"; [`MAXWELL_PER_SCALAR`] times that for
+//! Maxwell's three components), 32 B for the pipeline's ε grid and its
 //! flipped copy for the solves from below, and 8 B per species for the
 //! raster's volume fractions. The grid is the one the run solves on
 //! (including the cells a relief adds on top).
@@ -17,7 +18,7 @@
 //! system refuses is an error of this scene rather than an abort of the
 //! process.
 
-use crate::config::{Method, Precision, Scene};
+use crate::config::{Equation, Method, Precision, Scene};
 
 use super::grains::grid_of;
 use super::PipelineError;
@@ -26,10 +27,21 @@ use super::PipelineError;
 /// geometry, tables): the 23 MB baseline of docs/PERFORMANCE.md, rounded up.
 pub const BASELINE_BYTES: f64 = 25e6;
 
+/// A Maxwell solve's own peak per voxel over the scalar one's, same method
+/// and precision: three field components (fields, spectrum, sweep tables),
+/// one ε grid. Measured 2.8–3.2× (`solver_memory … maxwell`, every method
+/// and precision, docs/PERFORMANCE.md "Memory"); the largest is kept.
+pub const MAXWELL_PER_SCALAR: f64 = 3.2;
+
 /// Bytes per voxel of a solve: the method's own peak from the solver's
-/// registry plus the pipeline's ε grid and its flipped copy (16 B each).
-pub fn bytes_per_voxel(m: Method, p: Precision) -> f64 {
-    m.solver().bytes_per_voxel(p) + 32.0
+/// registry (times [`MAXWELL_PER_SCALAR`] for Maxwell) plus the pipeline's
+/// ε grid and its flipped copy (16 B each).
+pub fn bytes_per_voxel(m: Method, p: Precision, e: Equation) -> f64 {
+    let factor = match e {
+        Equation::Helmholtz => 1.0,
+        Equation::Maxwell => MAXWELL_PER_SCALAR,
+    };
+    factor * m.solver().bytes_per_voxel(p) + 32.0
 }
 
 /// The grid a scene solves on, `[nx, ny, nz]`.
@@ -43,21 +55,28 @@ pub fn estimate_bytes(scene: &Scene) -> f64 {
     let voxels: f64 = solve_grid(scene).iter().map(|&n| n as f64).product();
     BASELINE_BYTES
         + voxels
-            * (bytes_per_voxel(scene.solver.method, scene.solver.precision)
-                + 8.0 * scene.species.len() as f64)
+            * (bytes_per_voxel(
+                scene.solver.method,
+                scene.solver.precision,
+                scene.solver.equation,
+            ) + 8.0 * scene.species.len() as f64)
 }
 
 /// A run whose memory estimate exceeds the limit: what to say about it.
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "grid {grid}, method {method} ({precision} fields): estimated peak memory {estimate} \
-     exceeds {limit}; use fewer cells (a larger [grid] cell_nm or a smaller fragment), \
-     solver precision = \"f32\" or method = \"time-marching\", or {remedy}"
+    "grid {grid}, method {method} ({precision} fields, {equation}): estimated peak memory \
+     {estimate} exceeds {limit}; use fewer cells (a larger [grid] cell_nm or a smaller \
+     fragment), solver precision = \"f32\" or method = \"time-marching\"{scalar}, or {remedy}"
 )]
 pub struct OverMemory {
     pub grid: String,
     pub method: String,
     pub precision: String,
+    /// The equation's name.
+    pub equation: &'static str,
+    /// `, equation = "helmholtz"` for a Maxwell run, else empty.
+    pub scalar: &'static str,
     pub estimate: String,
     pub limit: String,
     pub remedy: &'static str,
@@ -156,6 +175,11 @@ fn admit(scene: &Scene, limit: Option<MemoryLimit>, reserve: bool) -> Result<(),
                 Precision::F32 => "f32",
             }
             .to_string(),
+            equation: scene.solver.equation.name(),
+            scalar: match scene.solver.equation {
+                Equation::Maxwell => ", equation = \"helmholtz\" (a third of the memory)",
+                Equation::Helmholtz => "",
+            },
             estimate: human_bytes(bytes),
             limit,
             remedy,
@@ -252,10 +276,16 @@ mod tests {
 
     #[test]
     fn the_model_adds_the_pipeline_grids_to_the_solver_rates() {
-        assert_eq!(bytes_per_voxel(Method::TimeMarching, Precision::F64), 118.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64), 197.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32), 141.0);
-        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64), 453.0);
+        let h = Equation::Helmholtz;
+        assert_eq!(
+            bytes_per_voxel(Method::TimeMarching, Precision::F64, h),
+            118.0
+        );
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64, h), 197.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32, h), 141.0);
+        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64, h), 453.0);
+        let m = bytes_per_voxel(Method::BiCgStab, Precision::F32, Equation::Maxwell);
+        assert!((m - (3.2 * 109.0 + 32.0)).abs() < 1e-9, "{m}");
         assert_eq!(human_bytes(2.5e9), "2.5 GB");
         assert_eq!(human_bytes(2.05e5), "205 kB");
         assert_eq!(human_bytes(2.2e14), "220.0 TB");

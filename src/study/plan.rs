@@ -27,14 +27,17 @@
 //! spheres take a third of the applications of 450 nm ones); closed-form
 //! layers (no grid, [`ANALYTIC_SOLVE_S`] per solve) are left out of that
 //! ratio and out
-//! of the model. Geometry packing and output are not modelled
-//! (seconds per variant). The estimate is a guide (±2×), not a promise.
+//! of the model. A Maxwell variant is timed on the vector operator and
+//! pays its setup and applications once per polarisation solved
+//! ([`wave_solves`]: two for natural light). Geometry packing and output
+//! are not modelled (seconds per variant). The estimate is a guide (±2×),
+//! not a promise.
 
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Background, Scene, Surface};
+use crate::config::{Background, Equation, Linear, Scene, Surface};
 use crate::pipeline;
-use crate::solver::{Problem, System};
+use crate::solver::{Problem, System, Wave};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
@@ -67,6 +70,15 @@ pub fn default_applications(scene: &Scene) -> f64 {
         Background::Mean => MEAN_APPLICATIONS_SURFACE,
     }
 }
+/// Wave solves per incidence: one (Helmholtz), or one per polarisation
+/// solved (Maxwell; natural light is an s and a p solve).
+pub fn wave_solves(scene: &Scene) -> usize {
+    match scene.solver.equation {
+        Equation::Helmholtz => 1,
+        Equation::Maxwell => scene.solver.polarisation.components().len(),
+    }
+}
+
 /// How many finished results the background's measured rate counts as
 /// when it is averaged with them ([`calibrate`]).
 pub const PRIOR_RESULTS: f64 = 5.0;
@@ -92,8 +104,9 @@ pub struct GridTiming {
 /// The measured basis of the time model.
 #[derive(Debug, Clone)]
 pub struct Calibration {
-    /// Per distinct grid (nx, ny, nz) → its timing, scaled to that grid.
-    pub grids: BTreeMap<[usize; 3], GridTiming>,
+    /// Per distinct grid (nx, ny, nz) and equation → its timing, scaled to
+    /// that grid.
+    pub grids: BTreeMap<([usize; 3], Equation), GridTiming>,
     /// Factor on every variant's assumed applications per solve
     /// ([`default_applications`]) from the study's finished results.
     pub ratio: f64,
@@ -116,8 +129,9 @@ fn grid_of(s: &Scene) -> [usize; 3] {
     [s.grid.nx, s.grid.ny, s.grid.nz]
 }
 
-/// Time setup and one application on `grid` (reduced if large) and scale.
-pub fn time_grid(grid: [usize; 3]) -> GridTiming {
+/// Time setup and one application of `equation`'s operator on `grid`
+/// (reduced if large) and scale.
+pub fn time_grid(grid: [usize; 3], equation: Equation) -> GridTiming {
     let [nx, ny, nz] = grid;
     let (mut tx, mut ty) = (nx, ny);
     while tx * ty * nz > CALIBRATION_VOXELS && (tx > 4 || ty > 4) {
@@ -128,7 +142,7 @@ pub fn time_grid(grid: [usize; 3]) -> GridTiming {
         }
     }
     let timed = [tx, ty, nz];
-    let (setup, apply) = time_exact(timed);
+    let (setup, apply) = time_exact(timed, equation);
     let work = |x: usize, y: usize| (x * y * nz) as f64 * ((x * y) as f64).log2().max(1.0);
     let scale = work(nx, ny) / work(tx, ty);
     GridTiming {
@@ -139,8 +153,9 @@ pub fn time_grid(grid: [usize; 3]) -> GridTiming {
 }
 
 /// Median of three timings of the system setup and of one shifted operator
-/// application on a layer with grains of index 1.4 + 0.3i in the binder.
-fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
+/// application on a layer with grains of index 1.4 + 0.3i in the binder
+/// (Maxwell: s polarisation; p costs the same).
+fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
     let eb = 1.558f64.powi(2);
     let ep = C64::new(1.4, 0.3).powi(2);
     let eps = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
@@ -157,18 +172,28 @@ fn time_exact([nx, ny, nz]: [usize; 3]) -> (f64, f64) {
         30.0,
         0.0,
     );
+    let (wave, components) = match equation {
+        Equation::Helmholtz => (Wave::Scalar, 1),
+        Equation::Maxwell => (
+            Wave::Vector {
+                polarisation: Linear::S,
+                azimuth_deg: 0.0,
+            },
+            3,
+        ),
+    };
     let p = Problem {
         lattice,
         eps: &eps,
         eps_binder: eb,
-        wave: crate::solver::Wave::Scalar,
+        wave,
     };
     let mut setups = vec![];
     let mut applies = vec![];
-    let x = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
+    let x = Array3::from_shape_fn((components * nz, ny, nx), |(k, j, i)| {
         C64::new(((i + 2 * j) as f64 * 0.01).cos(), (k as f64 * 0.1).sin())
     });
-    let mut out = Array3::zeros((nz, ny, nx));
+    let mut out = Array3::zeros((components * nz, ny, nx));
     // The process's CPU time over its threads: what the operator costs on
     // this machine idle. Other jobs sharing the cores stretch the wall
     // clock (by 2× and more on a loaded 2-core machine) but not this.
@@ -219,7 +244,7 @@ pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
         for e in &s.entries {
             measured +=
                 (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
-            assumed += default_applications(&v.scene);
+            assumed += default_applications(&v.scene) * wave_solves(&v.scene) as f64;
         }
     }
     (assumed > 0.0).then(|| (measured / assumed, files))
@@ -229,8 +254,8 @@ pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
 pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
     let mut grids = BTreeMap::new();
     for v in variants {
-        let g = grid_of(&v.scene);
-        grids.entry(g).or_insert_with(|| time_grid(g));
+        let key = (grid_of(&v.scene), v.scene.solver.equation);
+        grids.entry(key).or_insert_with(|| time_grid(key.0, key.1));
     }
     let (ratio, applications_source) = match measured_ratio(finished) {
         Some((r, files)) => (
@@ -265,9 +290,11 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
     let seconds = if pipeline::RunPlan::of(scene).analytic {
         solves as f64 * ANALYTIC_SOLVE_S
     } else {
-        cal.grids.get(&grid).map_or(f64::NAN, |t| {
+        let key = (grid, scene.solver.equation);
+        cal.grids.get(&key).map_or(f64::NAN, |t| {
             let applications = default_applications(scene) * cal.ratio;
-            solves as f64 * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)
+            let waves = wave_solves(scene) as f64;
+            solves as f64 * waves * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)
         })
     };
     let bytes = pipeline::memory::estimate_bytes(scene);
@@ -332,9 +359,28 @@ mod tests {
         assert_eq!(default_applications(&binder), BINDER_APPLICATIONS);
     }
 
+    /// Natural light in Maxwell is two wave solves per incidence, one
+    /// polarisation one, Helmholtz one.
+    #[test]
+    fn maxwell_pays_per_polarisation() {
+        let scene = |polarisation: &str, equation: &str| {
+            let text = format!(
+                "[layer]\nthickness_nm = 500.0\nfragment_nm = [400.0, 400.0]\npvc = 0.3\n\
+                 [[pigment]]\nname = \"red\"\nmaterial = {{ builtin = \"red\" }}\n\
+                 diameter_nm = 100.0\n[illumination]\nwavelengths_nm = [550.0]\npolar_deg = [0.0]\n\
+                 polarisation = \"{polarisation}\"\n[solver]\nequation = \"{equation}\"\n\
+                 [grid]\ncell_nm = 25.0\n"
+            );
+            crate::config::parse_scene(std::path::Path::new("t.toml"), &text).unwrap()
+        };
+        assert_eq!(wave_solves(&scene("unpolarised", "helmholtz")), 1);
+        assert_eq!(wave_solves(&scene("unpolarised", "maxwell")), 2);
+        assert_eq!(wave_solves(&scene("p", "maxwell")), 1);
+    }
+
     #[test]
     fn large_grids_are_timed_reduced_and_scaled() {
-        let t = time_grid([64, 64, 200]);
+        let t = time_grid([64, 64, 200], Equation::Helmholtz);
         assert!(t.timed[0] * t.timed[1] * t.timed[2] <= CALIBRATION_VOXELS);
         assert_eq!(t.timed[2], 200);
         assert!(t.apply_s > 0.0 && t.setup_s > 0.0);

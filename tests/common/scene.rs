@@ -209,6 +209,10 @@ impl SceneToml {
         self.set("solver.precision", p)
     }
 
+    pub fn equation(self, e: &str) -> Self {
+        self.set("solver.equation", e)
+    }
+
     pub fn effective_medium_tolerance(self, tol: f64) -> Self {
         self.set("solver.effective_medium_tolerance", tol)
     }

@@ -249,9 +249,16 @@ fn check_reads_a_structure_file_as_a_run_would() {
             f.new_dataset_builder().with_data(a).create(*name).unwrap();
         }
     };
-    let check = || {
+    // A fresh output folder for the runs.
+    let out = dir.path().join("fresh");
+    let command = |verb: &str| {
+        let mut args = vec![verb, cfg.to_str().unwrap()];
+        if verb == "run" {
+            args.extend(["--output-dir", out.to_str().unwrap()]);
+        }
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_inksim"))
-            .args(["check", cfg.to_str().unwrap()])
+            .args(args)
+            .current_dir(dir.path())
             .output()
             .unwrap();
         (
@@ -259,6 +266,7 @@ fn check_reads_a_structure_file_as_a_run_would() {
             String::from_utf8_lossy(&o.stderr).into_owned(),
         )
     };
+    let check = || command("check");
     write(&[("eps_re", grid(2.4)), ("eps_im", grid(0.0))]);
     let (ok, err) = check();
     assert!(ok, "{err}");
@@ -299,6 +307,23 @@ fn check_reads_a_structure_file_as_a_run_would() {
             "{said}: {err}"
         );
         assert_eq!(err.trim().lines().count(), 1, "{err}");
+        // A run refuses with the same one line after its plan (timestamped
+        // progress), nothing after it, and leaves no folder or lock file.
+        assert!(!out.exists(), "{}", out.display());
+        let (ok, err) = command("run");
+        assert!(!ok, "{said}");
+        let errors: Vec<&str> = err
+            .lines()
+            .filter(|l| !l.starts_with(|c: char| c.is_ascii_digit()))
+            .collect();
+        assert_eq!(errors.len(), 1, "{said}: {err}");
+        assert!(err.trim_end().lines().last() == Some(errors[0]), "{err}");
+        assert!(errors[0].contains(said), "{said}: {err}");
+        assert!(
+            !out.exists(),
+            "{said}: a refused run left {}",
+            out.display()
+        );
     }
 }
 

@@ -17,11 +17,22 @@ pub fn run(
     if let Some(d) = output_dir {
         scene.output.dir = d;
     }
+    let (result_path, _) = inksim::pipeline::result_paths(&scene);
+    // A refusal leaves nothing new behind: the lock file, and the output
+    // folder if this run made it and nothing else is in it.
+    let fresh_folder = result_path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty() && !p.exists())
+        .map(PathBuf::from);
     // One writer per result: a second run of the same output refuses at
     // once (after the output paths are known to be usable).
-    inksim::pipeline::check_output_files(&scene).with_context(|| config.display().to_string())?;
-    let (result_path, _) = inksim::pipeline::result_paths(&scene);
-    let _lock = match OutputLock::try_acquire(&result_path)
+    if let Err(e) = inksim::pipeline::check_output_files(&scene) {
+        if let Some(f) = &fresh_folder {
+            let _ = std::fs::remove_dir(f);
+        }
+        return Err(e).with_context(|| config.display().to_string());
+    }
+    let lock = match OutputLock::try_acquire(&result_path)
         .with_context(|| config.display().to_string())?
     {
         Some(l) => l,
@@ -44,8 +55,18 @@ pub fn run(
          command again to start over",
         result_path.display()
     ));
-    let report = inksim::pipeline::run_with(&scene, false, memory)
-        .with_context(|| config.display().to_string())?;
+    let report = match inksim::pipeline::run_with(&scene, false, memory) {
+        Ok(r) => r,
+        Err(e) => {
+            lock.remove();
+            if let Some(f) = &fresh_folder {
+                // Only an empty folder goes (remove_dir refuses others).
+                let _ = std::fs::remove_dir(f);
+            }
+            return Err(e).with_context(|| config.display().to_string());
+        }
+    };
+    drop(lock);
     let worst = report
         .entries
         .iter()

@@ -7,9 +7,12 @@
 //! so it is released when the process ends, however it ends (a kill, a
 //! crash, a lost node); a lock file left behind by a dead process locks
 //! nothing. The file holds the holder's process id and host for messages.
-//! Lock files stay in the folder (removing one while another process waits
-//! on it would let two processes hold "the" lock at once); they are empty
-//! of results and hidden by their leading dot.
+//! A run that computed something leaves its lock file in the folder (empty
+//! of results, hidden by its leading dot); a refused run removes it
+//! ([`OutputLock::remove`]), so that a refusal leaves nothing behind. A lock
+//! is only held once the file it was taken on is still the one at the path
+//! (checked after locking, retried otherwise): a process that waited on a
+//! file another one then removed does not hold "the" lock beside a third.
 
 use crate::output::error::IoError;
 use std::fs;
@@ -40,22 +43,36 @@ impl OutputLock {
     /// Take the lock of `target` if no other process holds it: `Ok(None)`
     /// when one does. The folder is created if missing.
     pub fn try_acquire(target: &Path) -> Result<Option<OutputLock>, IoError> {
-        let (file, path) = open(target)?;
-        match file.try_lock() {
-            Ok(()) => Ok(Some(OutputLock::held(file, path)?)),
-            Err(fs::TryLockError::WouldBlock) => Ok(None),
-            Err(fs::TryLockError::Error(source)) => Err(IoError::File { path, source }),
+        loop {
+            let (file, path) = open(target)?;
+            match file.try_lock() {
+                Ok(()) if is_current(&file, &path) => {
+                    return Ok(Some(OutputLock::held(file, path)?))
+                }
+                Ok(()) => continue,
+                Err(fs::TryLockError::WouldBlock) => return Ok(None),
+                Err(fs::TryLockError::Error(source)) => return Err(IoError::File { path, source }),
+            }
         }
     }
 
     /// Take the lock of `target`, waiting for another process to release it.
     pub fn acquire(target: &Path) -> Result<OutputLock, IoError> {
-        let (file, path) = open(target)?;
-        file.lock().map_err(|source| IoError::File {
-            path: path.clone(),
-            source,
-        })?;
-        OutputLock::held(file, path)
+        loop {
+            let (file, path) = open(target)?;
+            file.lock().map_err(|source| IoError::File {
+                path: path.clone(),
+                source,
+            })?;
+            if is_current(&file, &path) {
+                return OutputLock::held(file, path);
+            }
+        }
+    }
+
+    /// Remove the lock file and let go: for a run that wrote nothing.
+    pub fn remove(self) {
+        let _ = fs::remove_file(&self.path);
     }
 
     fn held(mut file: fs::File, path: PathBuf) -> Result<OutputLock, IoError> {
@@ -112,6 +129,23 @@ fn open(target: &Path) -> Result<(fs::File, PathBuf), IoError> {
     Ok((file, path))
 }
 
+/// Whether `file` is still the file at `path` (not removed, not replaced).
+fn is_current(file: &fs::File, path: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (file.metadata(), fs::metadata(path)) {
+            (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (file, path);
+        true
+    }
+}
+
 fn holder_text() -> String {
     let host = fs::read_to_string("/proc/sys/kernel/hostname")
         .ok()
@@ -125,6 +159,25 @@ fn holder_text() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A removed lock file is gone, and a lock taken on a file that was
+    /// removed meanwhile is not held: the next taker gets the new file.
+    #[test]
+    fn a_removed_lock_leaves_nothing_and_stale_files_are_not_locks() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("a.h5");
+        let lock = OutputLock::try_acquire(&target).unwrap().expect("free");
+        let path = lock.path().to_path_buf();
+        lock.remove();
+        assert!(!path.exists());
+        // A file opened before its removal is not the lock any more.
+        let (stale, _) = open(&target).unwrap();
+        fs::remove_file(&path).unwrap();
+        assert!(!is_current(&stale, &path));
+        let (fresh, _) = open(&target).unwrap();
+        assert!(is_current(&fresh, &path));
+        assert!(!is_current(&stale, &path));
+    }
 
     #[test]
     fn a_second_holder_is_refused_until_the_first_lets_go() {

@@ -351,10 +351,21 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     for needle in [
         "f64 fields, maxwell",
         "190.6 GB",
+        "precision = \"f32\"",
         "equation = \"helmholtz\"",
     ] {
         assert!(err.contains(needle), "`{needle}` missing: {err}");
     }
+    // Only what the scene does not use yet is offered.
+    let f32 = huge_scene()
+        .equation("maxwell")
+        .precision("f32")
+        .tolerance(1e-5);
+    let f32 = f32.write(dir.path());
+    let (ok, _, err) = inksim(&["check", f32.to_str().unwrap(), "--max-memory", "1G"]);
+    assert!(!ok);
+    assert!(err.contains("f32 fields, maxwell"), "{err}");
+    assert!(!err.contains("precision = \"f32\""), "{err}");
     let small = SceneToml::tiny().write(dir.path());
     let (ok, out, _) = inksim(&["check", small.to_str().unwrap(), "--max-memory", "1G"]);
     assert!(ok, "20 × 20 × 20 fits in 1 GB: {out}");

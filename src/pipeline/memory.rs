@@ -67,7 +67,7 @@ pub fn estimate_bytes(scene: &Scene) -> f64 {
 #[error(
     "grid {grid}, method {method} ({precision} fields, {equation}): estimated peak memory \
      {estimate} exceeds {limit}; use fewer cells (a larger [grid] cell_nm or a smaller \
-     fragment), solver precision = \"f32\" or method = \"time-marching\"{scalar}, or {remedy}"
+     fragment){lighter}, or {remedy}"
 )]
 pub struct OverMemory {
     pub grid: String,
@@ -75,8 +75,9 @@ pub struct OverMemory {
     pub precision: String,
     /// The equation's name.
     pub equation: &'static str,
-    /// `, equation = "helmholtz"` for a Maxwell run, else empty.
-    pub scalar: &'static str,
+    /// The lighter settings the scene does not use yet (f32 fields,
+    /// time-marching, the scalar equation), each after a comma.
+    pub lighter: String,
     pub estimate: String,
     pub limit: String,
     pub remedy: &'static str,
@@ -176,10 +177,7 @@ fn admit(scene: &Scene, limit: Option<MemoryLimit>, reserve: bool) -> Result<(),
             }
             .to_string(),
             equation: scene.solver.equation.name(),
-            scalar: match scene.solver.equation {
-                Equation::Maxwell => ", equation = \"helmholtz\" (a third of the memory)",
-                Equation::Helmholtz => "",
-            },
+            lighter: lighter(scene),
             estimate: human_bytes(bytes),
             limit,
             remedy,
@@ -200,6 +198,22 @@ fn admit(scene: &Scene, limit: Option<MemoryLimit>, reserve: bool) -> Result<(),
         })?;
     }
     Ok(())
+}
+
+/// The settings that would lower a scene's memory and that it does not
+/// use yet, each as `, key = value`.
+fn lighter(scene: &Scene) -> String {
+    let mut s = String::new();
+    if scene.solver.precision == Precision::F64 {
+        s.push_str(", solver precision = \"f32\"");
+    }
+    if scene.solver.method != Method::TimeMarching {
+        s.push_str(", method = \"time-marching\"");
+    }
+    if scene.solver.equation == Equation::Maxwell {
+        s.push_str(", equation = \"helmholtz\" (a third of the memory)");
+    }
+    s
 }
 
 /// `800 kB`, `12 MB`, `3.4 GB`, `1.2 TB`.

@@ -128,9 +128,23 @@ class Result:
       ``input_hash``, ``seed``, ``created`` (UTC datetime), ``grid`` (nx, ny,
       nz), ``size_nm`` (Lx, Ly, H);
     - ``config``: the exact scene TOML text; ``plan``: the run's plan text;
-    - ``solves``: Dataset over ``solve`` (one per ``/solves/NNNN``);
+    - ``solves``: Dataset over ``solve`` (one per ``/solves/NNNN``): the
+      group attributes, with coordinates ``equation`` (``helmholtz`` |
+      ``maxwell``) and ``polarisation`` (``unpolarised``, ``s``, ``p``, or
+      ``none`` for the scalar wave; the keyword of the stored text). A
+      file written before these attributes were stored holds only
+      Helmholtz solves: ``equation`` reads ``helmholtz`` and
+      ``polarisation`` ``none`` there. ``total_reflectance``,
+      ``total_transmittance``, ``absorption``, ``energy_balance`` are the
+      solve's (for Maxwell's unpolarised light the mean of s and p); the
+      same with suffix ``_s`` / ``_p`` are each polarisation's own, NaN
+      where the solve has no such polarisation (Helmholtz, or a Maxwell
+      run of the other one);
     - ``orders``: Dataset over ``order``, every propagating order of every
-      solve (coordinate ``solve`` says which), ``orders_of(i)`` one solve's;
+      solve (coordinate ``solve`` says which), ``orders_of(i)`` one solve's:
+      ``orders_reflectance``, ``orders_transmittance`` and, per
+      polarisation, ``orders_reflectance_s`` / ``_p``,
+      ``orders_transmittance_s`` / ``_p`` (NaN where absent);
     - ``spectra``: reflectance, transmittance, absorption over
       (``wavelength_nm``, ``above_deg``);
     - ``appearance``: the whole ``/appearance`` group, ``brdf`` /
@@ -309,9 +323,26 @@ def open_result(path: "os.PathLike[str] | str") -> Result:
 
 # --- readers ---------------------------------------------------------------
 
-_SOLVE_COORDS = ["wavelength_nm", "polar_deg", "azimuth_deg", "side", "realisation", "method"]
-_SOLVE_VARS = ["total_reflectance", "total_transmittance", "absorption", "energy_balance",
-               "r00", "t00", "iterations", "operator_applications", "residual", "seconds", "note"]
+_SOLVE_COORDS = ["wavelength_nm", "polar_deg", "azimuth_deg", "side", "realisation", "method",
+                 "equation", "polarisation"]
+_TOTALS = ["total_reflectance", "total_transmittance", "absorption", "energy_balance"]
+# Maxwell: each polarisation solved, its totals beside their mean.
+_POLARISED_TOTALS = [f"{t}_{p}" for t in _TOTALS for p in ("s", "p")]
+_SOLVE_VARS = _TOTALS + _POLARISED_TOTALS + [
+    "r00", "t00", "iterations", "operator_applications", "residual", "seconds", "note"]
+_SOLVE_TEXT = ("side", "method", "note", "equation", "polarisation")
+# What a solve group without the attribute holds: files written before
+# ``equation`` and ``polarisation`` were stored are all scalar (Helmholtz).
+_SOLVE_TEXT_DEFAULT = {"equation": "helmholtz", "polarisation": "none"}
+_ORDER_EFFICIENCIES = ["orders_reflectance", "orders_transmittance"]
+_ORDER_VARS = _ORDER_EFFICIENCIES + [f"{n}_{p}" for n in _ORDER_EFFICIENCIES for p in ("s", "p")]
+
+
+def _polarisation_keyword(text: str) -> str:
+    """The keyword of a stored ``polarisation`` attribute: ``unpolarised``
+    (stored as ``unpolarised: the mean of s and p solved apart``), ``s``,
+    ``p``, or ``none`` (stored as ``none (scalar wave: …)``)."""
+    return text.split(":", 1)[0].split("(", 1)[0].strip()
 
 
 def _solve_groups(f: h5py.File) -> List[h5py.Group]:
@@ -331,7 +362,9 @@ def _read_solves(f: h5py.File) -> xr.Dataset:
             if k in ("r00", "t00"):
                 v = complex(v[0], v[1]) if v is not None else complex(np.nan, np.nan)
             elif v is None:
-                v = "" if k in ("side", "method", "note") else np.nan
+                v = _SOLVE_TEXT_DEFAULT.get(k, "") if k in _SOLVE_TEXT else np.nan
+            elif k == "polarisation":
+                v = _polarisation_keyword(v)
             cols[k].append(v)
         n_orders.append(g["orders_mn"].shape[0] if "orders_mn" in g else 0)
     n = len(groups)
@@ -340,7 +373,7 @@ def _read_solves(f: h5py.File) -> xr.Dataset:
     data = {}
     for k in _SOLVE_COORDS + _SOLVE_VARS:
         vals = cols[k]
-        if k in ("side", "method", "note"):
+        if k in _SOLVE_TEXT:
             arr = np.asarray(vals, dtype=object) if n else np.zeros(0, dtype=object)
         elif k in ("r00", "t00"):
             arr = np.asarray(vals, dtype=complex)
@@ -358,9 +391,8 @@ def _read_solves(f: h5py.File) -> xr.Dataset:
 
 def _read_orders(f: h5py.File) -> xr.Dataset:
     groups = _solve_groups(f)
-    parts: Dict[str, list] = {k: [] for k in ("solve", "m", "n", "orders_theta_deg", "orders_phi_deg",
-                                               "orders_reflectance", "orders_transmittance",
-                                               "wavelength_nm", "polar_deg", "side")}
+    parts: Dict[str, list] = {k: [] for k in ["solve", "m", "n", "orders_theta_deg", "orders_phi_deg"]
+                              + _ORDER_VARS + ["wavelength_nm", "polar_deg", "side"]}
     for i, g in enumerate(groups):
         if "orders_mn" not in g:
             continue
@@ -369,7 +401,7 @@ def _read_orders(f: h5py.File) -> xr.Dataset:
         parts["solve"].append(np.full(k, i))
         parts["m"].append(mn[:, 0])
         parts["n"].append(mn[:, 1])
-        for name in ("orders_theta_deg", "orders_phi_deg", "orders_reflectance", "orders_transmittance"):
+        for name in ["orders_theta_deg", "orders_phi_deg"] + _ORDER_VARS:
             parts[name].append(g[name][()] if name in g else np.full(k, np.nan))
         a = _attrs(g)
         parts["wavelength_nm"].append(np.full(k, a.get("wavelength_nm", np.nan)))
@@ -394,7 +426,7 @@ def _read_orders(f: h5py.File) -> xr.Dataset:
     }
     data = {
         name: xr.Variable(d, cat(name), attrs=_meta("solves/*/" + name))
-        for name in ("orders_reflectance", "orders_transmittance")
+        for name in _ORDER_VARS
     }
     return xr.Dataset(data, coords=coords)
 

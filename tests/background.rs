@@ -3,7 +3,7 @@
 //! and absorption to solver tolerance on random layers, absorbing and
 //! lossless (where its loss floor acts), and a homogeneous layer is its own
 //! background (solved by the first residual).
-use inksim::config::{Background, Method, Precision};
+use inksim::config::{Background, Method};
 use inksim::optics::farfield::efficiencies;
 use inksim::solver::{self, Controls, Problem, Solution, System};
 use ndarray::Array3;
@@ -11,16 +11,7 @@ use num_complex::Complex64 as C64;
 use rand::{Rng, SeedableRng};
 
 mod common;
-use common::layers::{in_binder, EPS_B};
-
-fn ctl(background: Background) -> Controls {
-    Controls {
-        tolerance: 1e-11,
-        max_iterations: 20000,
-        precision: Precision::F64,
-        background,
-    }
-}
+use common::layers::{in_binder, tight, EPS_B};
 
 /// Voxels of random ε: binder plus Re Δε in [−0.6, 1.6] and Im ε in
 /// [0, max_im].
@@ -56,10 +47,10 @@ fn mean_background_gives_the_binder_solution_on_random_layers() {
         let eps = random_layer((40, 12, 16), max_im, seed);
         let lat = Problem::lattice([16, 12, 40], size, 500.0, 30.0, 20.0);
         let p = in_binder(lat, &eps);
-        let binder = solver::solve(&p, Method::BiCgStab, &ctl(Background::Binder)).unwrap();
+        let binder = solver::solve(&p, Method::BiCgStab, &tight(Background::Binder)).unwrap();
         let fb = efficiencies(&binder);
         for method in [Method::BiCgStab, Method::Gmres, Method::Auto] {
-            let mean = solver::solve(&p, method, &ctl(Background::Mean)).unwrap();
+            let mean = solver::solve(&p, method, &tight(Background::Mean)).unwrap();
             assert!(
                 mean.record.note.contains("mean background"),
                 "{}",
@@ -116,8 +107,8 @@ fn a_homogeneous_layer_is_solved_by_its_own_background() {
     let eps = Array3::from_elem((100, 4, 4), eps_layer);
     let lat = Problem::lattice([4, 4, 100], [800.0, 800.0, 1000.0], 500.0, 50.0, 0.0);
     let p = in_binder(lat, &eps);
-    let binder = solver::solve(&p, Method::BiCgStab, &ctl(Background::Binder)).unwrap();
-    let mean = solver::solve(&p, Method::BiCgStab, &ctl(Background::Mean)).unwrap();
+    let binder = solver::solve(&p, Method::BiCgStab, &tight(Background::Binder)).unwrap();
+    let mean = solver::solve(&p, Method::BiCgStab, &tight(Background::Mean)).unwrap();
     // V' = 0: the first residual is zero, the answer is u_s itself.
     assert_eq!(mean.record.iterations, 0, "{}", mean.record.note);
     assert_eq!(mean.record.operator_applications, 1);
@@ -133,7 +124,7 @@ fn time_marching_keeps_the_cbs_shift_on_the_mean_background() {
     let p = in_binder(lat, &eps);
     let c = Controls {
         tolerance: 1e-8,
-        ..ctl(Background::Mean)
+        ..tight(Background::Mean)
     };
     let tm = solver::solve(&p, Method::TimeMarching, &c).unwrap();
     assert!(tm.record.note.contains("ε_r ="), "{}", tm.record.note);

@@ -3,24 +3,15 @@
 //! scalar solver for TE of a y-invariant structure, energy balance,
 //! reciprocity and rotation of a lattice of spheres, and thread-count
 //! independence.
-use inksim::config::{Background, Linear, Method, Precision};
+use inksim::config::{Background, Linear, Method};
 use inksim::optics::farfield::efficiencies;
-use inksim::solver::{self, airy::SlabField, Controls, Problem, Solution, Wave};
+use inksim::solver::{self, airy::SlabField, Problem, Solution, Wave};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
 mod common;
 use common::airy::{airy, airy_p};
-use common::layers::EPS_B;
-
-fn ctl(background: Background) -> Controls {
-    Controls {
-        tolerance: 1e-11,
-        max_iterations: 20000,
-        precision: Precision::F64,
-        background,
-    }
-}
+use common::layers::{tight, EPS_B};
 
 fn vector(polarisation: Linear, azimuth_deg: f64) -> Wave {
     Wave::Vector {
@@ -42,7 +33,7 @@ fn solve(
         eps_binder: EPS_B,
         wave,
     };
-    solver::solve(&p, method, &ctl(background)).expect("solve")
+    solver::solve(&p, method, &tight(background)).expect("solve")
 }
 
 /// The closed-form p slab (H_y with continuous H_y'/ε) against the

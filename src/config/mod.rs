@@ -304,6 +304,17 @@ pub struct SolverSpec {
     pub effective_medium_tolerance: f64,
 }
 
+impl SolverSpec {
+    /// The linear polarisations solved per incidence: `None` for the scalar
+    /// wave (one solve), else Maxwell's (natural light: s and p).
+    pub fn polarisations(&self) -> Option<&'static [Linear]> {
+        match self.equation {
+            Equation::Helmholtz => None,
+            Equation::Maxwell => Some(self.polarisation.components()),
+        }
+    }
+}
+
 /// One direction of incidence (from above, in vacuum).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Incidence {

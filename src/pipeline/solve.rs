@@ -6,7 +6,7 @@
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 
-use crate::config::{Equation, Incidence, Linear, Method, Scene};
+use crate::config::{Incidence, Linear, Method, Scene};
 use crate::optics::farfield::{self, Efficiencies, Side, SolveEntry};
 use crate::output::progress::Progress;
 use crate::raster::structure::EpsGrid;
@@ -236,12 +236,9 @@ fn solve_balanced(
 /// The problems one incidence is solved as: the scalar wave, or Maxwell's
 /// for each linear polarisation the scene asks for (unpolarised: s and p).
 fn waves(scene: &Scene, inc: &Incidence) -> Vec<Wave> {
-    match scene.solver.equation {
-        Equation::Helmholtz => vec![Wave::Scalar],
-        Equation::Maxwell => scene
-            .solver
-            .polarisation
-            .components()
+    match scene.solver.polarisations() {
+        None => vec![Wave::Scalar],
+        Some(linear) => linear
             .iter()
             .map(|&polarisation| Wave::Vector {
                 polarisation,

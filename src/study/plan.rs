@@ -73,10 +73,7 @@ pub fn default_applications(scene: &Scene) -> f64 {
 /// Wave solves per incidence: one (Helmholtz), or one per polarisation
 /// solved (Maxwell; natural light is an s and a p solve).
 pub fn wave_solves(scene: &Scene) -> usize {
-    match scene.solver.equation {
-        Equation::Helmholtz => 1,
-        Equation::Maxwell => scene.solver.polarisation.components().len(),
-    }
+    scene.solver.polarisations().map_or(1, <[Linear]>::len)
 }
 
 /// How many finished results the background's measured rate counts as

@@ -1,9 +1,10 @@
 //! A layer of one pigment in the binder, from packing to ε and to the
 //! problem the solver takes, and a brute-force check of particle gaps.
 
+use inksim::config::{Background, Precision};
 use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
 use inksim::raster::{rasterize, Grid};
-use inksim::solver::{Lattice, Problem};
+use inksim::solver::{Controls, Lattice, Problem};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 
@@ -17,6 +18,17 @@ pub fn in_binder(lattice: Lattice, eps: &Array3<C64>) -> Problem<'_> {
         eps,
         eps_binder: EPS_B,
         wave: inksim::solver::Wave::Scalar,
+    }
+}
+
+/// Controls tight enough to compare against closed forms: residual 1e-11,
+/// f64 fields, on `background`.
+pub fn tight(background: Background) -> Controls {
+    Controls {
+        tolerance: 1e-11,
+        max_iterations: 20000,
+        precision: Precision::F64,
+        background,
     }
 }
 

@@ -41,6 +41,19 @@ pub struct Efficiencies {
     pub energy_balance: f64,
 }
 
+impl Efficiencies {
+    /// The totals by their stored names: reflectance, transmittance,
+    /// absorption and the energy balance.
+    pub fn totals(&self) -> [(&'static str, f64); 4] {
+        [
+            ("total_reflectance", self.total_reflectance),
+            ("total_transmittance", self.total_transmittance),
+            ("absorption", self.absorption),
+            ("energy_balance", self.energy_balance),
+        ]
+    }
+}
+
 /// Which face of the layer the light comes from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Side {

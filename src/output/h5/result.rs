@@ -326,13 +326,12 @@ fn write_entry(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> 
         ("wavelength_nm", e.wavelength_nm),
         ("polar_deg", e.incidence.polar_deg),
         ("azimuth_deg", e.incidence.azimuth_deg),
-        ("total_reflectance", eff.total_reflectance),
-        ("total_transmittance", eff.total_transmittance),
-        ("absorption", eff.absorption),
-        ("energy_balance", eff.energy_balance),
         ("residual", rec.residual),
         ("seconds", rec.seconds),
-    ] {
+    ]
+    .into_iter()
+    .chain(eff.totals())
+    {
         write_scalar_attr(g, name, v)?;
     }
     g.new_attr_builder()
@@ -431,12 +430,7 @@ fn write_polarised(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<
     )?;
     for (pol, eff) in &e.polarised {
         let p = pol.name();
-        for (name, v) in [
-            ("total_reflectance", eff.total_reflectance),
-            ("total_transmittance", eff.total_transmittance),
-            ("absorption", eff.absorption),
-            ("energy_balance", eff.energy_balance),
-        ] {
+        for (name, v) in eff.totals() {
             write_scalar_attr(g, &format!("{name}_{p}"), v)?;
         }
         for (name, values, what) in [

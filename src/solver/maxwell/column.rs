@@ -33,6 +33,7 @@
 //! continuous field. Scratch ([`ColumnScratch`]) is the caller's.
 
 use crate::solver::green::{self, Slab};
+use crate::solver::lattice::Lattice;
 use num_complex::Complex64 as C64;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
@@ -63,6 +64,17 @@ pub struct Harmonic {
 }
 
 impl Harmonic {
+    /// The harmonic at FFT indices (ix, iy) of `lat`, binder `eps_b` inside.
+    pub fn at(lat: &Lattice, eps_b: f64, ix: usize, iy: usize) -> Harmonic {
+        let [kx, ky] = lat.kappa(ix, iy);
+        Harmonic {
+            slab: lat.slab(),
+            eps_b: C64::new(eps_b, 0.0),
+            kappa: kx.hypot(ky),
+            beta: lat.beta(ix, iy),
+        }
+    }
+
     pub(super) fn gamma2(&self) -> C64 {
         let k0 = self.slab.k0;
         k0 * k0 * self.eps_b - self.kappa * self.kappa

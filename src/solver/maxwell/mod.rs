@@ -126,17 +126,11 @@ impl VectorOperator {
     /// ê_κ and the harmonic's constants at FFT indices (ix, iy).
     fn harmonic(&self, ix: usize, iy: usize) -> ([f64; 2], Harmonic) {
         let [kx, ky] = self.lat.kappa(ix, iy);
-        let kappa = kx.hypot(ky);
-        let unit = if kappa > 1e-12 * self.lat.k0 {
-            [kx / kappa, ky / kappa]
+        let h = Harmonic::at(&self.lat, self.eps_b, ix, iy);
+        let unit = if h.kappa > 1e-12 * self.lat.k0 {
+            [kx / h.kappa, ky / h.kappa]
         } else {
             self.reference
-        };
-        let h = Harmonic {
-            slab: self.lat.slab(),
-            eps_b: C64::new(self.eps_b, 0.0),
-            kappa,
-            beta: self.lat.beta(ix, iy),
         };
         (unit, h)
     }

@@ -142,13 +142,7 @@ impl TmTable {
         for ix in 0..nx {
             for iy in 0..ny {
                 let col = &mut full[iy * cells..(iy + 1) * cells];
-                let [kx, ky] = lat.kappa(ix, iy);
-                let h = Harmonic {
-                    slab,
-                    eps_b: C64::new(eps_b, 0.0),
-                    kappa: kx.hypot(ky),
-                    beta: lat.beta(ix, iy),
-                };
+                let h = Harmonic::at(lat, eps_b, ix, iy);
                 let g2 = h.gamma2();
                 if green::is_small_gamma(&slab, g2) {
                     dense.push(ix * ny + iy);

@@ -58,7 +58,7 @@ fn main() {
     let wave = match args.get(6).map(String::as_str) {
         None | Some("helmholtz") => inksim::solver::Wave::Scalar,
         Some("maxwell") => inksim::solver::Wave::Vector {
-            polarisation: inksim::config::Linear::S,
+            polarisation: inksim::config::Linear::S.into(),
             azimuth_deg: 0.0,
         },
         Some(e) => panic!("unknown equation {e}"),

@@ -838,3 +838,51 @@ fn equation_and_polarisation_are_checked() {
     assert_eq!(key, "appearance.baseline");
     assert!(msg.contains("scalar"), "{msg}");
 }
+
+/// `solver.natural_light`: auto by default (random-phase for an ensemble of
+/// generated layers, two solves for one realisation); random-phase only for
+/// unpolarised light in Maxwell's equations on a random layer.
+#[test]
+fn natural_light_is_checked() {
+    use inksim::config::NaturalLight;
+    let maxwell = || base().set("solver.equation", "maxwell");
+    let s = parse(&maxwell().realisations(1)).unwrap();
+    assert_eq!(s.solver.natural_light, NaturalLight::TwoSolves);
+    assert_eq!(s.solver.solves_per_incidence(), 2);
+    let s = parse(&maxwell().realisations(4)).unwrap();
+    assert!(s.solver.random_phase());
+    assert_eq!(s.solver.solves_per_incidence(), 1);
+    let s = parse(&maxwell().raw("realisations", "{ target_de00 = 0.5, max = 8 }")).unwrap();
+    assert!(s.solver.random_phase());
+    let s = parse(
+        &maxwell()
+            .realisations(4)
+            .set("solver.natural_light", "two-solves"),
+    )
+    .unwrap();
+    assert_eq!(s.solver.solves_per_incidence(), 2);
+    let s = parse(
+        &maxwell()
+            .realisations(4)
+            .set("illumination.polarisation", "p"),
+    )
+    .unwrap();
+    assert!(!s.solver.random_phase());
+    let s = parse(&maxwell().set("solver.natural_light", "random-phase")).unwrap();
+    assert!(s.solver.random_phase());
+    assert_eq!(s.solver.solves_per_incidence(), 1);
+    for scene in [
+        base().set("solver.natural_light", "random-phase"),
+        maxwell()
+            .set("illumination.polarisation", "s")
+            .set("solver.natural_light", "random-phase"),
+        SceneToml::structure(&[common::scene::PrimitiveToml::slab(0.0, 500.0).index(1.6, 0.0)])
+            .set("solver.equation", "maxwell")
+            .set("solver.natural_light", "random-phase"),
+    ] {
+        let (key, msg) = invalid(&scene);
+        assert_eq!(key, "solver.natural_light", "{msg}");
+    }
+    let err = parse(&maxwell().set("solver.natural_light", "alternate")).unwrap_err();
+    assert!(err.to_string().contains("random-phase"), "{err}");
+}

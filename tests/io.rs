@@ -46,6 +46,7 @@ fn entries() -> Vec<SolveEntry> {
                 ],
                 r00: Complex64::new(-0.123_456_789, 0.987_654_321),
                 t00: Complex64::new(0.5, -1.0e-12),
+                specular_p: None,
                 total_reflectance: 0.041_234_667_890_123,
                 total_transmittance: 0.812_378_978_901_234,
                 absorption: 0.146_386_353_208_643,
@@ -60,6 +61,7 @@ fn entries() -> Vec<SolveEntry> {
                 note: "born: estimated contraction 0.61 — OK".into(),
             },
             polarised: Vec::new(),
+            random_phase_deg: None,
         },
         SolveEntry {
             wavelength_nm: 632.8,
@@ -74,6 +76,7 @@ fn entries() -> Vec<SolveEntry> {
                 orders: vec![],
                 r00: Complex64::new(0.0, 0.0),
                 t00: Complex64::new(1.0, 0.0),
+                specular_p: None,
                 total_reflectance: 0.0,
                 total_transmittance: 1.0,
                 absorption: 0.0,
@@ -88,6 +91,7 @@ fn entries() -> Vec<SolveEntry> {
                 note: String::new(),
             },
             polarised: Vec::new(),
+            random_phase_deg: None,
         },
         SolveEntry {
             wavelength_nm: 700.000_000_000_1,
@@ -102,6 +106,7 @@ fn entries() -> Vec<SolveEntry> {
                 orders: vec![order(0, 0, 60.0, 180.0, 0.3, 0.6)],
                 r00: Complex64::new(0.1, 0.2),
                 t00: Complex64::new(0.3, 0.4),
+                specular_p: None,
                 total_reflectance: 0.3,
                 total_transmittance: 0.6,
                 absorption: 0.1,
@@ -116,6 +121,7 @@ fn entries() -> Vec<SolveEntry> {
                 note: "fallback after Born diverged\nsecond line".into(),
             },
             polarised: Vec::new(),
+            random_phase_deg: None,
         },
     ]
 }

@@ -15,7 +15,7 @@ use common::layers::{tight, EPS_B};
 
 fn vector(polarisation: Linear, azimuth_deg: f64) -> Wave {
     Wave::Vector {
-        polarisation,
+        polarisation: polarisation.into(),
         azimuth_deg,
     }
 }
@@ -312,4 +312,100 @@ fn threads_do_not_change_the_answer() {
     let two = common::threads::on_threads(2, run);
     assert_eq!(one.1.to_bits(), two.1.to_bits());
     assert!(one.0.iter().zip(two.0.iter()).all(|(a, b)| a == b));
+}
+
+/// Natural light from one mixed state `(ŝ + e^{iφ} p̂)/√2`: every order's
+/// power is the mean of the s and p solves plus a cross term linear in
+/// `e^{iφ}`, so the mean over φ = 0, π/2, π, 3π/2 is natural light to
+/// solver tolerance (while one phase alone is not: the cross term is there
+/// to cancel), and the co-polarised specular amplitudes per unit incident
+/// amplitude average to the s and p solves' own. The homogeneous slab
+/// converts no polarisation: one phase alone is exact there.
+#[test]
+fn random_phase_states_average_to_natural_light() {
+    let (n, nz) = (10, 10);
+    let eps = sphere_cell(n, nz, C64::new(2.9, 0.6));
+    let lat = Problem::lattice([n, n, nz], [400.0, 400.0, 400.0], 550.0, 35.0, 20.0);
+    let mixed = |phi: f64| Wave::Vector {
+        polarisation: solver::Jones::phased(phi),
+        azimuth_deg: 20.0,
+    };
+    let s = solve(
+        lat,
+        &eps,
+        vector(Linear::S, 20.0),
+        Method::BiCgStab,
+        Background::Mean,
+    );
+    let p = solve(
+        lat,
+        &eps,
+        vector(Linear::P, 20.0),
+        Method::BiCgStab,
+        Background::Mean,
+    );
+    let (fs, fp) = (efficiencies(&s), efficiencies(&p));
+    let natural: Vec<f64> = fs
+        .orders
+        .iter()
+        .zip(&fp.orders)
+        .map(|(a, b)| 0.5 * (a.reflectance + b.reflectance))
+        .collect();
+    let mut mean = vec![0.0; natural.len()];
+    let (mut absorption, mut r_s, mut r_p) = (0.0, C64::new(0.0, 0.0), C64::new(0.0, 0.0));
+    let mut largest_cross: f64 = 0.0;
+    for k in 0..4 {
+        let sol = solve(
+            lat,
+            &eps,
+            mixed(k as f64 * std::f64::consts::FRAC_PI_2),
+            Method::BiCgStab,
+            Background::Mean,
+        );
+        let f = efficiencies(&sol);
+        assert!(
+            f.energy_balance.abs() < 1e-7,
+            "balance {}",
+            f.energy_balance
+        );
+        for (i, o) in f.orders.iter().enumerate() {
+            mean[i] += o.reflectance / 4.0;
+            largest_cross = largest_cross.max((o.reflectance - natural[i]).abs());
+        }
+        absorption += f.absorption / 4.0;
+        let [[rs, _], [rp, _]] = f.specular_amplitudes()[..] else {
+            panic!("a mixed state keeps both co-polarised amplitudes")
+        };
+        r_s += rs / 4.0;
+        r_p += rp / 4.0;
+    }
+    assert!(
+        largest_cross > 1e-5,
+        "no cross term to cancel: {largest_cross:e}"
+    );
+    for (i, (m, nat)) in mean.iter().zip(&natural).enumerate() {
+        assert!((m - nat).abs() < 1e-8, "order {i}: {m} against {nat}");
+    }
+    assert!((absorption - 0.5 * (fs.absorption + fp.absorption)).abs() < 1e-8);
+    assert!((r_s - fs.r00).norm() < 1e-7 && (r_p - fp.r00).norm() < 1e-7);
+
+    let slab = Array3::from_elem((8, 2, 2), C64::new(1.87, 0.84));
+    let lat = Problem::lattice([2, 2, 8], [400.0, 400.0, 600.0], 550.0, 50.0, 0.0);
+    let kap = lat.q[0].hypot(lat.q[1]);
+    let (rs, _) = airy(lat.k0, C64::new(1.87, 0.84), kap, 600.0);
+    let (rp, _) = airy_p(lat.k0, C64::new(1.87, 0.84), kap, 600.0);
+    let f = efficiencies(&solve(
+        lat,
+        &slab,
+        mixed(1.1),
+        Method::Airy,
+        Background::Mean,
+    ));
+    let r = 0.5 * (rs.norm_sqr() + rp.norm_sqr());
+    assert!(
+        (f.total_reflectance - r).abs() < 1e-12,
+        "slab R {} against {r}",
+        f.total_reflectance
+    );
+    assert!((f.specular_power().0 - r).abs() < 1e-12);
 }

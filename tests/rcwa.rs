@@ -379,7 +379,7 @@ fn lamellar_grating_matches_rcwa_per_order_in_p() {
     let (root, cases) = fixture_at("lamellar_rcwa_p.json");
     assert!(root.get("airy_check").num("max_error") < 1e-9);
     let wave = inksim::solver::Wave::Vector {
-        polarisation: inksim::config::Linear::P,
+        polarisation: inksim::config::Linear::P.into(),
         azimuth_deg: 0.0,
     };
     for c in cases.iter().filter(|c| c.period < 2000.0) {

@@ -74,6 +74,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
             orders,
             r00: Complex64::new(0.2, 0.0),
             t00: Complex64::new(0.9, 0.0),
+            specular_p: None,
             total_reflectance: 0.05,
             total_transmittance: 0.9,
             absorption: 0.05,
@@ -88,6 +89,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
             note: String::new(),
         },
         polarised: Vec::new(),
+        random_phase_deg: None,
     }
 }
 

@@ -207,3 +207,50 @@ def test_helmholtz_without_the_attributes(tiny, tmp_path):
             del g.attrs["equation"]
             del g.attrs["polarisation"]
     _helmholtz_reads_as_scalar(inksim.open_result(p))
+
+
+@pytest.fixture(scope="module")
+def ensemble(binary, tmp_path_factory):
+    """The scene with two realisations: natural light by default as one
+    random-phase solve per incidence, and as s and p solved apart."""
+    d = tmp_path_factory.mktemp("ensemble")
+    out = {}
+    for how in ("auto", "two-solves"):
+        text = MAXWELL_SCENE.format(polarisation="unpolarised").replace(
+            "seed = 3", "seed = 3\nrealisations = 2").replace(
+            'equation = "maxwell"', f'equation = "maxwell"\nnatural_light = "{how}"').replace(
+            'name = "maxwell-unpolarised"', f'name = "ensemble-{how}"')
+        cfg = d / f"ensemble-{how}.toml"
+        cfg.write_text(text, encoding="utf-8")
+        out[how] = inksim.run(cfg, d / "out").open()
+    return out
+
+
+def test_random_phase_natural_light(ensemble):
+    """One solve per incidence at a relative phase of its own; its powers
+    are natural light's plus an s-p cross term bounded by Cauchy-Schwarz
+    (|cross| <= sqrt(X_s X_p)) against the same layers solved in s and p."""
+    r, two = ensemble["auto"], ensemble["two-solves"]
+    s, t = r.solves, two.solves
+    assert s.sizes["solve"] == t.sizes["solve"] == 4
+    assert set(s["polarisation"].values) == {"unpolarised"}
+    assert set(s["equation"].values) == {"maxwell"}
+    phase = s["random_phase_deg"].values
+    assert s["random_phase_deg"].attrs["units"] == "deg"
+    assert np.all((phase >= -180) & (phase <= 180)) and len(set(phase)) == 4
+    assert np.all(np.isnan(t["random_phase_deg"].values))
+    for name in SUFFIXED:
+        assert np.all(np.isnan(s[name].values)), name
+    np.testing.assert_allclose(
+        s["total_reflectance"] + s["total_transmittance"] + s["absorption"], 1.0, atol=1e-6)
+    # half the solves: each incidence's iterations are one solve's
+    assert s["iterations"].sum() < 0.75 * t["iterations"].sum()
+    np.testing.assert_array_equal(s["realisation"], t["realisation"])
+    np.testing.assert_array_equal(s["polar_deg"], t["polar_deg"])
+    largest = 0.0
+    for name in ("total_reflectance", "total_transmittance", "absorption"):
+        xs, xp = t[name + "_s"].values, t[name + "_p"].values
+        cross = s[name].values - 0.5 * (xs + xp)
+        assert np.all(np.abs(cross) <= np.sqrt(xs * xp) + 1e-6), name
+        largest = max(largest, float(np.abs(cross).max()))
+    assert largest > 1e-6  # the phase is really there to average out

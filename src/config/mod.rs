@@ -26,7 +26,7 @@ pub use stack::{
     Stack, StackCoupling, StackLayer, DEFAULT_ESCAPE_DIRECTIONS, DEFAULT_TRAPPED_DIRECTIONS,
     MAX_STACK_DIRECTIONS, MAX_STACK_LAYERS, MAX_YULE_NIELSEN_N,
 };
-pub use wave::{Equation, Linear, Polarisation};
+pub use wave::{Equation, Linear, NaturalLight, Polarisation};
 
 /// Largest total pigment volume concentration a scene may ask for: what the
 /// first-order dynamics packer reaches (spheres to ~55 %, rice grains 50 %).
@@ -290,6 +290,8 @@ pub struct SolverSpec {
     /// The incident light's polarisation (Maxwell only; the scalar wave is
     /// always `Unpolarised`, which it treats as s).
     pub polarisation: Polarisation,
+    /// How natural light is solved for (Maxwell, unpolarised).
+    pub natural_light: NaturalLight,
     pub method: Method,
     /// Target relative residual.
     pub tolerance: f64,
@@ -311,6 +313,24 @@ impl SolverSpec {
         match self.equation {
             Equation::Helmholtz => None,
             Equation::Maxwell => Some(self.polarisation.components()),
+        }
+    }
+
+    /// Whether natural light is solved once per incidence at a random
+    /// relative phase of s and p (Maxwell, unpolarised, `random-phase`).
+    pub fn random_phase(&self) -> bool {
+        self.equation == Equation::Maxwell
+            && self.polarisation == Polarisation::Unpolarised
+            && self.natural_light == NaturalLight::RandomPhase
+    }
+
+    /// Wave solves per incidence of a grid layer: 1 for the scalar wave and
+    /// random-phase natural light, else one per linear polarisation.
+    pub fn solves_per_incidence(&self) -> usize {
+        if self.random_phase() {
+            1
+        } else {
+            self.polarisations().map_or(1, <[Linear]>::len)
         }
     }
 }

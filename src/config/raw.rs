@@ -322,6 +322,17 @@ pub struct RawSolver {
     pub precision: Option<RawPrecision>,
     pub background: Option<RawBackground>,
     pub effective_medium_tolerance: Option<f64>,
+    /// `"auto"`, `"two-solves"` or `"random-phase"` (Maxwell's natural
+    /// light).
+    pub natural_light: Option<RawNaturalLight>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawNaturalLight {
+    Auto,
+    TwoSolves,
+    RandomPhase,
 }
 
 #[derive(Debug, Clone, Copy, Deserialize)]

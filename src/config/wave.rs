@@ -72,3 +72,30 @@ impl Polarisation {
         }
     }
 }
+
+/// How natural light is solved for in Maxwell's equations. The scene's
+/// `"auto"` (the default) is random-phase for an ensemble of random
+/// layers (generated grains, two realisations or more, or a target
+/// uncertainty) and two solves otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NaturalLight {
+    /// s and p solved apart and their powers averaged: exact for every
+    /// realisation, two solves per incidence.
+    #[default]
+    TwoSolves,
+    /// One solve per incidence, lit by `(ŝ + e^{iφ} p̂)/√2` with a phase φ
+    /// drawn per realisation and solve: its powers are natural light's plus
+    /// a cross term between s and p that averages out over the ensemble
+    /// like the grains' own randomness (and is counted in the colours'
+    /// standard errors). For random layers only.
+    RandomPhase,
+}
+
+impl NaturalLight {
+    pub fn name(self) -> &'static str {
+        match self {
+            NaturalLight::TwoSolves => "two-solves",
+            NaturalLight::RandomPhase => "random-phase",
+        }
+    }
+}

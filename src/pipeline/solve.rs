@@ -6,13 +6,15 @@
 use ndarray::{s, Array3};
 use num_complex::Complex64 as C64;
 
-use crate::config::{Incidence, Linear, Method, Scene};
+use crate::config::{Incidence, Method, Scene};
 use crate::optics::farfield::{self, Efficiencies, Side, SolveEntry};
 use crate::output::progress::Progress;
 use crate::raster::structure::EpsGrid;
 use crate::raster::{Grid, Raster};
 use crate::solver::heartbeat::{self, Beat};
-use crate::solver::{self, Controls, Problem, SolveRecord, Wave};
+use crate::solver::{self, Controls, Jones, Problem, SolveRecord, Wave};
+use rand::{RngCore, SeedableRng};
+use rand_xoshiro::SplitMix64;
 
 use super::eps::{fraction_eps, mean_eps};
 use super::plan::{incidences, RunPlan};
@@ -118,7 +120,11 @@ pub fn solve_layer(
                 (Side::Below, Some(f)) => f,
                 _ => &eps,
             };
-            let waves = waves(scene, inc);
+            let phase = plan
+                .seeds
+                .get(realisation)
+                .map(|&seed| random_phase(seed, lambda, inc, *side));
+            let waves = waves(scene, inc, phase);
             // A long solve reports where it stands (solver::heartbeat).
             let beat = |b: Beat| {
                 progress.log(&format!(
@@ -160,17 +166,7 @@ pub fn solve_layer(
                     )?;
                 parts.push((wave, efficiencies, record));
             }
-            let (efficiencies, record, polarised) = combine(parts);
-            let entry = SolveEntry {
-                wavelength_nm: lambda,
-                incidence: *inc,
-                side: *side,
-                realisation,
-                layer: 0,
-                efficiencies,
-                record,
-                polarised,
-            };
+            let entry = combine(parts, lambda, inc, *side, realisation);
             log_solve(progress, &entry);
             entries.push(entry);
         }
@@ -234,38 +230,67 @@ fn solve_balanced(
 }
 
 /// The problems one incidence is solved as: the scalar wave, or Maxwell's
-/// for each linear polarisation the scene asks for (unpolarised: s and p).
-fn waves(scene: &Scene, inc: &Incidence) -> Vec<Wave> {
-    match scene.solver.polarisations() {
-        None => vec![Wave::Scalar],
-        Some(linear) => linear
-            .iter()
-            .map(|&polarisation| Wave::Vector {
-                polarisation,
-                azimuth_deg: inc.azimuth_deg,
-            })
-            .collect(),
+/// for each linear polarisation the scene asks for (unpolarised: s and p),
+/// or, for random-phase natural light on a grid layer (`phase` given), one
+/// mixed state `(ŝ + e^{iφ} p̂)/√2`.
+fn waves(scene: &Scene, inc: &Incidence, phase: Option<f64>) -> Vec<Wave> {
+    let vector = |polarisation: Jones| Wave::Vector {
+        polarisation,
+        azimuth_deg: inc.azimuth_deg,
+    };
+    match (scene.solver.polarisations(), phase) {
+        (None, _) => vec![Wave::Scalar],
+        (Some(_), Some(phi)) if scene.solver.random_phase() => vec![vector(Jones::phased(phi))],
+        (Some(linear), _) => linear.iter().map(|&l| vector(l.into())).collect(),
     }
 }
 
-/// One incidence's answer from its solves: the scalar solve as it is; for
-/// Maxwell the incoherent mean over the polarisations solved (powers, not
-/// amplitudes), the records added up, and each polarisation's own
-/// efficiencies kept.
-#[allow(clippy::type_complexity)]
+/// The relative phase of s and p for one random-phase solve, uniform in
+/// [0, 2π): a hash of the realisation's seed, the wavelength, the
+/// incidence and the side, so that it is the same for any thread count and
+/// independent between solves.
+fn random_phase(seed: u64, lambda: f64, inc: &Incidence, side: Side) -> f64 {
+    let mut h = seed;
+    for v in [
+        lambda.to_bits(),
+        inc.polar_deg.to_bits(),
+        inc.azimuth_deg.to_bits(),
+        side as u64,
+    ] {
+        h = SplitMix64::seed_from_u64(h ^ v).next_u64();
+    }
+    (h >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU
+}
+
+/// One incidence's entry from its solves: the scalar solve as it is; for
+/// Maxwell the incoherent mean over the linear polarisations solved
+/// (powers, not amplitudes), the records added up, and each polarisation's
+/// own efficiencies kept; a mixed (random-phase) state's solve as it is,
+/// with no per-polarisation efficiencies.
 fn combine(
     parts: Vec<(Wave, Efficiencies, SolveRecord)>,
-) -> (Efficiencies, SolveRecord, Vec<(Linear, Efficiencies)>) {
+    wavelength_nm: f64,
+    inc: &Incidence,
+    side: Side,
+    realisation: usize,
+) -> SolveEntry {
     let mut record: Option<SolveRecord> = None;
     let mut polarised = Vec::new();
     let mut notes = Vec::new();
-    let mut scalar = None;
+    let (mut single, mut random_phase_deg) = (None, None);
     for (wave, eff, rec) in parts {
         match wave {
-            Wave::Scalar => scalar = Some(eff),
+            Wave::Scalar => single = Some(eff),
             Wave::Vector { polarisation, .. } => {
                 notes.push(format!("{}: {}", polarisation.name(), rec.note));
-                polarised.push((polarisation, eff));
+                match polarisation.as_linear() {
+                    Some(l) => polarised.push((l, eff)),
+                    None => {
+                        single = Some(eff);
+                        random_phase_deg =
+                            Some((polarisation.p / polarisation.s).arg().to_degrees());
+                    }
+                }
             }
         }
         match record.as_mut() {
@@ -277,12 +302,32 @@ fn combine(
         }
     }
     let mut record = record.expect("at least one solve per incidence");
-    match scalar {
-        Some(eff) => (eff, record, polarised),
-        None => {
-            record.note = format!("Maxwell, {}", notes.join("; "));
-            (farfield::polarisation_mean(&polarised), record, polarised)
-        }
+    if !notes.is_empty() {
+        let how = if single.is_some() {
+            "natural light as one random-phase state"
+        } else {
+            "natural light as s and p"
+        };
+        record.note = if polarised.len() == 1 {
+            format!("Maxwell, {}", notes.join("; "))
+        } else {
+            format!("Maxwell, {how}, {}", notes.join("; "))
+        };
+    }
+    let efficiencies = match single {
+        Some(eff) => eff,
+        None => farfield::polarisation_mean(&polarised),
+    };
+    SolveEntry {
+        wavelength_nm,
+        incidence: *inc,
+        side,
+        realisation,
+        layer: 0,
+        efficiencies,
+        record,
+        polarised,
+        random_phase_deg,
     }
 }
 
@@ -323,7 +368,7 @@ pub fn solve_analytic(
             let lattice =
                 Problem::lattice([1, 1, 1], size, lambda / outside.sqrt(), inc.polar_deg, 0.0);
             let mut parts = Vec::new();
-            for wave in waves(scene, inc) {
+            for wave in waves(scene, inc, None) {
                 let p = Problem {
                     lattice,
                     eps: &mean,
@@ -341,17 +386,7 @@ pub fn solve_analytic(
                 let eff = farfield::slab_efficiencies(&sol.slab_response(), inc);
                 parts.push((wave, eff, sol.record));
             }
-            let (efficiencies, record, polarised) = combine(parts);
-            let entry = SolveEntry {
-                wavelength_nm: lambda,
-                incidence: *inc,
-                side: *side,
-                realisation: 0,
-                layer: 0,
-                efficiencies,
-                record,
-                polarised,
-            };
+            let entry = combine(parts, lambda, inc, *side, 0);
             log_solve(progress, &entry);
             entries.push(entry);
         }

@@ -55,6 +55,7 @@ pub mod airy;
 pub mod fft;
 pub mod green;
 pub mod heartbeat;
+pub mod jones;
 pub mod lattice;
 pub mod maxwell;
 pub mod methods;
@@ -69,6 +70,7 @@ use crate::config::{Background, Linear, Method, Precision};
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
+pub use jones::Jones;
 pub use lattice::Lattice;
 pub use methods::{Outcome, Solver, Validity};
 pub use storage::{dot, Field, Storage};
@@ -134,12 +136,12 @@ pub struct Problem<'a> {
 pub enum Wave {
     /// The scalar Helmholtz equation; the field is (nz, ny, nx).
     Scalar,
-    /// Maxwell's equations, lit by a plane wave of one linear polarisation
-    /// (relative to the plane of incidence at `azimuth_deg`, which also
-    /// fixes s and p at normal incidence); the field is (3 nz, ny, nx),
-    /// E_x, E_y, E_z stacked.
+    /// Maxwell's equations, lit by a plane wave of polarisation state
+    /// `polarisation` (s and p relative to the plane of incidence at
+    /// `azimuth_deg`, which also fixes them at normal incidence); the field
+    /// is (3 nz, ny, nx), E_x, E_y, E_z stacked.
     Vector {
-        polarisation: Linear,
+        polarisation: Jones,
         azimuth_deg: f64,
     },
 }
@@ -198,10 +200,10 @@ pub struct Solution {
 
 /// The p amplitudes of every order of a Maxwell solution (E_p along
 /// p̂ = (β ê_κ ± κ ẑ)/k0 of the outgoing wave), beside the s ones in
-/// [`Solution::r`], [`Solution::t`], and the incident polarisation.
+/// [`Solution::r`], [`Solution::t`], and the incident polarisation state.
 #[derive(Debug, Clone)]
 pub struct VectorAmplitudes {
-    pub incident: Linear,
+    pub incident: Jones,
     pub r_p: Array2<C64>,
     pub t_p: Array2<C64>,
 }
@@ -217,20 +219,41 @@ impl Solution {
         }
     }
 
+    /// The specular order's co-polarised (r, t) amplitudes: the scalar
+    /// wave's; for Maxwell those of the incident linear polarisation, and
+    /// for a mixed state the s ones per unit incident s amplitude (see
+    /// [`Solution::specular_p`] for p).
+    fn specular(&self) -> (C64, C64) {
+        match &self.vector {
+            Some(v) => match v.incident.as_linear() {
+                Some(Linear::P) => (v.r_p[[0, 0]], v.t_p[[0, 0]]),
+                Some(Linear::S) => (self.r[[0, 0]], self.t[[0, 0]]),
+                None => (self.r[[0, 0]] / v.incident.s, self.t[[0, 0]] / v.incident.s),
+            },
+            None => (self.r[[0, 0]], self.t[[0, 0]]),
+        }
+    }
+
     /// The specular order's reflection amplitude in the incident
     /// polarisation (co-polarised for Maxwell).
     pub fn specular_r(&self) -> C64 {
-        match &self.vector {
-            Some(v) if v.incident == Linear::P => v.r_p[[0, 0]],
-            _ => self.r[[0, 0]],
-        }
+        self.specular().0
     }
 
     /// The specular order's co-polarised transmission amplitude.
     pub fn specular_t(&self) -> C64 {
-        match &self.vector {
-            Some(v) if v.incident == Linear::P => v.t_p[[0, 0]],
-            _ => self.t[[0, 0]],
+        self.specular().1
+    }
+
+    /// For a mixed incident state, p's co-polarised specular (r, t) per
+    /// unit incident p amplitude: `r_pp + r_ps s/p`, whose mean over the
+    /// relative phase is `r_pp` (likewise s's in [`Solution::specular_r`]);
+    /// `None` for the scalar wave and a linear polarisation.
+    pub fn specular_p(&self) -> Option<[C64; 2]> {
+        let v = self.vector.as_ref()?;
+        match v.incident.as_linear() {
+            Some(_) => None,
+            None => Some([v.r_p[[0, 0]] / v.incident.p, v.t_p[[0, 0]] / v.incident.p]),
         }
     }
 

@@ -20,8 +20,8 @@ use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
 use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
-use super::{Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
-use crate::config::{Background, Linear};
+use super::{Jones, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
+use crate::config::Background;
 use ndarray::{s, Array2, Array3, Ix3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -95,11 +95,11 @@ enum BackgroundOperator {
         top00: Vec<C64>,
         bottom00: Vec<C64>,
     },
-    /// Maxwell's equations for one incident linear polarisation: the
+    /// Maxwell's equations for one incident polarisation state: the
     /// unknowns are (3 nz, ny, nx), E_x, E_y, E_z stacked.
     Vector {
         op: VectorOperator,
-        pol: Linear,
+        pol: Jones,
         /// `G_b`'s row tables (shift 0), made on first use (Born).
         binder: Option<Box<VectorShift>>,
     },

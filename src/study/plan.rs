@@ -70,10 +70,11 @@ pub fn default_applications(scene: &Scene) -> f64 {
         Background::Mean => MEAN_APPLICATIONS_SURFACE,
     }
 }
-/// Wave solves per incidence: one (Helmholtz), or one per polarisation
-/// solved (Maxwell; natural light is an s and a p solve).
+/// Wave solves per incidence: one (Helmholtz, and Maxwell's random-phase
+/// natural light), or one per polarisation solved (Maxwell; natural light
+/// in two solves is an s and a p solve).
 pub fn wave_solves(scene: &Scene) -> usize {
-    scene.solver.polarisations().map_or(1, <[Linear]>::len)
+    scene.solver.solves_per_incidence()
 }
 
 /// How many finished results the background's measured rate counts as
@@ -173,7 +174,7 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
         Equation::Helmholtz => (Wave::Scalar, 1),
         Equation::Maxwell => (
             Wave::Vector {
-                polarisation: Linear::S,
+                polarisation: Linear::S.into(),
                 azimuth_deg: 0.0,
             },
             3,
@@ -356,8 +357,8 @@ mod tests {
         assert_eq!(default_applications(&binder), BINDER_APPLICATIONS);
     }
 
-    /// Natural light in Maxwell is two wave solves per incidence, one
-    /// polarisation one, Helmholtz one.
+    /// Natural light in Maxwell is two wave solves per incidence (one as a
+    /// random-phase state), one polarisation one, Helmholtz one.
     #[test]
     fn maxwell_pays_per_polarisation() {
         let scene = |polarisation: &str, equation: &str| {
@@ -373,6 +374,10 @@ mod tests {
         assert_eq!(wave_solves(&scene("unpolarised", "helmholtz")), 1);
         assert_eq!(wave_solves(&scene("unpolarised", "maxwell")), 2);
         assert_eq!(wave_solves(&scene("p", "maxwell")), 1);
+        // An ensemble takes natural light as one random-phase solve.
+        let mut ensemble = scene("unpolarised", "maxwell");
+        ensemble.solver.natural_light = crate::config::NaturalLight::RandomPhase;
+        assert_eq!(wave_solves(&ensemble), 1);
     }
 
     #[test]

@@ -105,6 +105,7 @@ LAYOUT: Dict[str, Tuple[Tuple[str, ...], Optional[str], str]] = {
     "solves/*@note": ((), None, "why this method"),
     "solves/*@equation": ((), None, "wave equation solved (helmholtz: scalar, maxwell: vector)"),
     "solves/*@polarisation": ((), None, "incident polarisation (unpolarised, s, p; none: scalar wave)"),
+    "solves/*@random_phase_deg": ((), "deg", "relative phase of p to s of a random-phase natural-light solve (NaN: s and p solved apart, or scalar)"),
     "solves/*@total_reflectance_s": ((), "1", "total reflectance, s-polarised incidence"),
     "solves/*@total_reflectance_p": ((), "1", "total reflectance, p-polarised incidence"),
     "solves/*@total_transmittance_s": ((), "1", "total transmittance, s-polarised incidence"),

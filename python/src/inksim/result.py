@@ -138,8 +138,10 @@ class Result:
       ``total_transmittance``, ``absorption``, ``energy_balance`` are the
       solve's (for Maxwell's unpolarised light the mean of s and p); the
       same with suffix ``_s`` / ``_p`` are each polarisation's own, NaN
-      where the solve has no such polarisation (Helmholtz, or a Maxwell
-      run of the other one);
+      where the solve has no such polarisation (Helmholtz, a Maxwell
+      run of the other one, or natural light solved as one random-phase
+      state, whose relative phase of p to s is ``random_phase_deg``, NaN
+      elsewhere);
     - ``orders``: Dataset over ``order``, every propagating order of every
       solve (coordinate ``solve`` says which), ``orders_of(i)`` one solve's:
       ``orders_reflectance``, ``orders_transmittance`` and, per
@@ -329,7 +331,7 @@ _TOTALS = ["total_reflectance", "total_transmittance", "absorption", "energy_bal
 # Maxwell: each polarisation solved, its totals beside their mean.
 _POLARISED_TOTALS = [f"{t}_{p}" for t in _TOTALS for p in ("s", "p")]
 _SOLVE_VARS = _TOTALS + _POLARISED_TOTALS + [
-    "r00", "t00", "iterations", "operator_applications", "residual", "seconds", "note"]
+    "random_phase_deg", "r00", "t00", "iterations", "operator_applications", "residual", "seconds", "note"]
 _SOLVE_TEXT = ("side", "method", "note", "equation", "polarisation")
 # What a solve group without the attribute holds: files written before
 # ``equation`` and ``polarisation`` were stored are all scalar (Helmholtz).

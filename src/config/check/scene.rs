@@ -80,7 +80,16 @@ impl Checker<'_> {
         };
         let (wavelengths_nm, wl_key) = self.wavelengths(&raw.illumination)?;
         let incidence = self.incidence(&raw.illumination)?;
-        let solver = self.solver(raw.solver.as_ref(), raw.illumination.polarisation)?;
+        // Generated grains are random; an ensemble of them averages
+        // random-phase natural light's cross term (and counts it).
+        let random_layer = structure.is_none() && stack.is_none();
+        let ensemble = random_layer && (realisations >= 2 || realisation_target.is_some());
+        let solver = self.solver(
+            raw.solver.as_ref(),
+            raw.illumination.polarisation,
+            random_layer,
+            ensemble,
+        )?;
         let output = self.output(path, raw.output.as_ref())?;
         // An incoherent stack's default outputs are its tile alone: the
         // BRDF at every azimuth (the default "brdf") is not made there.

@@ -5,10 +5,11 @@
 
 use super::Checker;
 use crate::config::raw::{
-    RawBackground, RawEquation, RawMethod, RawPolarisation, RawPrecision, RawSolver,
+    RawBackground, RawEquation, RawMethod, RawNaturalLight, RawPolarisation, RawPrecision,
+    RawSolver,
 };
 use crate::config::{
-    Background, ConfigError, Equation, Method, Polarisation, Precision, SolverSpec,
+    Background, ConfigError, Equation, Method, NaturalLight, Polarisation, Precision, SolverSpec,
 };
 
 const DEFAULT_TOLERANCE: f64 = 1e-6;
@@ -28,6 +29,8 @@ impl Checker<'_> {
         &self,
         raw: Option<&RawSolver>,
         polarisation: Option<RawPolarisation>,
+        random_layer: bool,
+        ensemble: bool,
     ) -> Result<SolverSpec, ConfigError> {
         let equation = match raw.and_then(|s| s.equation) {
             Some(RawEquation::Maxwell) => Equation::Maxwell,
@@ -48,6 +51,32 @@ impl Checker<'_> {
                 ),
             ));
         }
+        let natural = equation == Equation::Maxwell && polarisation == Polarisation::Unpolarised;
+        let natural_light = match raw.and_then(|s| s.natural_light) {
+            Some(RawNaturalLight::TwoSolves) => NaturalLight::TwoSolves,
+            Some(RawNaturalLight::RandomPhase) if !natural => {
+                return Err(self.invalid(
+                    "solver.natural_light",
+                    format!(
+                        "\"random-phase\" is a way of solving unpolarised light in Maxwell's \
+                         equations; this scene is {} with polarisation \"{}\"",
+                        equation.name(),
+                        polarisation.name()
+                    ),
+                ))
+            }
+            Some(RawNaturalLight::RandomPhase) if !random_layer => {
+                return Err(self.invalid(
+                    "solver.natural_light",
+                    "\"random-phase\" averages its s-p cross term out over random \
+                     realisations; an explicit structure or a stack is one fixed layer: use \
+                     \"two-solves\"",
+                ))
+            }
+            Some(RawNaturalLight::RandomPhase) => NaturalLight::RandomPhase,
+            None | Some(RawNaturalLight::Auto) if natural && ensemble => NaturalLight::RandomPhase,
+            None | Some(RawNaturalLight::Auto) => NaturalLight::TwoSolves,
+        };
         let method = raw
             .and_then(|s| s.method)
             .map_or(Method::Auto, |RawMethod(m)| m);
@@ -98,6 +127,7 @@ impl Checker<'_> {
         Ok(SolverSpec {
             equation,
             polarisation,
+            natural_light,
             method,
             tolerance,
             max_iterations,

@@ -96,7 +96,7 @@ fn reflectance_factor<'e>(
                 v += albedo * td * e.total_transmittance / (1.0 - albedo * rdd);
             }
             if m == Measurement::DiffuseEightSce {
-                v -= e.r00.norm_sqr();
+                v -= e.specular_power().0;
             }
             v
         }

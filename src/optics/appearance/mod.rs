@@ -5,7 +5,10 @@
 //! realisations; outputs are ensemble means with their standard errors
 //! (sample standard deviation / √R, present only when R ≥ 2):
 //! - per wavelength and incidence from above: R, T, A and the specular split
-//!   (coherent `|⟨r00⟩|²`, incoherent `⟨|r00|²⟩ − |⟨r00⟩|²`; the same for t00);
+//!   (coherent `|⟨r00⟩|²`, incoherent `⟨|r00|²⟩ − |⟨r00⟩|²`; the same for t00;
+//!   for Maxwell `⟨|r00|²⟩` is the (0, 0) order's power in both outgoing
+//!   polarisations and the coherent part averages `|⟨r00⟩|²` of the
+//!   co-polarised amplitudes over s and p);
 //! - the diffuse BRDF (and on request BTDF) table of every illumination angle
 //!   ([`crate::optics::farfield::table`]: power-preserving, orders (0,0) excluded) and
 //!   its values in the plane of incidence on the specular side
@@ -218,9 +221,11 @@ pub fn assemble(
     let mut s_btdf = Vec::with_capacity(rr);
     let mut s_rdd = Vec::with_capacity(rr);
     let mut s_td = Vec::with_capacity(rr);
-    let mut r00 = Array2::<C64>::zeros((nl, na));
+    // Specular amplitudes summed per incident polarisation (one, or s and
+    // p for Maxwell's natural light) and specular powers.
+    let mut r00: Vec<Array2<C64>> = Vec::new();
     let mut r00_sq = Array2::<f64>::zeros((nl, na));
-    let mut t00 = Array2::<C64>::zeros((nl, na));
+    let mut t00: Vec<Array2<C64>> = Vec::new();
     let mut t00_sq = Array2::<f64>::zeros((nl, na));
     let az = spec.azimuth_deg;
     for r in 0..rr {
@@ -239,10 +244,17 @@ pub fn assemble(
                 tr[[l, a]] = e.total_reflectance;
                 tt[[l, a]] = e.total_transmittance;
                 ta[[l, a]] = e.absorption;
-                r00[[l, a]] += e.r00;
-                r00_sq[[l, a]] += e.r00.norm_sqr();
-                t00[[l, a]] += e.t00;
-                t00_sq[[l, a]] += e.t00.norm_sqr();
+                for (k, [r, t]) in e.specular_amplitudes().into_iter().enumerate() {
+                    if r00.len() <= k {
+                        r00.push(Array2::zeros((nl, na)));
+                        t00.push(Array2::zeros((nl, na)));
+                    }
+                    r00[k][[l, a]] += r;
+                    t00[k][[l, a]] += t;
+                }
+                let (rs, ts) = e.specular_power();
+                r00_sq[[l, a]] += rs;
+                t00_sq[[l, a]] += ts;
             }
             for (i, &polar) in spec.illumination_deg.iter().enumerate() {
                 let e = &find(Side::Above, r, wl, polar)?.efficiencies;
@@ -292,7 +304,14 @@ pub fn assemble(
         s_td.push(td);
     }
     let n = rr as f64;
-    let coherent = |sum: &Array2<C64>| sum.mapv(|z| (z / n).norm_sqr());
+    // |⟨amplitude⟩|², averaged over the incident polarisations.
+    let coherent = |sums: &[Array2<C64>]| {
+        let mut out = Array2::<f64>::zeros((nl, na));
+        for sum in sums {
+            out += &sum.mapv(|z| (z / n).norm_sqr());
+        }
+        out / sums.len().max(1) as f64
+    };
     let specular_coherent = coherent(&r00);
     let direct_coherent = coherent(&t00);
     let incoherent = |sq: &Array2<f64>, coh: &Array2<f64>| {

@@ -8,7 +8,7 @@
 
 pub mod table;
 
-use crate::config::Incidence;
+use crate::config::{Incidence, Linear};
 use crate::solver::SolveRecord;
 use num_complex::Complex64;
 
@@ -31,9 +31,14 @@ pub struct Order {
 #[derive(Debug, Clone)]
 pub struct Efficiencies {
     pub orders: Vec<Order>,
-    /// Specular amplitudes r_00 and t_00.
+    /// Specular amplitudes r_00 and t_00, co-polarised for Maxwell (for
+    /// natural light, s's).
     pub r00: Complex64,
     pub t00: Complex64,
+    /// p's co-polarised specular amplitudes (r_00, t_00) where the
+    /// efficiencies stand for natural light (`r00`, `t00` then being s's);
+    /// `None` for the scalar wave and one linear polarisation.
+    pub specular_p: Option<[Complex64; 2]>,
     pub total_reflectance: f64,
     pub total_transmittance: f64,
     pub absorption: f64,
@@ -42,6 +47,25 @@ pub struct Efficiencies {
 }
 
 impl Efficiencies {
+    /// The specular (0, 0) order's reflected and transmitted power: `|r00|²`
+    /// and `|t00|²` for the scalar wave; for Maxwell both outgoing
+    /// polarisations, averaged like every order for natural light.
+    pub fn specular_power(&self) -> (f64, f64) {
+        self.orders
+            .iter()
+            .find(|o| o.m == 0 && o.n == 0)
+            .map_or((0.0, 0.0), |o| (o.reflectance, o.transmittance))
+    }
+
+    /// The co-polarised specular amplitudes (r_00, t_00) of each incident
+    /// polarisation these efficiencies average (one, or s and p), whose
+    /// ensemble means give the coherent specular power.
+    pub fn specular_amplitudes(&self) -> Vec<[Complex64; 2]> {
+        std::iter::once([self.r00, self.t00])
+            .chain(self.specular_p)
+            .collect()
+    }
+
     /// The totals by their stored names: reflectance, transmittance,
     /// absorption and the energy balance.
     pub fn totals(&self) -> [(&'static str, f64); 4] {
@@ -101,6 +125,9 @@ pub struct SolveEntry {
     /// Maxwell: each incident polarisation's own efficiencies (the mean
     /// of which is `efficiencies`); empty for the scalar wave.
     pub polarised: Vec<(crate::config::Linear, Efficiencies)>,
+    /// Maxwell's natural light solved as one mixed state
+    /// `(ŝ + e^{iφ} p̂)/√2`: its φ in degrees (`polarised` is then empty).
+    pub random_phase_deg: Option<f64>,
 }
 
 /// Order efficiencies, absorption and the energy balance of a solution.
@@ -139,6 +166,7 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
         orders,
         r00: sol.specular_r(),
         t00: sol.specular_t(),
+        specular_p: sol.specular_p(),
         total_reflectance: tr,
         total_transmittance: tt,
         absorption: sol.absorption,
@@ -148,10 +176,11 @@ pub fn efficiencies(sol: &crate::solver::Solution) -> Efficiencies {
 
 /// Natural light from linear polarisations solved apart: the incoherent mean
 /// of their powers, order by order (the same lattice, so the same orders),
-/// and of the totals, absorption and balance. The specular amplitudes are
-/// the first polarisation's (s when both were solved): amplitudes of
-/// different polarisations do not average.
-pub fn polarisation_mean(parts: &[(crate::config::Linear, Efficiencies)]) -> Efficiencies {
+/// and of the totals, absorption and balance. Amplitudes of different
+/// polarisations do not average: the specular ones are kept per
+/// polarisation (the first's in `r00`, `t00`; p's beside them when s and p
+/// were both solved).
+pub fn polarisation_mean(parts: &[(Linear, Efficiencies)]) -> Efficiencies {
     let n = parts.len() as f64;
     let first = &parts[0].1;
     let mean = |f: &dyn Fn(&Efficiencies) -> f64| parts.iter().map(|(_, e)| f(e)).sum::<f64>() / n;
@@ -169,6 +198,10 @@ pub fn polarisation_mean(parts: &[(crate::config::Linear, Efficiencies)]) -> Eff
         orders,
         r00: first.r00,
         t00: first.t00,
+        specular_p: match parts {
+            [(Linear::S, _), (Linear::P, p)] => Some([p.r00, p.t00]),
+            _ => None,
+        },
         total_reflectance: mean(&|e| e.total_reflectance),
         total_transmittance: mean(&|e| e.total_transmittance),
         absorption: mean(&|e| e.absorption),
@@ -198,6 +231,7 @@ pub fn slab_efficiencies(
         }],
         r00: resp.r,
         t00: resp.t,
+        specular_p: None,
         total_reflectance: rr,
         total_transmittance: t,
         absorption: resp.absorption,

@@ -207,10 +207,10 @@ pub fn layer_slab<'e, E>(
     for side in [Side::Above, Side::Below] {
         for j in 0..k {
             let eff = solve(side, j)?;
-            // The specular (0, 0) order's power, |r00|² and |t00|² (the
-            // same medium above and below): along the light's own
-            // direction, the same in every Fourier term.
-            let (r00, t00) = (eff.r00.norm_sqr(), eff.t00.norm_sqr());
+            // The specular (0, 0) order's power (|r00|² and |t00|² of the
+            // scalar wave; the same medium above and below): along the
+            // light's own direction, the same in every Fourier term.
+            let (r00, t00) = eff.specular_power();
             let cr = q.diffuse_columns(eff, Part::DiffuseReflection, terms);
             let ct = q.diffuse_columns(eff, Part::DiffuseTransmission, terms);
             for (m, s) in all.iter_mut().enumerate() {
@@ -263,13 +263,15 @@ mod tests {
                 }
                 let dx = (sx - s0.0, sy - s0.1);
                 let p = (-(dx.0 * dx.0 + dx.1 * dx.1) / 0.3).exp() * (1.0 + 0.6 * dx.0);
+                // The specular order carries |r00|², |t00|² (below).
+                let specular = m == 0 && n == 0;
                 orders.push(Order {
                     m,
                     n,
                     theta_deg: rho.asin().to_degrees(),
                     phi_deg: sy.atan2(sx).to_degrees(),
-                    reflectance: 1e-3 * p,
-                    transmittance: 2e-3 * p,
+                    reflectance: if specular { 0.01 } else { 1e-3 * p },
+                    transmittance: if specular { 0.81 } else { 2e-3 * p },
                 });
             }
         }
@@ -277,6 +279,7 @@ mod tests {
             orders,
             r00: C64::new(0.1, 0.0),
             t00: C64::new(0.9, 0.0),
+            specular_p: None,
             total_reflectance: 0.0,
             total_transmittance: 0.0,
             absorption: 0.0,

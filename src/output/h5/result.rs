@@ -406,6 +406,18 @@ fn write_entry(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> 
 /// incident polarisation's totals (attributes `<total>_s`, `<total>_p`) and
 /// order efficiencies (`orders_reflectance_s`, …) beside their mean.
 fn write_polarised(s: &Scales, g: &hdf5::Group, e: &SolveEntry) -> hdf5::Result<()> {
+    if let Some(phi) = e.random_phase_deg {
+        write_str_attr(g, "equation", Equation::Maxwell.name())?;
+        write_scalar_attr(g, "random_phase_deg", phi)?;
+        return write_str_attr(
+            g,
+            "polarisation",
+            &format!(
+                "unpolarised: one random-phase state (s + exp(i phi) p)/sqrt 2 at phi = \
+                 {phi:.2} deg, whose s-p cross term averages out over the realisations"
+            ),
+        );
+    }
     if e.polarised.is_empty() {
         write_str_attr(g, "equation", Equation::Helmholtz.name())?;
         return write_str_attr(

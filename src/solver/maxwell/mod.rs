@@ -24,6 +24,7 @@ mod tm_sweep;
 pub use shifted::VectorShift;
 
 use super::fft::{Fft2, FftScratch};
+use super::jones::Jones;
 use super::lattice::Lattice;
 use super::operator::for_each_row;
 use crate::config::Linear;
@@ -248,8 +249,33 @@ impl VectorOperator {
     }
 
     /// The background slab's response to a unit plane wave of polarisation
-    /// `pol` (harmonic 00).
-    pub fn background(&self, pol: Linear) -> BackgroundField {
+    /// state `pol` (harmonic 00): the superposition of its s and p parts.
+    pub fn background(&self, pol: Jones) -> BackgroundField {
+        let nz = self.lat.nz;
+        let mut out = BackgroundField {
+            rows: vec![ZERO; 3 * nz],
+            r: [ZERO; 2],
+            t: [ZERO; 2],
+        };
+        for (l, a) in [(Linear::S, pol.s), (Linear::P, pol.p)] {
+            if a == ZERO {
+                continue;
+            }
+            let f = self.background_linear(l);
+            for (o, v) in out.rows.iter_mut().zip(&f.rows) {
+                *o += a * v;
+            }
+            for k in 0..2 {
+                out.r[k] += a * f.r[k];
+                out.t[k] += a * f.t[k];
+            }
+        }
+        out
+    }
+
+    /// The background slab's response to a unit plane wave of linear
+    /// polarisation `pol`.
+    fn background_linear(&self, pol: Linear) -> BackgroundField {
         let nz = self.lat.nz;
         let ([ux, uy], h) = self.harmonic(0, 0);
         let zero = vec![ZERO; nz];

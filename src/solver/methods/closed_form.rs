@@ -6,7 +6,7 @@
 //! effective-medium shortcut; scenes cannot ask for it.
 
 use super::{Solver, Validity};
-use crate::config::{Linear, Method, Precision};
+use crate::config::{Method, Precision};
 use crate::solver::airy::{self, SlabField};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
@@ -62,15 +62,6 @@ impl Solver for Airy {
             )));
         }
         let kappa = lat.q[0].hypot(lat.q[1]);
-        let (p_pol, azimuth) = match p.wave {
-            Wave::Scalar => (false, 0.0),
-            Wave::Vector {
-                polarisation,
-                azimuth_deg,
-            } => (polarisation == Linear::P, azimuth_deg),
-        };
-        let slab = SlabField::polarised(eps, lat.size_nm[2], lat.k0, kappa, p_pol);
-        let airy::SlabResponse { r, t, absorption } = slab.response;
         let nz = lat.nz;
         let specular = |amplitude| {
             let mut a = Array2::zeros((lat.nx, lat.ny));
@@ -78,47 +69,63 @@ impl Solver for Airy {
             a
         };
         let zero = C64::new(0.0, 0.0);
-        let (field, r_s, t_s, vector) = match p.wave {
+        let (field, r_s, t_s, vector, absorption) = match p.wave {
             Wave::Scalar => {
+                let slab = SlabField::polarised(eps, lat.size_nm[2], lat.k0, kappa, false);
+                let airy::SlabResponse { r, t, absorption } = slab.response;
                 let cells = slab.cell_averages(nz);
                 let field = Array3::from_shape_fn(p.eps.dim(), |(k, _, _)| cells[k]);
-                (field, r, t, None)
+                (field, r, t, None, absorption)
             }
-            Wave::Vector { polarisation, .. } => {
+            Wave::Vector {
+                polarisation,
+                azimuth_deg,
+            } => {
                 // ê_κ along q (the azimuth at normal incidence), ê_s = ẑ × ê_κ.
                 let [ux, uy] = if kappa > 0.0 {
                     [lat.q[0] / kappa, lat.q[1] / kappa]
                 } else {
-                    let a = azimuth.to_radians();
+                    let a = azimuth_deg.to_radians();
                     [a.cos(), a.sin()]
                 };
+                // The s and p parts of the incident state superpose; their
+                // fields are orthogonal (ŝ against the plane of incidence),
+                // so the absorbed powers add.
                 let mut rows = vec![zero; 3 * nz];
-                match slab.p_cell_averages(nz) {
-                    Some((ek, ez)) => {
-                        for j in 0..nz {
-                            rows[j] = ux * ek[j];
-                            rows[nz + j] = uy * ek[j];
-                            rows[2 * nz + j] = ez[j];
-                        }
+                let (mut amp, mut absorption) = ([zero; 4], 0.0);
+                for (is_p, a) in [(false, polarisation.s), (true, polarisation.p)] {
+                    if a == zero {
+                        continue;
                     }
-                    None => {
-                        for (j, es) in slab.cell_averages(nz).into_iter().enumerate() {
-                            rows[j] = -uy * es;
-                            rows[nz + j] = ux * es;
+                    let slab = SlabField::polarised(eps, lat.size_nm[2], lat.k0, kappa, is_p);
+                    let resp = &slab.response;
+                    absorption += a.norm_sqr() * resp.absorption;
+                    let k = if is_p { 2 } else { 0 };
+                    amp[k] = a * resp.r;
+                    amp[k + 1] = a * resp.t;
+                    match slab.p_cell_averages(nz) {
+                        Some((ek, ez)) => {
+                            for j in 0..nz {
+                                rows[j] += a * ux * ek[j];
+                                rows[nz + j] += a * uy * ek[j];
+                                rows[2 * nz + j] += a * ez[j];
+                            }
+                        }
+                        None => {
+                            for (j, es) in slab.cell_averages(nz).into_iter().enumerate() {
+                                rows[j] += a * -uy * es;
+                                rows[nz + j] += a * ux * es;
+                            }
                         }
                     }
                 }
                 let field = Array3::from_shape_fn((3 * nz, lat.ny, lat.nx), |(k, _, _)| rows[k]);
-                let (rs, ts, rp, tp) = match polarisation {
-                    Linear::S => (r, t, zero, zero),
-                    Linear::P => (zero, zero, r, t),
-                };
                 let v = VectorAmplitudes {
                     incident: polarisation,
-                    r_p: specular(rp),
-                    t_p: specular(tp),
+                    r_p: specular(amp[2]),
+                    t_p: specular(amp[3]),
                 };
-                (field, rs, ts, Some(v))
+                (field, amp[0], amp[1], Some(v), absorption)
             }
         };
         Ok(Solution {

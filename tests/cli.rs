@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::scene::SceneToml;
+use common::scene::{PigmentToml, SceneToml};
 
 fn inksim(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
@@ -77,8 +77,8 @@ fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
             "pigment.0.material",
             r#"{ builtin = "red", index = [1.5, 0.0] }"#,
         ),
-        "a material is a table with exactly one of `builtin`, `csv`, `index`, `epsilon` (e.g. \
-         material = { builtin = \"red\" }); this one gives more than one",
+        "a material is a table with exactly one of `builtin`, `library`, `csv`, `index`, \
+         `epsilon` (e.g. material = { library = \"rutile\" }); this one gives more than one",
     );
     expect_error(
         SceneToml::tiny().raw("pigment.0.material", "{}"),
@@ -587,4 +587,81 @@ fn a_long_solve_reports_its_iterations_while_it_runs() {
     // By default (10 s) this quick run stays quiet.
     let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
     assert!(ok && !err.contains("still solving"), "{err}");
+}
+
+/// The tiny scene with its pigment made of the library material `name`,
+/// results in `dir/out`.
+fn library_scene(dir: &Path, name: &str, wavelengths_nm: &[f64]) -> PathBuf {
+    SceneToml::tiny()
+        .pigment(
+            PigmentToml::library(name)
+                .named("white")
+                .pvc(0.15)
+                .diameter_nm(150.0),
+        )
+        .wavelengths_nm(wavelengths_nm)
+        .output(&dir.join("out"), "white")
+        .write(dir)
+}
+
+/// The files in `dir`, by name.
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn a_wavelength_outside_a_library_material_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // Rutile's tables (Devore 1951) start at 430 nm.
+    let cfg = library_scene(dir.path(), "rutile", &[400.0, 550.0]);
+    for cmd in ["check", "run"] {
+        let (ok, out, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok && !err.contains("panicked"), "{cmd}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd}: {err}");
+        assert_eq!(
+            err.trim(),
+            format!(
+                "error: {}: key `illumination.wavelengths_nm`: wavelength 400 nm is outside \
+                 the data range [430, 1100] nm of material library `rutile` (pigment `white`)",
+                cfg.display()
+            ),
+            "{cmd}"
+        );
+        assert!(out.is_empty(), "{cmd}: {out}");
+        assert_eq!(
+            names_in(dir.path()),
+            ["scene.toml"],
+            "{cmd}: nothing left behind"
+        );
+    }
+    // Inside the range the same scene runs.
+    let cfg = library_scene(dir.path(), "rutile", &[450.0, 550.0]);
+    let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(dir.path().join("out/white.h5").is_file());
+}
+
+#[test]
+fn an_unknown_library_material_lists_the_known_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = library_scene(dir.path(), "titanium-white", &[450.0, 550.0]);
+    for cmd in ["check", "run"] {
+        let (ok, _, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok && !err.contains("panicked"), "{cmd}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd}: {err}");
+        assert!(
+            err.contains(
+                "key `pigment[0].material.library`: unknown library material `titanium-white`; \
+                 known: rutile, anatase, zno, calcite, hematite, cds, soot, amorphous-carbon, \
+                 aluminium"
+            ),
+            "{cmd}: {err}"
+        );
+        assert_eq!(names_in(dir.path()), ["scene.toml"], "{cmd}");
+    }
 }

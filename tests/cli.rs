@@ -665,3 +665,57 @@ fn an_unknown_library_material_lists_the_known_ones() {
         assert_eq!(names_in(dir.path()), ["scene.toml"], "{cmd}");
     }
 }
+
+#[test]
+fn materials_lists_every_stand_in_and_library_material() {
+    let (ok, out, err) = inksim(&["materials"]);
+    assert!(ok && err.is_empty(), "{err}");
+    let row = |name: &str| {
+        out.lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no row for {name}: {out}"))
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for name in inksim::config::materials::BUILTIN_NAMES {
+        assert!(
+            row(name).starts_with(&format!("{name} stand-in 380-780 nm MIT OR Apache-2.0")),
+            "{}",
+            row(name)
+        );
+    }
+    let cc0 = "CC0 1.0 Universal (public domain dedication), refractiveindex.info database";
+    for (name, kind, range) in [
+        ("rutile", "crystal o+e", "430-1100 nm"),
+        ("anatase", "library", "300.2-826.56 nm"),
+        ("zno", "library", "300-1100 nm"),
+        ("calcite", "crystal o+e", "300-1100 nm"),
+        ("hematite", "crystal o+e", "300-1100 nm"),
+        ("cds", "crystal o+e", "300.14-1033.2 nm"),
+        ("soot", "library", "300-1100 nm"),
+        ("amorphous-carbon", "library", "326.3-1033.2 nm"),
+        ("aluminium", "library", "309.96-1033.2 nm"),
+    ] {
+        assert_eq!(row(name), format!("{name} {kind} {range} {cc0}"));
+    }
+    for reference in [
+        "J. R. Devore. Refractive indices of rutile and sphalerite. J. Opt. Soc. Am. 41",
+        "[o: main/TiO2/Devore-o, e: main/TiO2/Devore-e]",
+        "M. R. Querry. Optical constants, Contractor Report CRDC-CR-85034 (1985)",
+        "A. D. Rakić. Algorithm for the determination of intrinsic optical constants",
+        "[main/Al/Rakic]",
+    ] {
+        assert!(out.contains(reference), "{reference}");
+    }
+    let (ok, help, _) = inksim(&["materials", "--help"]);
+    assert!(ok);
+    for said in [
+        "library = \"rutile\"",
+        "CC0 1.0",
+        "(2 ε_o + ε_e)/3",
+        "crystal o+e",
+    ] {
+        assert!(help.contains(said), "{said} not in: {help}");
+    }
+}

@@ -419,6 +419,10 @@ git -C rii checkout {db.commit or '<commit>'}
 python3 scripts/make_materials.py rii      # needs PyYAML
 ```
 
+`python/tests/test_make_materials.py` checks the conversion rules and these
+tables; with `INKSIM_RII_DATABASE=rii` (and PyYAML) it also regenerates the
+library and compares it with these files byte for byte.
+
 | file | database page | range | reference |
 |---|---|---|---|
 {rows}

@@ -532,6 +532,28 @@ mod tests {
     }
 
     #[test]
+    fn a_uniaxial_material_averages_its_axes_on_their_common_range() {
+        let o = Material::from_csv_text("o", "wavelength_nm,n,k\n400,2,0\n600,2,0\n").unwrap();
+        let e = Material::from_csv_text("e", "wavelength_nm,n,k\n450,1,0.5\n700,1,0.5\n").unwrap();
+        let m = Material::uniaxial("x", o.clone(), e.clone()).unwrap();
+        // The common range, on every wavelength either table has in it.
+        assert_eq!(m.range_nm(), (450.0, 600.0));
+        assert_eq!(m.wavelengths_nm(), [450.0, 600.0]);
+        let eps_e = Complex64::new(1.0, 0.5).powi(2);
+        let want = ((2.0 * 4.0 + eps_e) / 3.0).sqrt();
+        assert!((m.index_at(500.0).unwrap() - want).norm() < 1e-12);
+        assert_eq!(m.n_values()[0], m.index_at(450.0).unwrap().re);
+        assert_eq!(m.index_at(420.0), None);
+        assert_eq!(m.index_at(650.0), None);
+        let mut bytes = o.table_bytes().to_vec();
+        bytes.extend_from_slice(e.table_bytes());
+        assert_eq!(m.table_bytes(), bytes.as_slice());
+        let far = Material::from_csv_text("f", "wavelength_nm,n,k\n800,1,0\n900,1,0\n").unwrap();
+        let err = Material::uniaxial("x", o, far).unwrap_err().to_string();
+        assert!(err.contains("share no wavelength range"), "{err}");
+    }
+
+    #[test]
     fn bad_tables_name_the_line() {
         let cases = [
             ("wavelength,n,k\n400,1,0\n", "line 1"),

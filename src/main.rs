@@ -32,7 +32,7 @@ use std::process::ExitCode;
     version = inksim::VERSION,
     about,
     long_about,
-    after_help = "Examples:\n  inksim run configs/demo.toml                 run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml               validate and show the work a run would do\n  inksim --threads 1 run scene.toml            same numbers for any thread count\n  inksim plan configs/study.toml               variants, work, estimated time and memory per profile\n  inksim run configs/study.toml --profile quick    run (or resume) the whole study\n  inksim run configs/study.toml --shard 0/4    run a quarter of it\n  inksim slurm configs/study.toml --shards 16  write an sbatch job-array script\n  inksim merge configs/study.toml              summary.h5, comparison grids, summary.md/html\n  inksim export runs/demo/demo.h5              spectra and colours as CSV (or a study: colours.csv)"
+    after_help = "Examples:\n  inksim run configs/demo.toml                 run the demo scene (results in runs/demo/)\n  inksim check configs/demo.toml               validate and show the work a run would do\n  inksim --threads 1 run scene.toml            same numbers for any thread count\n  inksim plan configs/study.toml               variants, work, estimated time and memory per profile\n  inksim run configs/study.toml --profile quick    run (or resume) the whole study\n  inksim run configs/study.toml --shard 0/4    run a quarter of it\n  inksim slurm configs/study.toml --shards 16  write an sbatch job-array script\n  inksim merge configs/study.toml              summary.h5, comparison grids, summary.md/html\n  inksim export runs/demo/demo.h5              spectra and colours as CSV (or a study: colours.csv)\n  inksim materials                             the stand-in and library materials a scene may name"
 )]
 struct Cli {
     /// Worker threads (default: all cores). Results do not depend on it.
@@ -193,6 +193,22 @@ enum Command {
         /// Scene or study file (TOML).
         config: PathBuf,
     },
+    /// List the materials a scene may name: the built-in stand-ins and the
+    /// library of published optical constants.
+    ///
+    /// Each with its kind, wavelength range, licence and source. Stand-ins
+    /// (`material = { builtin = "red" }`) are inksim's own documented
+    /// spectra (scripts/make_pigments.py). Library materials (`material = {
+    /// library = "rutile" }`) are tables converted from the
+    /// refractiveindex.info database (public domain, CC0 1.0) by
+    /// scripts/make_materials.py, each naming its database page and
+    /// reference (data/materials/SOURCE.md has the database commit). Kinds:
+    /// `stand-in`; `library` (one table); `crystal o+e` (a uniaxial crystal
+    /// with ordinary and extraordinary tables, used in the scalar wave
+    /// equation as the orientation average ε = (2 ε_o + ε_e)/3). A scene
+    /// whose wavelengths leave a material's range is refused by `check` and
+    /// `run` before any work. Your own data: `material = { csv = "file.csv" }`.
+    Materials,
 }
 
 fn main() -> ExitCode {
@@ -294,6 +310,7 @@ fn real_main() -> Result<ExitCode> {
             output_dir,
             to,
         } => cli::export::export(&target, profile.as_deref(), output_dir, to)?,
+        Command::Materials => cli::materials::materials()?,
         Command::Check { config } => {
             let config = cli::ConfigFile::read(&config)?;
             if config.is_study() {

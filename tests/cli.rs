@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 mod common;
-use common::scene::SceneToml;
+use common::scene::{PigmentToml, SceneToml};
 
 fn inksim(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_inksim"))
@@ -77,8 +77,8 @@ fn a_key_of_the_wrong_form_is_told_the_forms_it_takes() {
             "pigment.0.material",
             r#"{ builtin = "red", index = [1.5, 0.0] }"#,
         ),
-        "a material is a table with exactly one of `builtin`, `csv`, `index`, `epsilon` (e.g. \
-         material = { builtin = \"red\" }); this one gives more than one",
+        "a material is a table with exactly one of `builtin`, `library`, `csv`, `index`, \
+         `epsilon` (e.g. material = { library = \"rutile\" }); this one gives more than one",
     );
     expect_error(
         SceneToml::tiny().raw("pigment.0.material", "{}"),
@@ -587,4 +587,135 @@ fn a_long_solve_reports_its_iterations_while_it_runs() {
     // By default (10 s) this quick run stays quiet.
     let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
     assert!(ok && !err.contains("still solving"), "{err}");
+}
+
+/// The tiny scene with its pigment made of the library material `name`,
+/// results in `dir/out`.
+fn library_scene(dir: &Path, name: &str, wavelengths_nm: &[f64]) -> PathBuf {
+    SceneToml::tiny()
+        .pigment(
+            PigmentToml::library(name)
+                .named("white")
+                .pvc(0.15)
+                .diameter_nm(150.0),
+        )
+        .wavelengths_nm(wavelengths_nm)
+        .output(&dir.join("out"), "white")
+        .write(dir)
+}
+
+/// The files in `dir`, by name.
+fn names_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn a_wavelength_outside_a_library_material_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // Rutile's tables (Devore 1951) start at 430 nm.
+    let cfg = library_scene(dir.path(), "rutile", &[400.0, 550.0]);
+    for cmd in ["check", "run"] {
+        let (ok, out, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok && !err.contains("panicked"), "{cmd}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd}: {err}");
+        assert_eq!(
+            err.trim(),
+            format!(
+                "error: {}: key `illumination.wavelengths_nm`: wavelength 400 nm is outside \
+                 the data range [430, 1100] nm of material library `rutile` (pigment `white`)",
+                cfg.display()
+            ),
+            "{cmd}"
+        );
+        assert!(out.is_empty(), "{cmd}: {out}");
+        assert_eq!(
+            names_in(dir.path()),
+            ["scene.toml"],
+            "{cmd}: nothing left behind"
+        );
+    }
+    // Inside the range the same scene runs.
+    let cfg = library_scene(dir.path(), "rutile", &[450.0, 550.0]);
+    let (ok, _, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(dir.path().join("out/white.h5").is_file());
+}
+
+#[test]
+fn an_unknown_library_material_lists_the_known_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = library_scene(dir.path(), "titanium-white", &[450.0, 550.0]);
+    for cmd in ["check", "run"] {
+        let (ok, _, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok && !err.contains("panicked"), "{cmd}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd}: {err}");
+        assert!(
+            err.contains(
+                "key `pigment[0].material.library`: unknown library material `titanium-white`; \
+                 known: rutile, anatase, zno, calcite, hematite, cds, soot, amorphous-carbon, \
+                 aluminium"
+            ),
+            "{cmd}: {err}"
+        );
+        assert_eq!(names_in(dir.path()), ["scene.toml"], "{cmd}");
+    }
+}
+
+#[test]
+fn materials_lists_every_stand_in_and_library_material() {
+    let (ok, out, err) = inksim(&["materials"]);
+    assert!(ok && err.is_empty(), "{err}");
+    let row = |name: &str| {
+        out.lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no row for {name}: {out}"))
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for name in inksim::config::materials::BUILTIN_NAMES {
+        assert!(
+            row(name).starts_with(&format!("{name} stand-in 380-780 nm MIT OR Apache-2.0")),
+            "{}",
+            row(name)
+        );
+    }
+    let cc0 = "CC0 1.0 Universal (public domain dedication), refractiveindex.info database";
+    for (name, kind, range) in [
+        ("rutile", "crystal o+e", "430-1100 nm"),
+        ("anatase", "library", "300.2-826.56 nm"),
+        ("zno", "library", "300-1100 nm"),
+        ("calcite", "crystal o+e", "300-1100 nm"),
+        ("hematite", "crystal o+e", "300-1100 nm"),
+        ("cds", "crystal o+e", "300.14-1033.2 nm"),
+        ("soot", "library", "300-1100 nm"),
+        ("amorphous-carbon", "library", "326.3-1033.2 nm"),
+        ("aluminium", "library", "309.96-1033.2 nm"),
+    ] {
+        assert_eq!(row(name), format!("{name} {kind} {range} {cc0}"));
+    }
+    for reference in [
+        "J. R. Devore. Refractive indices of rutile and sphalerite. J. Opt. Soc. Am. 41",
+        "[o: main/TiO2/Devore-o, e: main/TiO2/Devore-e]",
+        "M. R. Querry. Optical constants, Contractor Report CRDC-CR-85034 (1985)",
+        "A. D. Rakić. Algorithm for the determination of intrinsic optical constants",
+        "[main/Al/Rakic]",
+    ] {
+        assert!(out.contains(reference), "{reference}");
+    }
+    let (ok, help, _) = inksim(&["materials", "--help"]);
+    assert!(ok);
+    for said in [
+        "library = \"rutile\"",
+        "CC0 1.0",
+        "(2 ε_o + ε_e)/3",
+        "crystal o+e",
+    ] {
+        assert!(help.contains(said), "{said} not in: {help}");
+    }
 }

@@ -886,3 +886,58 @@ fn natural_light_is_checked() {
     let err = parse(&maxwell().set("solver.natural_light", "alternate")).unwrap_err();
     assert!(err.to_string().contains("random-phase"), "{err}");
 }
+
+#[test]
+fn a_library_crystal_loads_as_its_orientation_average_and_hashes_both_tables() {
+    let scene = base().pigment(PigmentToml::library("hematite").pvc(0.2).diameter_nm(200.0));
+    let s = parse(&scene).unwrap();
+    let m = &s.species[0].material;
+    assert_eq!(m.source, MaterialSource::Library("hematite".into()));
+    // Rows of data/materials/hematite-{o,e}.csv at 550 nm (Querry 1985):
+    // ε = (2 ε_o + ε_e)/3.
+    let (no, ne) = (Complex64::new(3.318, 0.498), Complex64::new(2.927, 0.460));
+    let want = (2.0 * no * no + ne * ne) / 3.0;
+    let n = m.index_at(550.0).unwrap();
+    assert!((n * n - want).norm() < 1e-12, "{n}");
+    assert_eq!(m.epsilon_axes_at(550.0), Some((no * no, ne * ne)));
+    // The input hash covers the canonical config and both tables' bytes.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/materials");
+    let mut tables = std::fs::read(dir.join("hematite-o.csv")).unwrap();
+    tables.extend(std::fs::read(dir.join("hematite-e.csv")).unwrap());
+    assert_eq!(m.table_bytes(), tables.as_slice());
+    let mut t: toml::Table = scene.toml().parse().unwrap();
+    t.remove("output");
+    let mut h = Sha256::new();
+    h.update(toml::to_string(&t).unwrap().as_bytes());
+    h.update(&tables);
+    let want: String = h.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    assert_eq!(s.provenance.input_hash, want);
+}
+
+#[test]
+fn a_library_material_is_refused_outside_its_range_and_by_unknown_name() {
+    let rutile = PigmentToml::library("rutile").pvc(0.2).diameter_nm(200.0);
+    let (key, shown) = invalid(
+        &base()
+            .pigment(rutile.clone())
+            .wavelengths_nm(&[420.0, 550.0]),
+    );
+    assert_eq!(key, "illumination.wavelengths_nm");
+    assert!(
+        shown.ends_with(
+            "wavelength 420 nm is outside the data range [430, 1100] nm of material library \
+             `rutile` (pigment `rutile`)"
+        ),
+        "{shown}"
+    );
+    assert!(parse(&base().pigment(rutile).wavelengths_nm(&[430.0, 700.0])).is_ok());
+    let (key, shown) = invalid(&base().raw("pigment.0.material", "{ library = \"titania\" }"));
+    assert_eq!(key, "pigment[0].material.library");
+    assert!(
+        shown.ends_with(
+            "unknown library material `titania`; known: rutile, anatase, zno, calcite, \
+                         hematite, cds, soot, amorphous-carbon, aluminium"
+        ),
+        "{shown}"
+    );
+}

@@ -8,11 +8,13 @@
 //! - [`plan`]: `plan`, the variants with their work and estimated time and
 //!   memory.
 //! - [`slurm`]: `slurm`, the sbatch job-array script.
+//! - [`materials`]: `materials`, the stand-ins and the material library.
 //!
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
 
 pub mod export;
+pub mod materials;
 pub mod plan;
 pub mod scene;
 pub mod slurm;

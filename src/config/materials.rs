@@ -17,6 +17,15 @@
 //! whose header comments (copied into each file) give the band parameters, and
 //! are embedded in the binary. The raw table text is kept so that results can
 //! be tied to the exact data they came from (see [`Material::table_bytes`]).
+//!
+//! The material library ([`library`]) holds published optical constants:
+//! tables converted from the refractiveindex.info database, with their
+//! provenance, and uniaxial crystals as an ordinary and an extraordinary table
+//! ([`Material::uniaxial`]).
+
+pub mod library;
+
+pub use library::TableInfo;
 
 use super::check::num;
 use num_complex::Complex64;
@@ -69,6 +78,8 @@ pub enum MaterialSource {
     Csv(PathBuf),
     /// CSV text handed over in memory ([`Material::from_csv_text`]).
     Text,
+    /// A table (or a crystal's two) of the material library, by name.
+    Library(String),
 }
 
 /// Why a table could not be loaded. Messages name the file (or the in-memory
@@ -88,19 +99,25 @@ pub enum MaterialError {
     },
     #[error("{origin}: {message}")]
     Table { origin: String, message: String },
+    #[error("unknown library material `{name}`; known: {known}")]
+    UnknownLibrary { name: String, known: String },
 }
 
 /// A tabulated complex refractive index.
 #[derive(Debug, Clone)]
 pub struct Material {
-    /// Short name: the built-in name, the CSV file stem, or the name given to
-    /// [`Material::from_csv_text`].
+    /// Short name: the built-in or library name, the CSV file stem, or the
+    /// name given to [`Material::from_csv_text`].
     pub name: String,
     pub source: MaterialSource,
     wavelengths_nm: Vec<f64>,
     n: Vec<f64>,
     k: Vec<f64>,
     text: String,
+    /// A library table's provenance, from its header.
+    info: Option<TableInfo>,
+    /// A uniaxial crystal's ordinary and extraordinary tables.
+    axes: Option<Box<[Material; 2]>>,
 }
 
 impl Material {
@@ -158,10 +175,74 @@ impl Material {
         )
     }
 
+    /// A uniaxial crystal from its ordinary and extraordinary tables. The
+    /// scalar wave equation has one permittivity per voxel, so the crystal
+    /// is its orientation average over randomly oriented grains,
+    /// `ε = (2 ε_o + ε_e) / 3` ([`index_at`](Self::index_at) is `√ε`, with
+    /// `ε_o`, `ε_e` from each table's interpolated `n + i k`), on the
+    /// wavelengths both tables cover; [`epsilon_axes_at`](Self::epsilon_axes_at)
+    /// and [`axes`](Self::axes) keep the two. Its own table
+    /// ([`wavelengths_nm`](Self::wavelengths_nm), `n_values`, `k_values`)
+    /// is the average at every wavelength either table has in that range, and
+    /// its [`table_bytes`](Self::table_bytes) are both tables' text.
+    pub fn uniaxial(
+        name: &str,
+        ordinary: Material,
+        extraordinary: Material,
+    ) -> Result<Material, MaterialError> {
+        let (o_lo, o_hi) = ordinary.range_nm();
+        let (e_lo, e_hi) = extraordinary.range_nm();
+        let (lo, hi) = (o_lo.max(e_lo), o_hi.min(e_hi));
+        if lo >= hi {
+            return Err(MaterialError::Table {
+                origin: name.to_string(),
+                message: format!(
+                    "the ordinary ({o_lo}-{o_hi} nm) and extraordinary ({e_lo}-{e_hi} nm) \
+                     tables share no wavelength range"
+                ),
+            });
+        }
+        let mut wl: Vec<f64> = ordinary
+            .wavelengths_nm
+            .iter()
+            .chain(&extraordinary.wavelengths_nm)
+            .copied()
+            .filter(|&w| w >= lo && w <= hi)
+            .collect();
+        wl.sort_by(f64::total_cmp);
+        wl.dedup();
+        let text = format!("{}{}", ordinary.text, extraordinary.text);
+        let mut m = Material {
+            name: name.to_string(),
+            source: MaterialSource::Text,
+            wavelengths_nm: Vec::new(),
+            n: Vec::new(),
+            k: Vec::new(),
+            text,
+            info: None,
+            axes: Some(Box::new([ordinary, extraordinary])),
+        };
+        for w in wl {
+            // Inside both tables' ranges, so always Some.
+            if let Some(n) = m.index_at(w) {
+                m.wavelengths_nm.push(w);
+                m.n.push(n.re);
+                m.k.push(n.im);
+            }
+        }
+        Ok(m)
+    }
+
     /// `n + i k` at `wavelength_nm`, linearly interpolating `n` and `k`
     /// between rows; exact at tabulated wavelengths. `None` outside
-    /// [`range_nm`](Self::range_nm) (or for a non-finite wavelength).
+    /// [`range_nm`](Self::range_nm) (or for a non-finite wavelength). A
+    /// uniaxial crystal gives the root of its orientation-averaged
+    /// permittivity ([`Material::uniaxial`]).
     pub fn index_at(&self, wavelength_nm: f64) -> Option<Complex64> {
+        if self.axes.is_some() {
+            let (eo, ee) = self.epsilon_axes_at(wavelength_nm)?;
+            return Some(((2.0 * eo + ee) / 3.0).sqrt());
+        }
         let w = &self.wavelengths_nm;
         let (lo, hi) = self.range_nm();
         if !(wavelength_nm >= lo && wavelength_nm <= hi) {
@@ -194,7 +275,30 @@ impl Material {
         &self.k
     }
 
-    /// The raw table text the material was parsed from (for input hashing).
+    /// The permittivities `(ε_o, ε_e)` along a uniaxial crystal's ordinary
+    /// and extraordinary axes, each `(n + i k)²` of its own table; for an
+    /// isotropic material its `ε` twice. `None` where there is no data.
+    pub fn epsilon_axes_at(&self, wavelength_nm: f64) -> Option<(Complex64, Complex64)> {
+        let eps = |m: &Material| m.index_at(wavelength_nm).map(|n| n * n);
+        match &self.axes {
+            Some(axes) => Some((eps(&axes[0])?, eps(&axes[1])?)),
+            None => eps(self).map(|e| (e, e)),
+        }
+    }
+
+    /// A uniaxial crystal's ordinary and extraordinary tables.
+    pub fn axes(&self) -> Option<(&Material, &Material)> {
+        self.axes.as_deref().map(|[o, e]| (o, e))
+    }
+
+    /// A library table's provenance (for a library crystal, see each of
+    /// its [`axes`](Self::axes)).
+    pub fn info(&self) -> Option<&TableInfo> {
+        self.info.as_ref()
+    }
+
+    /// The raw table text the material was parsed from (for input hashing);
+    /// a uniaxial crystal's two tables, ordinary first.
     pub fn table_bytes(&self) -> &[u8] {
         self.text.as_bytes()
     }
@@ -322,17 +426,21 @@ impl Material {
             n,
             k,
             text: text.to_string(),
+            info: None,
+            axes: None,
         })
     }
 }
 
 impl fmt::Display for Material {
-    /// `builtin red`, `csv path/to/file.csv` or `table name`.
+    /// `builtin `red``, `library `rutile``, `csv `path/to/file.csv`` or
+    /// `table `name``.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.source {
             MaterialSource::Builtin(name) => write!(f, "builtin `{name}`"),
             MaterialSource::Csv(path) => write!(f, "csv `{}`", path.display()),
             MaterialSource::Text => write!(f, "table `{}`", self.name),
+            MaterialSource::Library(name) => write!(f, "library `{name}`"),
         }
     }
 }
@@ -421,6 +529,28 @@ mod tests {
         assert!((at(550.0).re - 0.9).abs() < 1e-12 && (at(550.0).im - 1.6).abs() < 1e-12);
         // A lossless dielectric has k = 0 exactly.
         assert_eq!(index_of_epsilon(2.25, 0.0), (1.5, 0.0));
+    }
+
+    #[test]
+    fn a_uniaxial_material_averages_its_axes_on_their_common_range() {
+        let o = Material::from_csv_text("o", "wavelength_nm,n,k\n400,2,0\n600,2,0\n").unwrap();
+        let e = Material::from_csv_text("e", "wavelength_nm,n,k\n450,1,0.5\n700,1,0.5\n").unwrap();
+        let m = Material::uniaxial("x", o.clone(), e.clone()).unwrap();
+        // The common range, on every wavelength either table has in it.
+        assert_eq!(m.range_nm(), (450.0, 600.0));
+        assert_eq!(m.wavelengths_nm(), [450.0, 600.0]);
+        let eps_e = Complex64::new(1.0, 0.5).powi(2);
+        let want = ((2.0 * 4.0 + eps_e) / 3.0).sqrt();
+        assert!((m.index_at(500.0).unwrap() - want).norm() < 1e-12);
+        assert_eq!(m.n_values()[0], m.index_at(450.0).unwrap().re);
+        assert_eq!(m.index_at(420.0), None);
+        assert_eq!(m.index_at(650.0), None);
+        let mut bytes = o.table_bytes().to_vec();
+        bytes.extend_from_slice(e.table_bytes());
+        assert_eq!(m.table_bytes(), bytes.as_slice());
+        let far = Material::from_csv_text("f", "wavelength_nm,n,k\n800,1,0\n900,1,0\n").unwrap();
+        let err = Material::uniaxial("x", o, far).unwrap_err().to_string();
+        assert!(err.contains("share no wavelength range"), "{err}");
     }
 
     #[test]

@@ -255,12 +255,15 @@ pub enum RawOrientation {
     Perpendicular,
 }
 
-/// `{ builtin = "red" }`, `{ csv = "path.csv" }`, `{ index = [n, k] }` or
+/// `{ builtin = "red" }`, `{ library = "rutile" }`, `{ csv = "path.csv" }`,
+/// `{ index = [n, k] }` or
 /// `{ epsilon = [re, im] }`.
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RawMaterial {
     Builtin(String),
+    /// A material of the library (`inksim materials` lists them).
+    Library(String),
     Csv(String),
     /// Constant `[n, k]` at every wavelength.
     Index(Vec<f64>),

@@ -338,6 +338,13 @@ impl PigmentToml {
             .raw("material", &format!("{{ index = [{n}, {k}] }}"))
     }
 
+    /// A pigment named after the library material it is made of.
+    pub fn library(name: &str) -> Self {
+        Self(Table::new())
+            .set("name", name)
+            .raw("material", &format!("{{ library = \"{name}\" }}"))
+    }
+
     /// A pigment from a CSV table of n, k.
     pub fn csv(name: &str, file: &str) -> Self {
         Self(Table::new())

@@ -1,5 +1,5 @@
-//! A material key: a builtin name, a constant `[n, k]` or `[Re ε, Im ε]`,
-//! or a CSV table (resolved next to the config file).
+//! A material key: a builtin or library name, a constant `[n, k]` or
+//! `[Re ε, Im ε]`, or a CSV table (resolved next to the config file).
 
 use super::Checker;
 use crate::config::materials::BUILTIN_NAMES;
@@ -19,6 +19,8 @@ impl Checker<'_> {
                     ),
                 )
             }),
+            RawMaterial::Library(name) => Material::library(name)
+                .map_err(|e| self.invalid(format!("{key}.library"), e.to_string())),
             RawMaterial::Index(nk) => {
                 let k = format!("{key}.index");
                 if nk.len() != 2 {

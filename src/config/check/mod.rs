@@ -27,14 +27,15 @@
 //!   `layer.equilibrate_sweeps` in `[0, MAX_EQUILIBRATE_SWEEPS]`.
 //! - `Provenance::input_hash` is SHA-256 over the config's tables without
 //!   `[output]`, in a canonical form (sorted keys, no comments), followed by each
-//!   pigment's table text, in pigment order, then each structure primitive's
-//!   table text or the bytes of the structure's HDF5 file.
+//!   pigment's table text (a library crystal's: both of its tables), in
+//!   pigment order, then each structure primitive's table text or the bytes
+//!   of the structure's HDF5 file.
 //! - `[structure]` (explicit layer) and `[[pigment]]` exclude each other.
 //!
 //! One file per part of the scene, each adding its methods to [`Checker`]:
 //! `scene` (the whole scene, wavelength coverage, input hash, output names),
 //! `layer` (thickness, fragment, binder, grid), `pigments` (species, shapes,
-//! sizes, agglomeration), `material` (builtin, index, CSV), `structure`
+//! sizes, agglomeration), `material` (builtin, library, index, CSV), `structure`
 //! (explicit primitives or an ε grid), `illumination` (wavelengths, polar
 //! angles), `solver` (method, tolerance, precision) and `appearance`
 //! (products, viewing angles, substrate).
@@ -150,8 +151,8 @@ const TAGGED: [(&str, &str); 6] = [
 /// tagged key given as a bare string or without `kind`, a material with
 /// none or several of its kinds.
 fn in_config_terms(msg: &str) -> String {
-    const MATERIAL: &str = "a material is a table with exactly one of `builtin`, `csv`, \
-                            `index`, `epsilon` (e.g. material = { builtin = \"red\" })";
+    const MATERIAL: &str = "a material is a table with exactly one of `builtin`, `library`, \
+                            `csv`, `index`, `epsilon` (e.g. material = { library = \"rutile\" })";
     if msg.contains("wanted exactly 1 element, more than 1 element") {
         return format!("{MATERIAL}; this one gives more than one");
     }

@@ -257,3 +257,45 @@ fn the_page_lists_each_baselines_de00_to_the_wave_colour() {
     let md = std::fs::read_to_string(plain.join("summary.md")).unwrap();
     assert!(!md.contains("Classical baselines"));
 }
+
+/// The page says which wave equation the colours came from: one fact line
+/// for a study in one equation, and a column per variant when an axis sets
+/// `solver.equation`.
+#[test]
+fn the_page_names_the_wave_equation_of_every_colour() {
+    let sweep = SWEEP.replace(
+        "values = [0.1, 0.2]\n",
+        "values = [0.1]\n\n[[axis]]\nname = \"wave\"\n\
+         [[axis.value]]\nlabel = \"scalar\"\nset = { \"solver.equation\" = \"helmholtz\" }\n\
+         [[axis.value]]\nlabel = \"vector\"\nset = { \"solver.equation\" = \"maxwell\" }\n",
+    );
+    assert_ne!(sweep, SWEEP);
+    let (_guard, study_dir, _) = run_sweep(&sweep);
+    let md = std::fs::read_to_string(study_dir.join("summary.md")).unwrap();
+    let html = std::fs::read_to_string(study_dir.join("summary.html")).unwrap();
+    assert!(
+        md.contains("- wave equation: helmholtz for 2 variants, maxwell for 2"),
+        "{md}"
+    );
+    assert!(html.contains("helmholtz for 2 variants, maxwell for 2"));
+    let header = md
+        .lines()
+        .find(|l| l.starts_with("| # | name |"))
+        .expect("variants table");
+    assert!(header.contains("| equation |"), "{header}");
+    for (label, name) in [("scalar", "helmholtz"), ("vector", "maxwell")] {
+        let rows = md
+            .lines()
+            .filter(|l| l.contains(&format!("| {label} | {name} |")))
+            .count();
+        assert_eq!(rows, 2, "{name}\n{md}");
+    }
+    let (_guard, plain, _) = run_study();
+    let md = std::fs::read_to_string(plain.join("summary.md")).unwrap();
+    assert!(
+        md.contains("- wave equation: helmholtz for every variant"),
+        "{md}"
+    );
+    let header = md.lines().find(|l| l.starts_with("| # | name |")).unwrap();
+    assert!(!header.contains("equation"), "{header}");
+}

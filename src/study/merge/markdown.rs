@@ -56,9 +56,8 @@ pub(super) fn page(p: &PageInput) -> String {
     }
     md += "## Variants\n\nR, T, A: mean total reflectance, transmittance and absorption over \
            the solves from above (for a stack combined by adding, of the whole stack in air over its angles); L*, C*ab, h°: the measured colour ± s.e.\n\n";
-    let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
-    head.extend(axes.iter().map(|a| a.to_string()));
+    head.extend(p.columns());
     for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
         head.push(h.into());
     }
@@ -72,7 +71,7 @@ pub(super) fn page(p: &PageInput) -> String {
                 None => r.v.name.clone(),
             };
             let mut cells = vec![(i + 1).to_string(), name];
-            cells.extend(axes.iter().map(|a| r.v.label(a).unwrap_or("—").to_string()));
+            cells.extend(p.column_cells(r));
             cells.extend([r.r, r.t, r.a].map(|x| format!("{x:.4}")));
             match colour_cells(r) {
                 Some((lch, hex)) => {

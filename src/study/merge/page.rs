@@ -9,6 +9,7 @@
 
 use super::effects::{Effect, MeanSe};
 use super::Row;
+use crate::config::Equation;
 use crate::optics::colour::{lab_to_lch, lch_se};
 use crate::study::run;
 use crate::study::sweep::{Expansion, Study, Variant};
@@ -96,6 +97,7 @@ impl PageInput<'_> {
         );
         vec![
             ("study".into(), self.study.name.clone()),
+            ("wave equation".into(), self.equations()),
             ("sweep file".into(), self.study.path.display().to_string()),
             ("profile".into(), self.profile().to_string()),
             ("profile settings".into(), settings),
@@ -116,6 +118,58 @@ impl PageInput<'_> {
             ("inksim version".into(), crate::VERSION.to_string()),
             ("merged".into(), utc_date(self.unix_s)),
         ]
+    }
+
+    /// Which wave equation the colours came from: one for every variant,
+    /// or how many variants took each (the variants table then names each
+    /// variant's).
+    pub fn equations(&self) -> String {
+        let maxwell = self
+            .rows
+            .iter()
+            .filter(|r| r.v.scene.solver.equation == Equation::Maxwell)
+            .count();
+        let helmholtz = self.rows.len() - maxwell;
+        match (helmholtz, maxwell) {
+            (_, 0) => "helmholtz for every variant (the scalar approximation: its model \
+                       error against Maxwell's equations is in docs/ACCURACY.md and in `inksim \
+                       plan`'s expected error)"
+                .into(),
+            (0, _) => "maxwell for every variant (the vector field; natural light as s and p \
+                       or one random-phase solve per incidence, see each result's solves)"
+                .into(),
+            (h, m) => format!("helmholtz for {h} variants, maxwell for {m} (column \"equation\")"),
+        }
+    }
+
+    /// Whether the variants differ in their wave equation.
+    pub fn mixed_equations(&self) -> bool {
+        let mut e = self.rows.iter().map(|r| r.v.scene.solver.equation);
+        e.next().is_some_and(|first| e.any(|x| x != first))
+    }
+
+    /// The variants table's descriptive columns: the axes, and the
+    /// equation when the variants differ in it.
+    pub fn columns(&self) -> Vec<String> {
+        let mut c: Vec<String> = self.study.axes.iter().map(|a| a.name.clone()).collect();
+        if self.mixed_equations() {
+            c.push("equation".into());
+        }
+        c
+    }
+
+    /// A variant's cells under [`PageInput::columns`].
+    pub fn column_cells(&self, r: &Row) -> Vec<String> {
+        let mut c: Vec<String> = self
+            .study
+            .axes
+            .iter()
+            .map(|a| r.v.label(&a.name).unwrap_or("—").to_string())
+            .collect();
+        if self.mixed_equations() {
+            c.push(r.v.scene.solver.equation.name().into());
+        }
+        c
     }
 
     /// Links to a variant's files that exist: (text, relative path).
@@ -353,9 +407,8 @@ pub(super) fn html_page(p: &PageInput) -> String {
 
 fn variants_html(p: &PageInput) -> String {
     let e = html_escape;
-    let axes: Vec<&str> = p.study.axes.iter().map(|a| a.name.as_str()).collect();
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
-    head.extend(axes.iter().map(|a| e(a)));
+    head.extend(p.columns().iter().map(|a| e(a)));
     for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
         head.push(h.into());
     }
@@ -367,7 +420,7 @@ fn variants_html(p: &PageInput) -> String {
     s += &tr(&head, "th");
     for (i, r) in p.rows.iter().enumerate() {
         let mut cells = vec![(i + 1).to_string(), e(&r.v.name)];
-        cells.extend(axes.iter().map(|a| e(r.v.label(a).unwrap_or("—"))));
+        cells.extend(p.column_cells(r).iter().map(|c| e(c)));
         cells.extend([r.r, r.t, r.a].map(|x| format!("{x:.4}")));
         match colour_cells(r) {
             Some((lch, hex)) => {

@@ -45,7 +45,7 @@ pub fn plan(
     println!(
         "time model (calibrated now on this machine, {nthreads} thread(s)): per solve = setup + \
          applications × one operator application × {} (Maxwell: per polarisation solved, \
-         two for natural light); applications per solve {:.0} under a \
+         natural light one random-phase solve for an ensemble, else two); applications per solve {:.0} under a \
          flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
          background), × {:.2}: {}",
         plan::KRYLOV_OVERHEAD,

@@ -1,6 +1,6 @@
 //! Expected error of a scene's fidelity settings.
 //!
-//! Two kinds of term, summed:
+//! Three kinds of term, summed:
 //! - **Discretisation** (cells, spectral step, tolerance, quadrature): each
 //!   knob's ΔE00 (max over the tile) against its converged value, measured
 //!   on the weak layer of docs/ACCURACY.md (examples/accuracy.rs: red, 15 %
@@ -19,6 +19,8 @@
 //!   finer the step the more of it the colour averages away. Calibrated on
 //!   the quick study at 100 nm and measured at 20 nm (docs/ACCURACY.md,
 //!   "Statistics of the fragment").
+//! - **The scalar approximation** ([`super::model_error`]): a Helmholtz
+//!   scene's distance to Maxwell's equations, measured on the stand-ins.
 
 use crate::config::{GrainShape, Scene};
 
@@ -200,7 +202,8 @@ pub fn expected_error(scene: &Scene) -> Vec<String> {
         .collect();
     out.push(format!(
         "expected ΔE00 ≈ {total:.2} (sum of the terms; discretisation measured on a weak \
-         layer, statistics measured at 100 and 20 nm steps — docs/ACCURACY.md)"
+         layer, statistics measured at 100 and 20 nm steps, the scalar approximation on the \
+         stand-in pigments — docs/ACCURACY.md)"
     ));
     out
 }
@@ -279,6 +282,14 @@ pub fn expected_rows(scene: &Scene) -> Vec<(String, f64)> {
             false,
         ),
     ));
+    if let Some(m) = super::model_error::scalar_de00(scene) {
+        rows.push((
+            "scalar approximation (the Helmholtz equation against Maxwell's; \
+             solver.equation = \"maxwell\" removes it)"
+                .to_string(),
+            m,
+        ));
+    }
     rows
 }
 

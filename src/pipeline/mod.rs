@@ -39,6 +39,7 @@ mod fine_bodies;
 mod grains;
 mod layer;
 pub mod memory;
+pub mod model_error;
 mod plan;
 mod result;
 mod run;

@@ -29,7 +29,7 @@
 //! ratio and out
 //! of the model. A Maxwell variant is timed on the vector operator and
 //! pays its setup and applications once per polarisation solved
-//! ([`wave_solves`]: two for natural light). Geometry packing and output
+//! ([`wave_solves`]: natural light one random-phase solve for an ensemble, else two). Geometry packing and output
 //! are not modelled (seconds per variant). The estimate is a guide (±2×),
 //! not a promise.
 

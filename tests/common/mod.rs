@@ -6,6 +6,7 @@
 
 pub mod airy;
 pub mod cli;
+pub mod json;
 pub mod keys;
 pub mod layers;
 pub mod scene;

@@ -24,7 +24,6 @@ use std::collections::BTreeMap;
 mod common;
 use common::json::Json;
 
-
 const CTL: Controls = Controls {
     tolerance: 1e-8,
     max_iterations: 20000,
@@ -198,7 +197,12 @@ fn fixture_is_a_converged_treams_reference() {
         let incidences = c.arr("incidence");
         assert_eq!(incidences.len(), 4);
         for inc in incidences {
-            let what = format!("{} {}° {}", c.str("name"), inc.num("polar_deg"), inc.str("pol"));
+            let what = format!(
+                "{} {}° {}",
+                c.str("name"),
+                inc.num("polar_deg"),
+                inc.str("pol")
+            );
             for key in [
                 "max_change_from_lmax_minus",
                 "max_change_from_bmax_minus",
@@ -207,7 +211,10 @@ fn fixture_is_a_converged_treams_reference() {
                 assert!(inc.num(key) < 1e-4, "{what}: not converged: {key}");
             }
             let (r, t, a) = (inc.num("R"), inc.num("T"), inc.num("A"));
-            assert!(r > 0.0 && t > 0.0 && a > -1e-9 && r + t <= 1.0 + 1e-9, "{what}");
+            assert!(
+                r > 0.0 && t > 0.0 && a > -1e-9 && r + t <= 1.0 + 1e-9,
+                "{what}"
+            );
             if lossless {
                 assert!(a.abs() < 1e-9, "{what}: lossless A = {a}");
             }
@@ -282,6 +289,9 @@ fn sphere_lattices_match_treams_at_5_nm() {
         let e10 = error(&solve_case(c, polar, pol, 10.0), &want);
         let e5 = error(&solve_case(c, polar, pol, 5.0), &want);
         eprintln!("{name} {polar}° {pol}: error {e10:.2e} (10 nm), {e5:.2e} (5 nm)");
-        assert!(e5 < 0.8 * e10 && e5 < tolerance / 2.0, "{e10:.2e} → {e5:.2e}");
+        assert!(
+            e5 < 0.8 * e10 && e5 < tolerance / 2.0,
+            "{e10:.2e} → {e5:.2e}"
+        );
     }
 }

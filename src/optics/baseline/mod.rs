@@ -71,8 +71,10 @@ pub mod doubling;
 pub mod halftone;
 pub mod km;
 pub mod matrix;
+pub mod mie;
 pub mod ordinates;
 pub mod sizes;
+pub mod special;
 pub mod sphere;
 pub mod transfer;
 

@@ -7,6 +7,7 @@
 use inksim::config::Measurement;
 use inksim::optics::baseline::adding::{self, fresnel_scalar, Slab};
 use inksim::optics::baseline::doubling::{self, Medium};
+use inksim::optics::baseline::fresnel::Fresnel;
 use inksim::optics::baseline::km;
 use inksim::optics::baseline::matrix::Matrix;
 use inksim::optics::baseline::ordinates::{gauss_legendre, OrdinateParams, Ordinates};
@@ -64,8 +65,16 @@ fn two_absorbing_slabs_are_the_incoherent_closed_form() {
     let s1 = doubling::homogeneous(&o, &absorber(a1), x1).unwrap();
     let s2 = doubling::homogeneous(&o, &absorber(a2), x2).unwrap();
     let inner = adding::add(&s1, &s2).unwrap();
-    let lower = adding::add(&inner, &adding::surface_binder_over_air(&o)).unwrap();
-    let stack = adding::add(&adding::surface_air_over_binder(&o), &lower).unwrap();
+    let lower = adding::add(
+        &inner,
+        &adding::surface_binder_over_air(&o, Fresnel::Scalar),
+    )
+    .unwrap();
+    let stack = adding::add(
+        &adding::surface_air_over_binder(&o, Fresnel::Scalar),
+        &lower,
+    )
+    .unwrap();
     let (r, t) = (diag_of(&stack.r_down), diag_of(&stack.t_down));
     let mut worst = 0.0f64;
     for i in 0..o.len() {
@@ -101,7 +110,7 @@ fn scattering_stack(o: &Ordinates, mu_a: f64) -> Slab {
         mu_s: 4e-3,
         moments: sphere_moments(),
     };
-    transfer::free_layer(o, &m, 1000.0).unwrap()
+    transfer::free_layer(o, &m, 1000.0, Fresnel::Scalar).unwrap()
 }
 
 #[test]
@@ -353,13 +362,21 @@ fn the_scene_stack_without_scattering_is_the_clear_slab_on_paper() {
     // A non-scattering absorbing binder slab, air gap, Lambertian paper:
     // 45°/0° = ρ T(45°) T(0°) / (1 − ρ R_dd↑), T and R the incoherent slab's
     // per direction, R_dd↑ its albedo for Lambertian light from below
-    // (here summed over the same air bins; against a fine integral below).
+    // (here summed over the same air bins; against a fine integral below),
+    // with either surface law: the scalar wave's and natural light's (each
+    // passage reflecting the mean of s and p).
+    for fresnel in [Fresnel::Scalar, Fresnel::Unpolarised] {
+        clear_slab_on_paper(fresnel);
+    }
+}
+
+fn clear_slab_on_paper(fresnel: Fresnel) {
     let o = ords();
     let (mu_a, x, rho) = (2e-4, 1000.0, 0.9);
-    let s = transfer::stack(o.clone(), &absorber(mu_a), x, rho, Boundary::Scene).unwrap();
+    let s = transfer::stack(o.clone(), &absorber(mu_a), x, rho, Boundary::Scene, fresnel).unwrap();
     let slab = |mu_air: f64| {
         let mu = (1.0 - (1.0 - mu_air * mu_air) / (NB * NB)).sqrt();
-        let f = fresnel_scalar(NB, mu, mu_air);
+        let f = fresnel.between(NB, mu, mu_air);
         let t = (-mu_a * x / mu).exp();
         let d = 1.0 - f * f * t * t;
         (
@@ -372,7 +389,7 @@ fn the_scene_stack_without_scattering_is_the_clear_slab_on_paper() {
         .sum();
     let expect = rho * slab(45f64.to_radians().cos()).1 * slab(1.0).1 / (1.0 - rho * rdd);
     let got = s.factor(Measurement::FortyFiveZero).unwrap();
-    eprintln!("clear slab on paper, 45/0: AD {got:.12} vs closed form {expect:.12}");
+    eprintln!("clear slab on paper, {fresnel:?}, 45/0: AD {got:.12} vs closed form {expect:.12}");
     assert!((got - expect).abs() < 1e-10, "{got} vs {expect}");
     // The quadrature's own error: R_dd↑ by a fine integral.
     let (xg, wg) = gauss_legendre(400);

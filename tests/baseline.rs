@@ -2,8 +2,12 @@
 //! models): the key's checks, the models on a scene against their closed
 //! forms, and their colours beside the wave solution's.
 
-use inksim::config::{Baseline, ConfigError, Measurement};
-use inksim::optics::baseline::{self, km};
+use inksim::config::{Baseline, ConfigError, Equation, Measurement};
+use inksim::optics::baseline::fresnel::Fresnel;
+use inksim::optics::baseline::grain::GrainModel;
+use inksim::optics::baseline::ordinates::{OrdinateParams, Ordinates};
+use inksim::optics::baseline::transfer::{self, Boundary, AIR_DIRECTIONS_DEG};
+use inksim::optics::baseline::{self, doubling, km};
 use inksim::optics::colour::{delta_e2000, Observer};
 use inksim::pipeline;
 
@@ -138,8 +142,8 @@ fn an_invisible_pigment_leaves_the_bare_paper_through_saunderson() {
     }
 }
 
-/// A string attribute of a dataset.
-fn str_attr(d: &hdf5::Dataset, name: &str) -> String {
+/// A string attribute of a dataset or group.
+fn str_attr(d: &hdf5::Location, name: &str) -> String {
     d.attr(name)
         .unwrap()
         .read_scalar::<hdf5::types::VarLenUnicode>()
@@ -523,6 +527,145 @@ fn the_adding_doubling_quadrature_is_converged() {
             );
             eprintln!("{d} nm, PVC {pvc}, {boundary:?}: |ΔR| ≤ {gap:.1e}, ΔE00 {de:.4}");
             assert!(gap < 1e-4 && de < 0.01, "{gap} {de}");
+        }
+    }
+}
+
+/// The scene's equation picks the baselines' grains and surfaces: beside
+/// the Helmholtz equation the scalar sphere and s-like (TE) Fresnel
+/// surfaces, beside Maxwell's Mie's sphere and natural light's surfaces
+/// (`kubelka-munk` keeps Saunderson's unpolarised surface beside both).
+/// Checked on the medium (μa and μs' from the grain model's cross
+/// sections, to the bit), on an invisible pigment (the clear binder on
+/// paper, whose factors are the surfaces' alone), and in the result file.
+#[test]
+fn the_equation_picks_the_grains_and_the_surfaces() {
+    let dir = tempfile::tempdir().unwrap();
+    let nb = 1.558;
+    let all =
+        r#"["kubelka-munk", "kubelka-munk-scene", "adding-doubling", "adding-doubling-contact"]"#;
+    let scene = |equation: &str, p: PigmentToml| {
+        SceneToml::grains()
+            .binder_index(nb)
+            .pigment(p)
+            .wavelength_range_nm(400.0, 700.0, 100.0)
+            .paper(0.8)
+            .set("solver.equation", equation)
+            .raw("appearance.baseline", all)
+            .scene(dir.path())
+    };
+    // The medium: N σ of the equation's sphere.
+    let mut mu_s = Vec::new();
+    for (equation, model) in [
+        ("helmholtz", GrainModel::ScalarSphere),
+        ("maxwell", GrainModel::VectorMie),
+    ] {
+        let input = pipeline::baseline_input(&scene(equation, pigment(2.0, 0.05, 0.1, 300.0)))
+            .unwrap()
+            .unwrap();
+        assert_eq!(GrainModel::of(input.equation), model);
+        let pi = std::f64::consts::PI;
+        let number = input.species[0].volume_fraction / (pi * 300f64.powi(3) / 6.0);
+        for (l, &wl) in input.wavelengths_nm.iter().enumerate() {
+            let k = 2.0 * pi / wl * nb;
+            let c = model.cross_sections(k, input.species[0].eps[l] / (nb * nb), 150.0);
+            let got = baseline::coefficients(&input, l);
+            assert_eq!(got.mu_a, number * c.absorption, "{equation} {wl}");
+            let reduced = number * c.scattering * (1.0 - c.asymmetry);
+            assert_eq!(got.mu_s_reduced, reduced, "{equation} {wl}");
+        }
+        mu_s.push(baseline::coefficients(&input, 0).mu_s_reduced);
+    }
+    // 300 nm grains of index 2 are far from both small-sphere limits.
+    assert!((mu_s[1] / mu_s[0] - 1.0).abs() > 0.05, "{mu_s:?}");
+
+    // The surfaces: an invisible pigment leaves the clear binder on paper.
+    let obs = |s: &inksim::config::Scene| {
+        Observer::standard(s.appearance.illuminant, s.appearance.observer)
+    };
+    let mut ad_45 = Vec::new();
+    for equation in [Equation::Helmholtz, Equation::Maxwell] {
+        let s = scene(equation.name(), pigment(nb, 0.0, 0.2, 200.0));
+        let input = pipeline::baseline_input(&s).unwrap().unwrap();
+        let law = Fresnel::of(equation);
+        for model in Baseline::ALL {
+            let colours =
+                baseline::baseline_colours(model, &input, &Measurement::ALL, &|_| None, &obs(&s))
+                    .unwrap();
+            let surfaces = if model == Baseline::KubelkaMunk {
+                Fresnel::Unpolarised
+            } else {
+                law
+            };
+            for c in &colours {
+                assert_eq!(c.grains, GrainModel::of(equation));
+                assert_eq!(c.surfaces, surfaces, "{model:?} {equation:?}");
+            }
+            if model == Baseline::KubelkaMunkScene {
+                // K = S = 0: the body reflects its backing.
+                let (r_i, r_ed) = (law.internal(nb), law.diffuse_external(nb));
+                let body = km::scene_backing(0.8, r_i, r_ed);
+                let expect = km::saunderson_excluded(body, law.external(nb, 45.0), r_i);
+                let got = colours[0].reflectance_factor[0];
+                assert_eq!(colours[0].geometry, Measurement::FortyFiveZero);
+                assert!(
+                    (got - expect).abs() < 1e-12,
+                    "{equation:?}: {got} vs {expect}"
+                );
+            }
+            if model == Baseline::AddingDoubling {
+                // The clear layer between the law's surfaces, on paper.
+                let ords = Ordinates::new(nb, OrdinateParams::default(), &AIR_DIRECTIONS_DEG);
+                let clear = doubling::Medium {
+                    mu_a: 0.0,
+                    mu_s: 0.0,
+                    moments: Vec::new(),
+                };
+                let expect =
+                    transfer::stack(ords.unwrap(), &clear, 1000.0, 0.8, Boundary::Scene, law)
+                        .unwrap()
+                        .factor(Measurement::FortyFiveZero)
+                        .unwrap();
+                let got = colours[0].reflectance_factor[0];
+                assert!(
+                    (got - expect).abs() < 1e-9,
+                    "{equation:?}: {got} vs {expect}"
+                );
+                ad_45.push(got);
+            }
+        }
+    }
+    // The laws differ by more than the checks' tolerance.
+    assert!((ad_45[0] - ad_45[1]).abs() > 1e-4, "{ad_45:?}");
+
+    // The result file names both models on each model's group.
+    for (equation, grains, surfaces) in [
+        ("helmholtz", "scalar-sphere", "scalar-fresnel"),
+        ("maxwell", "vector-mie", "unpolarised-fresnel"),
+    ] {
+        let rep = SceneToml::tiny()
+            .set("solver.equation", equation)
+            .raw(
+                "appearance.baseline",
+                r#"["kubelka-munk", "adding-doubling"]"#,
+            )
+            .output_name(equation)
+            .run(dir.path());
+        let f = hdf5::File::open(&rep.result_path).unwrap();
+        for (model, surfaces) in [
+            ("kubelka-munk", "unpolarised-fresnel"),
+            ("adding-doubling", surfaces),
+        ] {
+            let g = f.group(&format!("appearance/baseline/{model}")).unwrap();
+            assert_eq!(str_attr(&g, "grain_model"), grains, "{equation} {model}");
+            assert_eq!(
+                str_attr(&g, "surface_model"),
+                surfaces,
+                "{equation} {model}"
+            );
+            for a in ["grain_model_description", "surface_model_description"] {
+                assert!(!str_attr(&g, a).is_empty(), "{equation} {model} {a}");
+            }
         }
     }
 }

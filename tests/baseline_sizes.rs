@@ -4,7 +4,7 @@
 //! log-normal, the size quadrature's convergence, and the colour shift the
 //! distribution makes.
 
-use inksim::config::{Baseline, GrainSize, Measurement};
+use inksim::config::{Baseline, Equation, GrainSize, Measurement};
 use inksim::optics::baseline::{self, sphere, transfer, BaselineInput, BaselineSpecies};
 use inksim::optics::colour::{delta_e2000, Observer};
 use inksim::pipeline;
@@ -163,6 +163,7 @@ fn small_spheres_follow_the_truncated_moments() {
             eps: vec![eps; wl.len()],
         }],
         size_quadrature: Default::default(),
+        equation: Equation::Helmholtz,
     };
     for (size, g) in [
         (

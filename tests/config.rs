@@ -810,7 +810,8 @@ fn a_material_may_be_given_as_its_complex_permittivity() {
 
 /// `solver.equation` and `illumination.polarisation` are read; a
 /// polarisation needs Maxwell's equation; what Maxwell mode cannot honour
-/// yet (stacks, the radiative-transfer baselines) is refused, naming the key.
+/// yet (stacks; the baselines, computed for natural light, beside one linear
+/// polarisation) is refused, naming the key.
 #[test]
 fn equation_and_polarisation_are_checked() {
     use inksim::config::{Equation, Polarisation};
@@ -830,13 +831,26 @@ fn equation_and_polarisation_are_checked() {
     assert!(msg.contains("maxwell"), "{msg}");
     let err = parse(&base().set("solver.equation", "vector")).unwrap_err();
     assert!(err.to_string().contains("helmholtz"), "{err}");
-    let (key, msg) = invalid(
+    // Beside a Maxwell solve of natural light the baselines are vector ones;
+    // beside one linear polarisation they are refused.
+    let s = parse(
         &base()
             .set("solver.equation", "maxwell")
             .set("appearance.baseline", "kubelka-munk"),
+    )
+    .unwrap();
+    assert_eq!(
+        s.appearance.baseline,
+        [inksim::config::Baseline::KubelkaMunk]
+    );
+    let (key, msg) = invalid(
+        &base()
+            .set("solver.equation", "maxwell")
+            .set("illumination.polarisation", "p")
+            .set("appearance.baseline", "kubelka-munk"),
     );
     assert_eq!(key, "appearance.baseline");
-    assert!(msg.contains("scalar"), "{msg}");
+    assert!(msg.contains("natural light"), "{msg}");
 }
 
 /// `solver.natural_light`: auto by default (random-phase for an ensemble of

@@ -455,10 +455,12 @@ pub struct Appearance {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Baseline {
     /// Kubelka–Munk two-flux reflectance on the paper with Saunderson's
-    /// surface correction, from the scalar sphere's cross sections.
+    /// surface correction, from the grains' cross sections (the scalar
+    /// sphere's beside the Helmholtz equation, Mie's beside Maxwell's).
     KubelkaMunk,
     /// The same two-flux body on the wave scene's boundary: the binder's
-    /// lower surface and an air gap before the paper, scalar Fresnel surfaces.
+    /// lower surface and an air gap before the paper, Fresnel surfaces of
+    /// the solver's equation.
     KubelkaMunkScene,
     /// Radiative transfer by adding–doubling with the wave scene's boundary.
     AddingDoubling,
@@ -509,15 +511,15 @@ impl Baseline {
                 "two-flux, K = 2 μa, S = 3/4 μs'; Saunderson's surface, paper in optical contact"
             }
             Baseline::KubelkaMunkScene => {
-                "two-flux, K = 2 μa, S = 3/4 μs'; scalar Fresnel surfaces, air gap over the paper"
+                "two-flux, K = 2 μa, S = 3/4 μs'; the equation's Fresnel surfaces, air gap over the paper"
             }
             Baseline::AddingDoubling => {
-                "radiative transfer (adding–doubling, phase function, δ-M); scalar Fresnel \
-                 surfaces with total internal reflection, air gap over the paper"
+                "radiative transfer (adding–doubling, phase function, δ-M); the equation's \
+                 Fresnel surfaces with total internal reflection, air gap over the paper"
             }
             Baseline::AddingDoublingContact => {
-                "radiative transfer (adding–doubling, phase function, δ-M); scalar Fresnel top \
-                 surface, paper in optical contact"
+                "radiative transfer (adding–doubling, phase function, δ-M); the equation's \
+                 Fresnel top surface, paper in optical contact"
             }
         }
     }

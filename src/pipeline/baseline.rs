@@ -1,7 +1,8 @@
 //! The classical baseline of a scene (`appearance.baseline`): its pigments
 //! as the baselines see them (volume fraction, nominal diameter and size
 //! distribution, permittivity), on the colour grid of the spectral proxy,
-//! beside the wave solution's measured colours.
+//! with the scene's equation (which picks the grains' sphere solution and
+//! the surfaces' Fresnel law), beside the wave solution's measured colours.
 
 use crate::config::{GrainShape, Scene, Substrate};
 use crate::optics::appearance::{Appearance, MeasuredColour};
@@ -52,6 +53,7 @@ pub fn baseline_input(scene: &Scene) -> Result<Option<BaselineInput>, PipelineEr
         paper_albedo: albedo,
         species,
         size_quadrature: Default::default(),
+        equation: scene.solver.equation,
     }))
 }
 

@@ -312,12 +312,16 @@ fn product_lines(scene: &Scene) -> Vec<String> {
             "tile and colours: skipped — not requested".to_string()
         },
     ];
-    for b in &scene.appearance.baseline {
+    for &b in &scene.appearance.baseline {
+        let grains = crate::optics::baseline::grain::GrainModel::of(scene.solver.equation);
+        let surfaces = crate::optics::baseline::surfaces(b, scene.solver.equation);
         lines.push(format!(
-            "baseline: {} computed beside the measured colours (equal-volume scalar spheres in \
-             the binder, independent scattering; {}; nominal sizes, shapes and clusters not seen)",
+            "baseline: {} computed beside the measured colours (equal-volume spheres in the \
+             binder, {}, independent scattering; {}; {} surfaces; shapes and clusters not seen)",
             b.name(),
-            b.summary()
+            grains.name(),
+            b.summary(),
+            surfaces.name()
         ));
     }
     if products.merl {

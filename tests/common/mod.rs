@@ -1,5 +1,5 @@
 //! Set-up shared by the tests: the program run as a user runs it,
-//! closed-form slab references, a packed layer
+//! closed-form slab references, a reader of the JSON fixtures, a packed layer
 //! of one pigment, runs on a thread pool of a given size, and builders of
 //! scene and study files (a test names only what it varies).
 #![allow(dead_code)]

@@ -122,12 +122,16 @@ impl Checker<'_> {
                      surfaces and coupling are scalar (s-like); use \"helmholtz\"",
                 ));
             }
-            if !appearance.baseline.is_empty() {
+            // The baselines are computed for natural light (Mie grains,
+            // unpolarised surfaces): beside an unpolarised solve only.
+            let polarised = solver.polarisation != crate::config::Polarisation::Unpolarised;
+            if !appearance.baseline.is_empty() && polarised {
                 return Err(self.invalid(
                     "appearance.baseline",
-                    "the radiative-transfer baselines are scalar (s-like Fresnel surfaces, \
-                     scalar Mie grains) and cannot stand beside a Maxwell solve yet: remove \
-                     appearance.baseline or use solver.equation = \"helmholtz\"",
+                    "beside a Maxwell solve the radiative-transfer baselines are for natural \
+                     light (Mie grains, unpolarised Fresnel surfaces) and cannot stand beside \
+                     one linear polarisation: remove appearance.baseline or \
+                     illumination.polarisation",
                 ));
             }
         }

@@ -10,16 +10,18 @@
 //! - `R↓ = R↓₁ + T↑₁ R↓₂ (I − R↑₁ R↓₂)⁻¹ T↓₁`, `T↓ = T↓₂ (I − R↑₁ R↓₂)⁻¹ T↓₁`;
 //! - `R↑ = R↑₂ + T↓₂ R↑₁ (I − R↓₂ R↑₁)⁻¹ T↑₂`, `T↑ = T↑₁ (I − R↓₂ R↑₁)⁻¹ T↑₂`.
 //!
-//! **Interfaces.** The solver solves the scalar Helmholtz equation, in
-//! which `u` and `∂u/∂z` are continuous across a flat interface
-//! (`solver/airy`): that is the s-polarised (TE) Fresnel coefficient,
-//! `r = (n₁μ₁ − n₂μ₂)/(n₁μ₁ + n₂μ₂)`, reflectance `r²`, transmittance
-//! `1 − r²` — the scalar interface, used throughout. Between the binder
+//! **Interfaces.** The scalar Helmholtz equation keeps `u` and `∂u/∂z`
+//! continuous across a flat interface (`solver/airy`): that is the
+//! s-polarised (TE) Fresnel coefficient, `r = (n₁μ₁ − n₂μ₂)/(n₁μ₁ + n₂μ₂)`,
+//! reflectance `r²`, transmittance `1 − r²` — the scalar interface. Beside
+//! a Maxwell solve the interface reflects natural light, the mean of the s
+//! and p powers ([`Fresnel`]). Between the binder
 //! (`n`) and air a bin keeps its flux across the surface (the bins are
 //! matched by refraction, [`Ordinates`]), so an interface is diagonal:
 //! `r(μ_i)` for an escaping bin, and total internal reflection (1 from
 //! inside, no flux from outside) for a trapped one.
 
+use super::fresnel::Fresnel;
 use super::matrix::Matrix;
 use super::ordinates::Ordinates;
 use super::BaselineError;
@@ -101,15 +103,16 @@ pub fn fresnel_scalar(n: f64, mu: f64, mu_air: f64) -> f64 {
     r * r
 }
 
-/// The flat binder surface with air above and the binder below.
-pub fn surface_air_over_binder(ords: &Ordinates) -> Slab {
+/// The flat binder surface with air above and the binder below, reflecting
+/// by `fresnel`.
+pub fn surface_air_over_binder(ords: &Ordinates, fresnel: Fresnel) -> Slab {
     let n = ords.binder_index;
     let k = ords.len();
     let (mut r_air, mut r_binder, mut t) = (vec![0.0; k], vec![0.0; k], vec![0.0; k]);
     for i in 0..k {
         match ords.mu_air[i] {
             Some(mu_a) => {
-                let r = fresnel_scalar(n, ords.mu[i], mu_a);
+                let r = fresnel.between(n, ords.mu[i], mu_a);
                 r_air[i] = r;
                 r_binder[i] = r;
                 t[i] = 1.0 - r;
@@ -127,8 +130,8 @@ pub fn surface_air_over_binder(ords: &Ordinates) -> Slab {
 }
 
 /// The flat binder surface with the binder above and air below.
-pub fn surface_binder_over_air(ords: &Ordinates) -> Slab {
-    surface_air_over_binder(ords).flipped()
+pub fn surface_binder_over_air(ords: &Ordinates, fresnel: Fresnel) -> Slab {
+    surface_air_over_binder(ords, fresnel).flipped()
 }
 
 /// Reflection matrix of a Lambertian paper of albedo `albedo` under air:

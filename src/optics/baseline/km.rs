@@ -93,6 +93,21 @@ pub fn internal_reflectance(binder_index: f64) -> f64 {
     mu_c * mu_c + gauss(integrand, 0.0, 1.0, 64)
 }
 
+/// The unpolarised surface's reflectance for Lambertian light from air,
+/// `r_ed = ∫₀¹ R(μ_a) 2μ_a dμ_a` (smooth in `μ_a`: composite Gauss).
+pub fn diffuse_external_reflectance(binder_index: f64) -> f64 {
+    gauss(
+        |mu_a: f64| {
+            external_reflectance(binder_index, mu_a.clamp(0.0, 1.0).acos().to_degrees())
+                * 2.0
+                * mu_a
+        },
+        0.0,
+        1.0,
+        64,
+    )
+}
+
 /// Scalar (TE) Fresnel reflectance of the binder's surface for light from
 /// air at `polar_deg`: the interface of the scalar wave equation the solver
 /// solves (`u` and `∂u/∂z` continuous, `solver/airy`),

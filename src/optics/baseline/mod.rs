@@ -9,11 +9,14 @@
 //!    the sphere of equal volume (radius `d/2`, `d` the grain's effective
 //!    diameter: the shape and any clusters are not seen) in the binder
 //!    (real index `n_b`). Its cross sections,
-//!    asymmetry parameter `g` and phase function come from the *scalar*
-//!    partial-wave solution at the wavelength in the binder `λ/n_b` with
-//!    relative permittivity `ε_s/ε_b`, `ε_s = (n + ik)²`: the solver solves
-//!    the scalar Helmholtz equation, so the scalar sphere is its consistent
-//!    single scatterer.
+//!    asymmetry parameter `g` and phase function come from the sphere
+//!    solution of the scene's equation ([`grain::GrainModel`]) at the
+//!    wavelength in the binder `λ/n_b` with relative permittivity
+//!    `ε_s/ε_b`, `ε_s = (n + ik)²`: beside the scalar Helmholtz equation the
+//!    *scalar* partial-wave sphere ([`sphere`]), beside Maxwell's equations
+//!    Mie theory ([`mie`], phase function of natural light) — each the
+//!    consistent single scatterer of the equation the wave solution
+//!    solves.
 //! 2. **Sizes** ([`sizes`]): a fixed size is the one sphere of the nominal
 //!    diameter `d` (`diameter_nm`). A size distribution (`pigment.size`,
 //!    normal or log-normal, truncated at 3σ as the geometry draws it) is a
@@ -51,13 +54,15 @@
 //! but under it the wave scene's boundary — the binder's lower surface, an
 //! air gap, the paper — as the effective backing
 //! `R_g = r_i + (1 − r_i) ρ (1 − r_ed)/(1 − ρ r_ed)` ([`km::scene_backing`]),
-//! and every surface with the scalar (TE) Fresnel reflectance of the
-//! solver's equation (`r_e`, `r_ed` from air, `r_i` from inside).
+//! and every surface with the Fresnel reflectance of the solver's equation
+//! ([`fresnel::Fresnel`]: s-like (TE) beside Helmholtz, the mean of s and p
+//! beside Maxwell; `r_e`, `r_ed` from air, `r_i` from inside).
 //!
 //! **Adding–doubling** (`adding-doubling`, scene boundary;
 //! `adding-doubling-contact`, paper in optical contact): the radiative
 //! transfer equation itself for the same medium, with the phase function,
-//! refraction and total internal reflection at the surfaces and the exact
+//! refraction and total internal reflection at the surfaces (the Fresnel
+//! law of the solver's equation, as for `kubelka-munk-scene`) and the exact
 //! measurement directions ([`transfer`]).
 //!
 //! **Colour**: the spectrum on the spectral proxy's fine grid, through the
@@ -68,16 +73,22 @@
 
 pub mod adding;
 pub mod doubling;
+pub mod fresnel;
+pub mod grain;
 pub mod halftone;
 pub mod km;
 pub mod matrix;
+pub mod mie;
 pub mod ordinates;
 pub mod sizes;
+pub mod special;
 pub mod sphere;
 pub mod transfer;
 
-use crate::config::{Baseline, GrainSize, Measurement};
+use crate::config::{Baseline, Equation, GrainSize, Measurement};
 use crate::optics::colour::{self, ColourError, Observer};
+use fresnel::Fresnel;
+use grain::GrainModel;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use thiserror::Error;
@@ -127,6 +138,10 @@ pub struct BaselineInput {
     pub species: Vec<BaselineSpecies>,
     /// The quadrature over each species' size distribution.
     pub size_quadrature: sizes::SizeQuadrature,
+    /// The equation of the wave solution the baseline stands beside: it
+    /// picks the grains' sphere solution ([`GrainModel::of`]) and the flat
+    /// surfaces' Fresnel law ([`surfaces`]).
+    pub equation: Equation,
 }
 
 /// The KM coefficients at one wavelength (1/nm).
@@ -145,7 +160,8 @@ pub struct KmCoefficients {
 /// One grain species, or one diameter of its size distribution, at one
 /// wavelength, as the independent-scattering models see it: number density
 /// (1/nm³), the binder's wavenumber `k`, the permittivity relative to the
-/// binder, the equal-volume radius and the scalar sphere's cross sections.
+/// binder, the equal-volume radius and the cross sections of the input's
+/// [`GrainModel`].
 pub(crate) struct GrainTerms {
     pub number: f64,
     pub k: f64,
@@ -163,6 +179,7 @@ pub(crate) fn at_wavelength(input: &BaselineInput, l: usize) -> (f64, Vec<GrainT
     let nb = input.binder_index;
     let eps_b = nb * nb;
     let k0 = 2.0 * PI / input.wavelengths_nm[l];
+    let model = GrainModel::of(input.equation);
     let mut dissolved = 0.0;
     let mut grains = Vec::new();
     for sp in &input.species {
@@ -184,7 +201,7 @@ pub(crate) fn at_wavelength(input: &BaselineInput, l: usize) -> (f64, Vec<GrainT
                 k,
                 eps_rel,
                 radius,
-                cross: sphere::cross_sections(k, eps_rel, radius),
+                cross: model.cross_sections(k, eps_rel, radius),
             });
         }
     }
@@ -218,18 +235,32 @@ pub fn body_reflectance(input: &BaselineInput) -> Vec<f64> {
 }
 
 /// The reflectance factor an instrument in geometry `m` reads from a body
-/// reflectance `r` under a binder surface of index `binder_index`.
-pub fn measured_factor(m: Measurement, r: f64, binder_index: f64) -> f64 {
-    let r_i = km::internal_reflectance(binder_index);
+/// reflectance `r` under a binder surface of index `binder_index` that
+/// reflects by `fresnel`: Saunderson's correction with its `r_e` and `r_i`.
+pub fn measured_factor_of(fresnel: Fresnel, m: Measurement, r: f64, binder_index: f64) -> f64 {
+    let r_i = fresnel.internal(binder_index);
+    let r_e = |deg| fresnel.external(binder_index, deg);
     match m {
-        Measurement::FortyFiveZero => {
-            km::saunderson_excluded(r, km::external_reflectance(binder_index, 45.0), r_i)
-        }
-        Measurement::DiffuseEightSce => {
-            km::saunderson_excluded(r, km::external_reflectance(binder_index, 8.0), r_i)
-        }
-        Measurement::DiffuseEightSci => {
-            km::saunderson(r, km::external_reflectance(binder_index, 8.0), r_i)
+        Measurement::FortyFiveZero => km::saunderson_excluded(r, r_e(45.0), r_i),
+        Measurement::DiffuseEightSce => km::saunderson_excluded(r, r_e(8.0), r_i),
+        Measurement::DiffuseEightSci => km::saunderson(r, r_e(8.0), r_i),
+    }
+}
+
+/// [`measured_factor_of`] the unpolarised surface (Saunderson's, as
+/// `kubelka-munk` has it beside either equation).
+pub fn measured_factor(m: Measurement, r: f64, binder_index: f64) -> f64 {
+    measured_factor_of(Fresnel::Unpolarised, m, r, binder_index)
+}
+
+/// The surfaces' Fresnel law of `model` beside a solve of `equation`:
+/// `kubelka-munk` keeps Saunderson's unpolarised surface; the models on the
+/// wave scene's boundary take the equation's ([`Fresnel::of`]).
+pub fn surfaces(model: Baseline, equation: Equation) -> Fresnel {
+    match model {
+        Baseline::KubelkaMunk => Fresnel::Unpolarised,
+        Baseline::KubelkaMunkScene | Baseline::AddingDoubling | Baseline::AddingDoublingContact => {
+            Fresnel::of(equation)
         }
     }
 }
@@ -239,6 +270,10 @@ pub fn measured_factor(m: Measurement, r: f64, binder_index: f64) -> f64 {
 pub struct BaselineColour {
     /// The model that computed it.
     pub model: Baseline,
+    /// Its grains' sphere solution.
+    pub grains: GrainModel,
+    /// Its flat surfaces' Fresnel law.
+    pub surfaces: Fresnel,
     pub geometry: Measurement,
     /// The fine grid, nm.
     pub spectrum_wavelengths_nm: Vec<f64>,
@@ -279,13 +314,15 @@ pub fn kubelka_munk(
 }
 
 /// The body reflectance of the KM layer on the wave scene's boundary
-/// ([`km::scene_backing`] with the scalar surface) on the grid.
+/// ([`km::scene_backing`] with the surface of the input's equation) on the
+/// grid.
 pub fn body_reflectance_scene(input: &BaselineInput) -> Vec<f64> {
     let n = input.binder_index;
+    let fresnel = Fresnel::of(input.equation);
     let r_g = km::scene_backing(
         input.paper_albedo,
-        km::internal_reflectance_scalar(n),
-        km::diffuse_external_reflectance_scalar(n),
+        fresnel.internal(n),
+        fresnel.diffuse_external(n),
     );
     (0..input.wavelengths_nm.len())
         .map(|l| {
@@ -299,13 +336,7 @@ pub fn body_reflectance_scene(input: &BaselineInput) -> Vec<f64> {
 /// under the scalar (TE) surface of index `binder_index`: Saunderson's
 /// correction with the scalar `r_e` and `r_i`.
 pub fn measured_factor_scalar(m: Measurement, r: f64, binder_index: f64) -> f64 {
-    let r_i = km::internal_reflectance_scalar(binder_index);
-    let r_e = |deg| km::external_reflectance_scalar(binder_index, deg);
-    match m {
-        Measurement::FortyFiveZero => km::saunderson_excluded(r, r_e(45.0), r_i),
-        Measurement::DiffuseEightSce => km::saunderson_excluded(r, r_e(8.0), r_i),
-        Measurement::DiffuseEightSci => km::saunderson(r, r_e(8.0), r_i),
-    }
+    measured_factor_of(Fresnel::Scalar, m, r, binder_index)
 }
 
 /// The reflectance factors of `model` for every geometry in
@@ -315,18 +346,21 @@ pub fn reflectance_factors(
     input: &BaselineInput,
     measurements: &[Measurement],
 ) -> Result<Vec<Vec<f64>>, BaselineError> {
-    let km_factors = |body: Vec<f64>, f: fn(Measurement, f64, f64) -> f64| {
+    let fresnel = surfaces(model, input.equation);
+    let km_factors = |body: Vec<f64>| {
         measurements
             .iter()
-            .map(|&m| body.iter().map(|&r| f(m, r, input.binder_index)).collect())
+            .map(|&m| {
+                body.iter()
+                    .map(|&r| measured_factor_of(fresnel, m, r, input.binder_index))
+                    .collect()
+            })
             .collect()
     };
     let params = ordinates::OrdinateParams::default();
     Ok(match model {
-        Baseline::KubelkaMunk => km_factors(body_reflectance(input), measured_factor),
-        Baseline::KubelkaMunkScene => {
-            km_factors(body_reflectance_scene(input), measured_factor_scalar)
-        }
+        Baseline::KubelkaMunk => km_factors(body_reflectance(input)),
+        Baseline::KubelkaMunkScene => km_factors(body_reflectance_scene(input)),
         Baseline::AddingDoubling => {
             transfer::reflectance_factors(input, transfer::Boundary::Scene, measurements, params)?
         }
@@ -422,6 +456,8 @@ fn colours(
         let lab = colour::xyz_to_lab(xyz, observer.white_xyz());
         out.push(BaselineColour {
             model,
+            grains: GrainModel::of(input.equation),
+            surfaces: surfaces(model, input.equation),
             geometry: m,
             spectrum_wavelengths_nm: input.wavelengths_nm.clone(),
             reflectance_factor: factor,

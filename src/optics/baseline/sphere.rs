@@ -15,42 +15,9 @@
 //! - `g = ∫|f|² cos θ dΩ / σ_sca = Σ 2(l+1) Re(c_l c*_{l+1}) / Σ (2l+1)|c_l|²`
 //!   (from `∫ P_l P_{l+1} x dx = 2(l+1)/((2l+1)(2l+3))`).
 
+use super::special::{bessel_j, hankel, legendre_moments};
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
-
-/// Spherical Bessel j_0..=j_lmax of a complex argument by Miller's downward
-/// recurrence, normalised by j_0 = sin z / z.
-pub fn bessel_j(z: C64, lmax: usize) -> Vec<C64> {
-    let start = lmax + 30 + z.norm() as usize;
-    let mut j = vec![C64::new(0.0, 0.0); start + 2];
-    j[start + 1] = C64::new(0.0, 0.0);
-    j[start] = C64::new(1e-30, 0.0);
-    for l in (1..=start).rev() {
-        j[l - 1] = (2 * l + 1) as f64 / z * j[l] - j[l + 1];
-        // Keep the recurrence in range for large orders.
-        if j[l - 1].norm() > 1e250 {
-            for v in &mut j[l - 1..] {
-                *v *= 1e-250;
-            }
-        }
-    }
-    let scale = (z.sin() / z) / j[0];
-    j.truncate(lmax + 1);
-    j.iter().map(|v| v * scale).collect()
-}
-
-/// Spherical Hankel h_l^(1) of a real argument by upward recurrence (stable).
-pub fn hankel(x: f64, lmax: usize) -> Vec<C64> {
-    let i = C64::i();
-    let mut h = vec![-i * (i * x).exp() / x];
-    h.push((i * x).exp() * (-i / (x * x) - 1.0 / x));
-    for l in 1..lmax {
-        let next = (2 * l + 1) as f64 / x * h[l] - h[l - 1];
-        h.push(next);
-    }
-    h.truncate(lmax + 1);
-    h
-}
 
 /// f_l'(z) = f_{l−1}(z) − (l+1)/z f_l(z) for l ≥ 1; f_0' = −f_1.
 fn derivative(f: &[C64], z: C64) -> Vec<C64> {
@@ -164,21 +131,7 @@ pub fn phase_moments(k: f64, eps_rel: C64, a: f64) -> Vec<f64> {
     }
     let lmax = orders_needed(k * a, eps_rel.sqrt().norm());
     let c = coefficients(k, eps_rel, a, lmax);
-    let orders = 2 * lmax + 1;
-    let (x, w) = super::ordinates::gauss_legendre(2 * lmax + 2);
-    let mut m = vec![0.0; orders];
-    for (&x, &w) in x.iter().zip(&w) {
-        let f2 = amplitude(&c, k, x).norm_sqr() * w * 2.0 * PI;
-        let (mut p0, mut p1) = (1.0, x);
-        m[0] += f2;
-        for (n, mn) in m.iter_mut().enumerate().skip(1) {
-            *mn += f2 * p1;
-            let p2 = ((2 * n + 1) as f64 * x * p1 - n as f64 * p0) / (n + 1) as f64;
-            p0 = p1;
-            p1 = p2;
-        }
-    }
-    m
+    legendre_moments(2 * lmax, |x| amplitude(&c, k, x).norm_sqr())
 }
 
 #[cfg(test)]

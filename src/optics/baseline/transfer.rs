@@ -6,8 +6,10 @@
 //! Kubelka–Munk baseline, [`super::coefficients`]): `μa = Σ N_s σ_abs,s`
 //! (plus a dissolved pigment's `f k₀ Im ε / n_b`), `μs = Σ N_s σ_sca,s`, and
 //! the phase function of the mixture weighted by `N_s σ_sca,s`: Legendre
-//! moments `χ_n = Σ N_s m_n,s / Σ N_s σ_sca,s` from the scalar sphere
-//! ([`super::sphere::phase_moments`]), `s` running over the species and,
+//! moments `χ_n = Σ N_s m_n,s / Σ N_s σ_sca,s` from the grain model of the
+//! input's equation ([`super::grain::GrainModel`]: the scalar sphere's
+//! `|f|²` beside the Helmholtz equation, Mie's `(|S_1|² + |S_2|²)/2` beside
+//! Maxwell's), `s` running over the species and,
 //! for a size distribution, over its diameters ([`super::sizes`]). No
 //! diffusion-approximation factors.
 //!
@@ -15,7 +17,9 @@
 //! index `n_b` with the scatterers, [`doubling::homogeneous`]), then the
 //! [`Boundary`]: the scene's (binder → air gap → Lambertian paper, as the
 //! wave scene is built) or Saunderson's contact (paper in optical contact
-//! with the binder).
+//! with the binder). Every flat surface reflects by the [`Fresnel`] law of
+//! the input's equation (s-like beside Helmholtz, natural light's beside
+//! Maxwell).
 //!
 //! **Geometries** (azimuthally averaged radiance, Fourier term `m = 0`,
 //! suffices for all three): 45°/0° is the bidirectional reflectance factor
@@ -27,11 +31,13 @@
 //! the lower surface through the layer (what the wave scene's (0,0) order
 //! carries).
 
-use super::adding::{self, fresnel_scalar, Slab};
+use super::adding::{self, Slab};
 use super::doubling::{self, Medium};
+use super::fresnel::Fresnel;
+use super::grain::GrainModel;
 use super::matrix::Matrix;
 use super::ordinates::{OrdinateParams, Ordinates};
-use super::{sphere, BaselineError, BaselineInput};
+use super::{BaselineError, BaselineInput};
 use crate::config::Measurement;
 
 /// What lies under the layer.
@@ -51,12 +57,13 @@ pub const AIR_DIRECTIONS_DEG: [f64; 3] = [0.0, 8.0, 45.0];
 /// The radiative-transfer medium at wavelength index `l` of the grid.
 pub fn medium(input: &BaselineInput, l: usize) -> Medium {
     let (mut mu_a, grains) = super::at_wavelength(input, l);
+    let model = GrainModel::of(input.equation);
     let mut mu_s = 0.0;
     let mut moments: Vec<f64> = Vec::new();
     for g in &grains {
         mu_a += g.number * g.cross.absorption.max(0.0);
         mu_s += g.number * g.cross.scattering;
-        let m = sphere::phase_moments(g.k, g.eps_rel, g.radius);
+        let m = model.phase_moments(g.k, g.eps_rel, g.radius);
         if moments.len() < m.len() {
             moments.resize(m.len(), 0.0);
         }
@@ -118,15 +125,17 @@ impl StackReflection {
 }
 
 /// The stack's reflection for `medium` in a layer `thickness_nm` thick of
-/// binder index `binder_index` on paper of `albedo` under `boundary`.
+/// binder index `binder_index` on paper of `albedo` under `boundary`, the
+/// flat surfaces reflecting by `fresnel`.
 pub fn stack(
     ords: Ordinates,
     medium: &Medium,
     thickness_nm: f64,
     albedo: f64,
     boundary: Boundary,
+    fresnel: Fresnel,
 ) -> Result<StackReflection, BaselineError> {
-    stack_of_layers(ords, &[(medium, thickness_nm)], albedo, boundary)
+    stack_of_layers(ords, &[(medium, thickness_nm)], albedo, boundary, fresnel)
 }
 
 /// The same for several layers of one binder, top first, each a medium and
@@ -136,6 +145,7 @@ pub fn stack_of_layers(
     layers: &[(&Medium, f64)],
     albedo: f64,
     boundary: Boundary,
+    fresnel: Fresnel,
 ) -> Result<StackReflection, BaselineError> {
     let mut body = Slab::transparent(ords.len());
     for &(medium, thickness_nm) in layers {
@@ -143,14 +153,17 @@ pub fn stack_of_layers(
     }
     let backing = match boundary {
         Boundary::Scene => adding::on_backing(
-            &adding::surface_binder_over_air(&ords),
+            &adding::surface_binder_over_air(&ords, fresnel),
             &adding::lambertian_in_air(&ords, albedo),
         )?,
         Boundary::Contact => adding::lambertian_in_binder(&ords, albedo),
     };
     let under_surface = adding::on_backing(&body, &backing)?;
-    let r = adding::on_backing(&adding::surface_air_over_binder(&ords), &under_surface)?;
-    let specular = mirror_reflectance(&ords, layers, boundary);
+    let r = adding::on_backing(
+        &adding::surface_air_over_binder(&ords, fresnel),
+        &under_surface,
+    )?;
+    let specular = mirror_reflectance(&ords, layers, boundary, fresnel);
     Ok(StackReflection { ords, r, specular })
 }
 
@@ -162,6 +175,7 @@ pub fn mirror_reflectance(
     ords: &Ordinates,
     layers: &[(&Medium, f64)],
     boundary: Boundary,
+    fresnel: Fresnel,
 ) -> Vec<f64> {
     let direct: Vec<Slab> = layers
         .iter()
@@ -175,7 +189,7 @@ pub fn mirror_reflectance(
             let Some(mu_a) = ords.mu_air[i] else {
                 return 0.0;
             };
-            let rt = fresnel_scalar(ords.binder_index, ords.mu[i], mu_a);
+            let rt = fresnel.between(ords.binder_index, ords.mu[i], mu_a);
             let rb = match boundary {
                 Boundary::Scene => rt,
                 Boundary::Contact => 0.0,
@@ -198,7 +212,7 @@ pub fn reflectance_factors(
 }
 
 /// The same for a stack of layers (top first) of one binder on one grid:
-/// the binder, the paper and the grid are the top layer's.
+/// the binder, the paper, the grid and the equation are the top layer's.
 pub fn stack_reflectance_factors(
     inputs: &[BaselineInput],
     boundary: Boundary,
@@ -209,6 +223,7 @@ pub fn stack_reflectance_factors(
         return Ok(vec![Vec::new(); measurements.len()]);
     };
     let ords = Ordinates::new(top.binder_index, params, &AIR_DIRECTIONS_DEG)?;
+    let fresnel = Fresnel::of(top.equation);
     let mut out = vec![Vec::with_capacity(top.wavelengths_nm.len()); measurements.len()];
     for l in 0..top.wavelengths_nm.len() {
         let media: Vec<Medium> = inputs.iter().map(|i| medium(i, l)).collect();
@@ -217,7 +232,7 @@ pub fn stack_reflectance_factors(
             .zip(inputs)
             .map(|(m, i)| (m, i.thickness_nm))
             .collect();
-        let s = stack_of_layers(ords.clone(), &layers, top.paper_albedo, boundary)?;
+        let s = stack_of_layers(ords.clone(), &layers, top.paper_albedo, boundary, fresnel)?;
         for (g, &geometry) in measurements.iter().enumerate() {
             out[g].push(s.factor(geometry)?);
         }
@@ -226,13 +241,15 @@ pub fn stack_reflectance_factors(
 }
 
 /// A slab's reflection and transmission on its own, for checks: the
-/// homogeneous layer of `medium` between the binder's two surfaces, in air.
+/// homogeneous layer of `medium` between the binder's two surfaces, in air,
+/// reflecting by `fresnel`.
 pub fn free_layer(
     ords: &Ordinates,
     medium: &Medium,
     thickness_nm: f64,
+    fresnel: Fresnel,
 ) -> Result<Slab, BaselineError> {
     let layer = doubling::homogeneous(ords, medium, thickness_nm)?;
-    let lower = adding::add(&layer, &adding::surface_binder_over_air(ords))?;
-    adding::add(&adding::surface_air_over_binder(ords), &lower)
+    let lower = adding::add(&layer, &adding::surface_binder_over_air(ords, fresnel))?;
+    adding::add(&adding::surface_air_over_binder(ords, fresnel), &lower)
 }

@@ -2,7 +2,8 @@
 //! top surface, each layer's [`LayerSlab`] from the top down (incoherently:
 //! one layer's fragment is uncorrelated with the next's, so fluxes add),
 //! the binder's flat lower surface, and under it the paper in air (the wave
-//! scene's boundary) or nothing.
+//! scene's boundary) or nothing. The flat surfaces are the scalar (s-like)
+//! ones: a stack is solved with the Helmholtz equation.
 //!
 //! The mirror reflection (what a gloss trap removes, d/8° SCE) is the light
 //! that met only specular orders on its way: the same adding over each
@@ -17,6 +18,7 @@
 
 use super::flux::LayerSlab;
 use crate::optics::baseline::adding::{self, Slab};
+use crate::optics::baseline::fresnel::Fresnel;
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::baseline::transfer::StackReflection;
@@ -35,11 +37,11 @@ pub enum Below {
 /// The stack of `layers` (top first) between the binder's two flat
 /// surfaces, in air on both sides: reflection and transmission of the whole.
 pub fn free_stack(ords: &Ordinates, layers: &[&Slab]) -> Result<Slab, BaselineError> {
-    let mut s = adding::surface_air_over_binder(ords);
+    let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
     for l in layers {
         s = adding::add(&s, l)?;
     }
-    adding::add(&s, &adding::surface_binder_over_air(ords))
+    adding::add(&s, &adding::surface_binder_over_air(ords, Fresnel::Scalar))
 }
 
 /// The reflection of the stack of `layers` (top first) on `below`, and its
@@ -49,7 +51,7 @@ pub fn stack_reflection(
     layers: &[&LayerSlab],
     below: Below,
 ) -> Result<StackReflection, BaselineError> {
-    let lower = adding::surface_binder_over_air(ords);
+    let lower = adding::surface_binder_over_air(ords, Fresnel::Scalar);
     let backing = match below {
         Below::Paper { albedo } => {
             adding::on_backing(&lower, &adding::lambertian_in_air(ords, albedo))?
@@ -57,7 +59,7 @@ pub fn stack_reflection(
         Below::Air => lower.r_down.clone(),
     };
     let reflect = |slabs: Vec<&Slab>, backing: &Matrix| -> Result<Matrix, BaselineError> {
-        let mut s = adding::surface_air_over_binder(ords);
+        let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
         for l in slabs {
             s = adding::add(&s, l)?;
         }
@@ -101,10 +103,10 @@ pub fn plane_factors(
 ) -> Result<Array2<f64>, BaselineError> {
     let node = |deg: f64| ords.air_node(deg).ok_or(BaselineError::NoDirection(deg));
     let terms = layers.first().map_or(0, |l| l.azimuthal.len());
-    let lower = adding::surface_binder_over_air(ords);
+    let lower = adding::surface_binder_over_air(ords, Fresnel::Scalar);
     let mut sum = sr.r.clone();
     for m in 0..terms {
-        let mut s = adding::surface_air_over_binder(ords);
+        let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
         for l in layers {
             s = adding::add(&s, &l.azimuthal[m])?;
         }

@@ -411,11 +411,26 @@ pub(super) fn write_baselines(
     for model in models {
         let mg = bg.create_group(model.name())?;
         write_str_attr(&mg, "model", model.name())?;
+        let mut first = true;
         for b in baseline.iter().filter(|b| b.model == model) {
+            if first {
+                write_models(&mg, b)?;
+                first = false;
+            }
             write_baseline(s, &mg, b)?;
         }
     }
     Ok(())
+}
+
+/// The grain and surface models a baseline used, on its model's group:
+/// `grain_model` and `surface_model` by name, each with a
+/// `<attribute>_description`.
+fn write_models(g: &hdf5::Group, b: &BaselineColour) -> hdf5::Result<()> {
+    write_str_attr(g, "grain_model", b.grains.name())?;
+    write_str_attr(g, "grain_model_description", b.grains.description())?;
+    write_str_attr(g, "surface_model", b.surfaces.name())?;
+    write_str_attr(g, "surface_model_description", b.surfaces.description())
 }
 
 /// `/appearance/baseline/<model>/<slug>`: one baseline model's colour in

@@ -21,6 +21,7 @@
 //! `r(μ_i)` for an escaping bin, and total internal reflection (1 from
 //! inside, no flux from outside) for a trapped one.
 
+pub use super::fresnel::fresnel_scalar;
 use super::fresnel::Fresnel;
 use super::matrix::Matrix;
 use super::ordinates::Ordinates;
@@ -93,14 +94,6 @@ pub fn add(top: &Slab, bottom: &Slab) -> Result<Slab, BaselineError> {
 pub fn on_backing(top: &Slab, backing: &Matrix) -> Result<Matrix, BaselineError> {
     let down = top.r_up.mul(backing).identity_minus().solve(&top.t_down)?;
     Ok(top.r_down.add(&top.t_up.mul(backing).mul(&down)))
-}
-
-/// Scalar (TE) Fresnel reflectance between the binder direction `mu` and
-/// its air direction `mu_air`, for a binder of index `n`:
-/// `((n μ − μ_a)/(n μ + μ_a))²`, the same from either side.
-pub fn fresnel_scalar(n: f64, mu: f64, mu_air: f64) -> f64 {
-    let r = (n * mu - mu_air) / (n * mu + mu_air);
-    r * r
 }
 
 /// The flat binder surface with air above and the binder below, reflecting

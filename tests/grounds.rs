@@ -284,3 +284,53 @@ fn a_constant_csv_ground_is_the_white_ground_of_that_albedo() {
         .all(|(p, q)| (p - q).abs() < 1e-12));
     assert_eq!(tc.tile_srgb8, tw.tile_srgb8);
 }
+
+#[test]
+fn ground_keys_are_checked_with_the_key_and_range_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    for (substrate, want) in [
+        (
+            "{ kind = \"black\", albedo = 0.1 }",
+            "unknown field `albedo`",
+        ),
+        (
+            "{ kind = \"white\", albedo = 1.5 }",
+            "key `substrate.albedo`: must be in [0, 1], got 1.5",
+        ),
+        (
+            "{ kind = \"chart\", white_albedo = -0.1 }",
+            "key `substrate.white_albedo`: must be in [0, 1]",
+        ),
+        (
+            "{ kind = \"chart\", white_albedo = 0.8, white_csv = \"w.csv\" }",
+            "key `substrate.white_csv`: give the white half's albedo",
+        ),
+        (
+            "{ kind = \"csv\", file = \"missing.csv\" }",
+            "key `substrate.file`: cannot read",
+        ),
+    ] {
+        let e = SceneToml::tiny()
+            .raw("substrate", substrate)
+            .parse(&path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&path.display().to_string()) && e.contains(want) && !e.contains('\n'),
+            "{substrate}: {e}"
+        );
+    }
+    // The defaults: white 0.8, a chart's white half 0.8, paper 0.9.
+    for (substrate, albedo) in [
+        ("{ kind = \"white\" }", 0.8),
+        ("{ kind = \"chart\" }", 0.8),
+        ("{ kind = \"paper\" }", 0.9),
+    ] {
+        let s = SceneToml::tiny()
+            .raw("substrate", substrate)
+            .parse(&path)
+            .unwrap();
+        assert_eq!(s.substrate.ground().unwrap().constant(), Some(albedo));
+    }
+}

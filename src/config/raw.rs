@@ -426,8 +426,10 @@ pub enum RawSubstrate {
     Paper {
         albedo: Option<f64>,
     },
-    None,
-    Black,
+    // Tables without fields (not unit variants), so that a stray key is
+    // refused as for the others.
+    None {},
+    Black {},
     White {
         albedo: Option<f64>,
     },

@@ -69,6 +69,15 @@ pub fn kubelka(r_black: f64, r_white: f64, r_ground: f64, x: f64) -> Kubelka {
         return NAN;
     }
     let b = (a * a - 1.0).sqrt();
+    if r_black == r_white && b > 0.0 {
+        // Complete hiding: the layer is its own R∞, S X = ∞ (the general
+        // formula's arcoth(1), up to rounding).
+        return Kubelka {
+            r_inf: r_black,
+            s: f64::INFINITY,
+            k: f64::INFINITY,
+        };
+    }
     if b == 0.0 {
         // No absorption: the limit b → 0, S X = R_b / (1 − R_b).
         return Kubelka {

@@ -171,14 +171,14 @@ impl Checker<'_> {
             self.range(key, a, (0.0..=1.0).contains(&a), "[0, 1]")
         };
         Ok(match raw {
-            Some(RawSubstrate::None) => Substrate::None,
+            Some(RawSubstrate::None {}) => Substrate::None,
             None => Substrate::Paper {
                 albedo: DEFAULT_PAPER_ALBEDO,
             },
             Some(RawSubstrate::Paper { albedo: a }) => Substrate::Paper {
                 albedo: albedo("substrate.albedo", *a, DEFAULT_PAPER_ALBEDO)?,
             },
-            Some(RawSubstrate::Black) => Substrate::Black,
+            Some(RawSubstrate::Black {}) => Substrate::Black,
             Some(RawSubstrate::White { albedo: a }) => Substrate::White {
                 albedo: albedo("substrate.albedo", *a, DEFAULT_WHITE_ALBEDO)?,
             },

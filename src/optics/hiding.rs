@@ -65,7 +65,7 @@ pub fn kubelka(r_black: f64, r_white: f64, r_ground: f64, x: f64) -> Kubelka {
         return NAN;
     }
     let a = 0.5 * (r_white + (r_black - r_white + r_ground) / (r_black * r_ground));
-    if !(a >= 1.0) {
+    if a.is_nan() || a < 1.0 {
         return NAN;
     }
     let b = (a * a - 1.0).sqrt();

@@ -647,6 +647,64 @@ fn a_wavelength_outside_a_library_material_is_refused_before_any_work() {
 }
 
 #[test]
+fn a_ground_spectrum_outside_its_range_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("ground.csv"),
+        "wavelength_nm,reflectance\n500,0.8\n700,0.85\n",
+    )
+    .unwrap();
+    let scene = SceneToml::tiny()
+        .wavelengths_nm(&[450.0, 600.0])
+        .raw("substrate", "{ kind = \"csv\", file = \"ground.csv\" }")
+        .output(&dir.path().join("out"), "ground");
+    let cfg = scene.write(dir.path());
+    for cmd in ["check", "run"] {
+        let (ok, out, err) = inksim(&[cmd, cfg.to_str().unwrap()]);
+        assert!(!ok && !err.contains("panicked"), "{cmd}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{cmd}: {err}");
+        assert_eq!(
+            err.trim(),
+            format!(
+                "error: {}: key `substrate.file`: wavelength 450 nm is outside the data range \
+                 [500, 700] nm of the ground reflectance `ground.csv` (tables are never \
+                 extrapolated)",
+                cfg.display()
+            ),
+            "{cmd}"
+        );
+        assert!(out.is_empty(), "{cmd}: {out}");
+        assert_eq!(
+            names_in(dir.path()),
+            ["ground.csv", "scene.toml"],
+            "{cmd}: nothing left behind"
+        );
+    }
+    // A chart's white half given as a spectrum is held to the same range.
+    let scene = scene.raw(
+        "substrate",
+        "{ kind = \"chart\", white_csv = \"ground.csv\" }",
+    );
+    let cfg = scene.write(dir.path());
+    let (ok, _, err) = inksim(&["check", cfg.to_str().unwrap()]);
+    assert!(!ok && err.trim().lines().count() == 1, "{err}");
+    assert!(
+        err.contains("key `substrate.white_csv`: wavelength 450 nm"),
+        "{err}"
+    );
+    // Inside the range the same scene runs, and a chart reports its hiding.
+    let scene = scene.wavelengths_nm(&[500.0, 600.0]);
+    let cfg = scene.write(dir.path());
+    let (ok, out, err) = inksim(&["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("hiding (d/8 SCI, D50, 2°): contrast ratio "),
+        "{out}"
+    );
+    assert!(dir.path().join("out/ground.h5").is_file());
+}
+
+#[test]
 fn an_unknown_library_material_lists_the_known_ones() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = library_scene(dir.path(), "titanium-white", &[450.0, 550.0]);

@@ -444,7 +444,8 @@ fn caption(obs: &Observer) -> TileCaption<'_> {
     TileCaption {
         name: "magenta",
         observer: obs,
-        paper_albedo: Some(0.8),
+        ground: "on paper of albedo 0.8",
+        hiding: None,
         azimuth_deg: 0.0,
     }
 }

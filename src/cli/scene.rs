@@ -86,6 +86,18 @@ pub fn run(
         "{} solves, worst energy balance |ΣR+ΣT+A−1| = {worst:.1e}",
         report.entries.len()
     );
+    if let Some(a) = &report.appearance {
+        let conditions = match a.colour_conditions {
+            Some((ill, obs)) => format!("{ill}, {}°", obs.degrees()),
+            None => "custom observer".into(),
+        };
+        for h in &a.hiding {
+            let x_um = a.spec.thickness_nm / 1000.0;
+            for line in inksim::output::hiding::lines(h, &conditions, x_um) {
+                println!("{line}");
+            }
+        }
+    }
     Ok(())
 }
 

@@ -10,6 +10,7 @@
 
 mod check;
 pub mod colour;
+pub mod ground;
 pub mod materials;
 mod method;
 mod raw;
@@ -18,8 +19,12 @@ mod wave;
 
 use std::path::{Path, PathBuf};
 
-pub use check::{load_scene, parse_scene, DEFAULT_PAPER_ALBEDO};
+pub use check::{load_scene, parse_scene};
 pub use colour::{Illuminant, Measurement, StandardObserver};
+pub use ground::{
+    GroundReflectance, ReflectanceSpectrum, SpectrumError, Substrate, DEFAULT_PAPER_ALBEDO,
+    DEFAULT_WHITE_ALBEDO,
+};
 pub use materials::{Material, MaterialError, MaterialSource};
 pub use method::Method;
 pub use stack::{
@@ -399,15 +404,6 @@ pub enum Structure {
     /// `eps_re`, `eps_im` of shape (nz, ny, nx) for every wavelength, or
     /// (L, nz, ny, nx) with `wavelengths_nm` (L) covering the scene's.
     Hdf5(PathBuf),
-}
-
-/// What lies under the layer.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Substrate {
-    /// Nothing: the layer alone in vacuum.
-    None,
-    /// Flat Lambertian paper of the given albedo (METHOD §5).
-    Paper { albedo: f64 },
 }
 
 /// Which appearance products a scene asks for; each one decides which solves

@@ -416,10 +416,28 @@ pub enum RawProduct {
     Preview,
 }
 
-/// `{ kind = "paper", albedo = 0.9 }` or `{ kind = "none" }`.
+/// `{ kind = "paper", albedo = 0.9 }`, `{ kind = "none" }`,
+/// `{ kind = "black" }`, `{ kind = "white", albedo = 0.8 }`,
+/// `{ kind = "csv", file = "ground.csv" }` or
+/// `{ kind = "chart", white_albedo = 0.8 }` / `{ kind = "chart", white_csv = "white.csv" }`.
 #[derive(Debug, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum RawSubstrate {
-    Paper { albedo: Option<f64> },
-    None,
+    Paper {
+        albedo: Option<f64>,
+    },
+    // Tables without fields (not unit variants), so that a stray key is
+    // refused as for the others.
+    None {},
+    Black {},
+    White {
+        albedo: Option<f64>,
+    },
+    Csv {
+        file: String,
+    },
+    Chart {
+        white_albedo: Option<f64>,
+        white_csv: Option<String>,
+    },
 }

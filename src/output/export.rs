@@ -24,6 +24,16 @@
 //!   (`kubelka-munk`, `adding-doubling`, …), `geometry`, `illuminant`,
 //!   `observer_deg`, `L_star`, `a_star`, `b_star`, `C_star_ab`, `h_deg` and
 //!   `de00_to_wave`, its CIEDE2000 to the wave colour of that geometry.
+//! - over a hiding chart (`substrate.kind = "chart"`): `<name>-colours.csv`
+//!   also has the colours over the black half (`geometry` `45/0 over
+//!   black`, …; the plain rows are over the white half), and
+//!   `<name>-hiding.csv` one row per measurement geometry from the
+//!   luminance factors (`wavelength_nm` empty) and one per solved
+//!   wavelength: `geometry`, `wavelength_nm`, `illuminant`,
+//!   `observer_deg`, `contrast_ratio` and `contrast_ratio_se` (Y rows),
+//!   `y_black`, `y_white`, `y_ground` (Y rows), Kubelka's `r_inf`,
+//!   `s_per_um`, `k_per_um` (1/µm), `k_over_s`, each with its `*_se`
+//!   (empty for one realisation of a random layer).
 //!
 //! Numbers are written in the shortest form that reads back to the same
 //! f64; a text field with a comma or a quote is quoted.
@@ -32,7 +42,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::error::IoError;
-use super::h5::{read_appearance, read_baseline, read_measured, read_optional, read_summary};
+use super::h5::{
+    read_appearance, read_baseline, read_hiding, read_measured, read_measured_black, read_optional,
+    read_summary,
+};
 use crate::optics::colour::lab_to_lch;
 use crate::optics::farfield::Side;
 
@@ -246,6 +259,19 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
             ));
         }
     }
+    if let Some((records, _, _)) = read_measured_black(path)? {
+        for r in records {
+            colours.row(lab_row(
+                &format!("{} over black", r.geometry),
+                String::new(),
+                String::new(),
+                r.lab,
+                r.lab_se,
+                r.de00_se,
+                Some(r.xyz),
+            ));
+        }
+    }
     for (o, &view) in a.viewing_deg.iter().enumerate() {
         for c in 0..tile.dim().1 {
             let at = |t: &ndarray::Array3<f64>| [t[[o, c, 0]], t[[o, c, 1]], t[[o, c, 2]]];
@@ -265,6 +291,56 @@ pub fn result_tables(path: &Path) -> Result<Vec<(&'static str, String)>, IoError
         }
     }
     tables.push(("colours", colours.into_text()));
+    let hiding = read_hiding(path)?;
+    if !hiding.is_empty() {
+        let mut t = Csv::new(&[
+            "geometry",
+            "wavelength_nm",
+            "illuminant",
+            "observer_deg",
+            "contrast_ratio",
+            "contrast_ratio_se",
+            "y_black",
+            "y_white",
+            "y_ground",
+            "r_inf",
+            "r_inf_se",
+            "s_per_um",
+            "s_per_um_se",
+            "k_per_um",
+            "k_per_um_se",
+            "k_over_s",
+            "k_over_s_se",
+        ]);
+        for h in &hiding {
+            let mut f = vec![
+                h.geometry.clone(),
+                String::new(),
+                ill.clone(),
+                obs.clone(),
+                num(h.contrast_ratio),
+                opt(h.contrast_ratio_se),
+                num(h.y_black),
+                num(h.y_white),
+                num(h.y_ground),
+            ];
+            for (v, se) in h.at_y {
+                f.push(num(v));
+                f.push(opt(se));
+            }
+            t.row(f);
+            for (l, &wl) in a.wavelengths_nm.iter().enumerate() {
+                let mut f = vec![h.geometry.clone(), num(wl), ill.clone(), obs.clone()];
+                f.extend(std::iter::repeat_n(String::new(), 5));
+                for (v, se) in &h.spectral {
+                    f.push(v.get(l).map_or_else(String::new, |x| num(*x)));
+                    f.push(opt(se.as_ref().and_then(|s| s.get(l).copied())));
+                }
+                t.row(f);
+            }
+        }
+        tables.push(("hiding", t.into_text()));
+    }
     let baseline = read_baseline(path)?;
     if !baseline.is_empty() {
         let mut header = vec!["model", "geometry"];

@@ -142,7 +142,7 @@ impl<'a> RgbBrdf<'a> {
         }
         let paper: Option<Vec<f64>> = a.paper.as_ref().map(|p| {
             (0..nl)
-                .map(|l| p.albedo / (PI * (1.0 - p.albedo * p.r_dd_up.mean[l])))
+                .map(|l| p.albedo[l] / (PI * (1.0 - p.albedo[l] * p.r_dd_up.mean[l])))
                 .collect()
         });
         let coverage: Vec<f64> = (0..nt * nt)

@@ -17,6 +17,7 @@ pub mod atomic;
 pub mod error;
 pub mod export;
 pub mod h5;
+pub mod hiding;
 pub mod lock;
 pub mod merl;
 pub mod progress;

@@ -4,6 +4,7 @@
 
 use crate::config::{Scene, Substrate};
 use crate::optics::appearance::{AppearanceSpec, SpectralProxy};
+use crate::optics::substrate::Hemisphere;
 
 use super::eps::mean_eps;
 use super::plan::RunPlan;
@@ -17,10 +18,9 @@ pub fn appearance_spec(scene: &Scene, plan: &RunPlan) -> AppearanceSpec {
         viewing_deg: scene.appearance.viewing_deg.clone(),
         above_deg: plan.above_deg.clone(),
         below: plan.below.clone(),
-        paper_albedo: match scene.substrate {
-            Substrate::Paper { albedo } => Some(albedo),
-            Substrate::None => None,
-        },
+        ground: scene.substrate.ground(),
+        chart: scene.substrate.is_chart(),
+        thickness_nm: scene.layer.thickness_nm,
         table: plan.table,
         realisations: plan.realisations,
         deterministic: plan.analytic || scene.structure.is_some(),
@@ -45,7 +45,7 @@ pub const PROXY_STEP_NM: f64 = 5.0;
 fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
     let wl = &scene.wavelengths_nm;
     // An explicit structure has no pigment mixture to stand in for it.
-    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) || scene.structure.is_some() {
+    if wl.len() < 2 || scene.substrate == Substrate::None || scene.structure.is_some() {
         return None;
     }
     let fine = fine_grid(wl);
@@ -57,6 +57,7 @@ fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
         wavelengths_nm: fine,
         eps,
         thickness_nm: scene.layer.thickness_nm,
+        quadrature: Hemisphere::new(scene.appearance.quadrature_points),
     })
 }
 

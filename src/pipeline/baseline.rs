@@ -4,7 +4,7 @@
 //! with the scene's equation (which picks the grains' sphere solution and
 //! the surfaces' Fresnel law), beside the wave solution's measured colours.
 
-use crate::config::{GrainShape, Scene, Substrate};
+use crate::config::{GrainShape, Scene};
 use crate::optics::appearance::{Appearance, MeasuredColour};
 use crate::optics::baseline::{self, BaselineColour, BaselineInput, BaselineSpecies};
 use crate::optics::colour::Observer;
@@ -17,7 +17,7 @@ use super::PipelineError;
 /// on the fine colour grid (on the solved wavelengths when a material has no
 /// data there, as for the spectral proxy). None without paper.
 pub fn baseline_input(scene: &Scene) -> Result<Option<BaselineInput>, PipelineError> {
-    let Substrate::Paper { albedo } = scene.substrate else {
+    let Some(albedo) = scene.substrate.ground().and_then(|g| g.constant()) else {
         return Ok(None);
     };
     let per_wavelength = |grid: &[f64]| -> Result<Vec<Vec<_>>, PipelineError> {

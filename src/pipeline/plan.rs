@@ -51,7 +51,8 @@ impl RunPlan {
         }
         let explicit = scene.structure.is_some();
         let (above, extra) = above_angles(scene);
-        let paper = matches!(scene.substrate, Substrate::Paper { .. });
+        // Only a ground that reflects needs the layer's terms from below.
+        let paper = scene.substrate.ground().is_some();
         // The paper term: for the tile's colours and the preview.
         let products = scene.appearance.products;
         let below = ((products.tile || products.preview) && paper)
@@ -75,7 +76,7 @@ impl RunPlan {
         let seeds = (0..realisations)
             .map(|r| realisation_seed(scene.seed, r))
             .collect();
-        lines.extend(solve_lines(&above, extra, below.as_ref(), paper));
+        lines.extend(solve_lines(&above, extra, below.as_ref(), &scene.substrate));
         let (table, line) = table_of(scene);
         lines.push(line);
         lines.extend(product_lines(scene));
@@ -234,7 +235,7 @@ fn solve_lines(
     above: &[f64],
     extra: usize,
     below: Option<&Hemisphere>,
-    paper: bool,
+    substrate: &Substrate,
 ) -> Vec<String> {
     let mut lines = vec![format!(
         "solves from above at {} polar angles {}{}",
@@ -252,8 +253,16 @@ fn solve_lines(
             h.mu.len(),
             fmt_list(&h.polar_deg())
         ));
-    } else if !paper {
+        if substrate.is_chart() {
+            lines.push(format!(
+                "substrate: {substrate}; both halves from the same solves (the ground enters \
+                 after them), with the contrast ratio and Kubelka's S and K"
+            ));
+        }
+    } else if *substrate == Substrate::None {
         lines.push("solves from below: skipped — no substrate".to_string());
+    } else if *substrate == Substrate::Black {
+        lines.push("solves from below: skipped — the black ground reflects nothing".to_string());
     } else {
         lines.push(
             "solves from below: skipped — no tile or preview requested, nothing uses the paper term"
@@ -598,9 +607,9 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
             .map(|d| format!("{d:.1}"))
             .collect::<Vec<_>>()
             .join(", "),
-        match scene.substrate {
-            Substrate::Paper { albedo } => format!("paper of albedo {albedo} in air"),
-            Substrate::None => "air".to_string(),
+        match scene.substrate.ground().and_then(|g| g.constant()) {
+            Some(albedo) => format!("a ground of albedo {albedo} in air"),
+            None => "air".to_string(),
         }
     )];
     if st.layers.iter().any(|l| l.coverage < 1.0) {

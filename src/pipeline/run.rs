@@ -172,6 +172,19 @@ fn assemble_products(
         None
     };
     // Colours are computed for the preview too; the tile is drawn when asked.
+    let ground = scene.substrate.on_phrase();
+    let hiding_line = appearance.as_ref().and_then(|a| {
+        let conditions = render::tile::TileCaption {
+            name: "",
+            observer: &obs,
+            ground: "",
+            hiding: None,
+            azimuth_deg: 0.0,
+        }
+        .conditions();
+        crate::output::hiding::reported(&a.hiding)
+            .map(|h| crate::output::hiding::tile_line(h, &conditions))
+    });
     let tile_png = match appearance.as_ref() {
         Some(
             a @ Appearance {
@@ -185,7 +198,8 @@ fn assemble_products(
             &render::tile::TileCaption {
                 name: &scene.output.name,
                 observer: &obs,
-                paper_albedo: a.spec.paper_albedo,
+                ground: &ground,
+                hiding: hiding_line.as_deref(),
                 azimuth_deg: a.spec.azimuth_deg,
             },
         )?),

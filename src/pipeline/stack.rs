@@ -10,7 +10,7 @@
 
 use ndarray::{Array1, Array2, Array3};
 
-use crate::config::{Scene, Substrate};
+use crate::config::Scene;
 use crate::optics::appearance::{self, MeasuredColour, TileSpectra};
 use crate::optics::colour::Observer;
 use crate::optics::farfield::Side;
@@ -105,10 +105,8 @@ pub fn run(
                     scene.appearance.illuminant,
                     scene.appearance.observer,
                 ),
-                paper_albedo: match scene.substrate {
-                    Substrate::Paper { albedo } => Some(albedo),
-                    Substrate::None => None,
-                },
+                ground: &scene.substrate.on_phrase(),
+                hiding: None,
                 azimuth_deg: scene.incidence.first().map_or(0.0, |i| i.azimuth_deg),
             },
         )?),
@@ -158,9 +156,10 @@ fn combine(
     let nodes = node_deg(&ords);
     let k = ords.len();
     let q = BinQuadrature::new(&ords, plan.table);
-    let below = match scene.substrate {
-        Substrate::Paper { albedo } => Below::Paper { albedo },
-        Substrate::None => Below::Air,
+    // The check leaves a stack only grounds of one albedo (or none).
+    let below = match scene.substrate.ground().and_then(|g| g.constant()) {
+        Some(albedo) => Below::Paper { albedo },
+        None => Below::Air,
     };
     let wl = &scene.wavelengths_nm;
     let measurements = &scene.appearance.measurements;

@@ -7,7 +7,7 @@
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
-use crate::config::{Scene, Substrate};
+use crate::config::Scene;
 use crate::optics::baseline::adding::Slab;
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
@@ -48,7 +48,7 @@ pub(super) fn proxy_factors(
     halftone: (&[f64], f64),
 ) -> Result<Option<StackProxy>, PipelineError> {
     let wl = &scene.wavelengths_nm;
-    if wl.len() < 2 || matches!(scene.substrate, Substrate::None) {
+    if wl.len() < 2 || scene.substrate.ground().is_none() {
         return Ok(None);
     }
     let fine = fine_grid(wl);

@@ -155,6 +155,17 @@ class Result:
     - ``geometry``, ``statistics``, ``realisations`` (and ``seeds``);
     - ``tile_png``, ``picture_png``: the stored PNG bytes.
     - ``stack``: ``/stack`` of a stack combined layer by layer, else None.
+    - ``hiding``: over a hiding chart (``substrate.kind = "chart"``),
+      ``/appearance/hiding`` as a Dataset over ``geometry`` (``45/0``,
+      ``d/8 SCI``, ``d/8 SCE``): ``contrast_ratio``, ``y_black``,
+      ``y_white``, ``y_ground``, Kubelka's ``r_inf_y``, ``s_y_per_um``,
+      ``k_y_per_um`` (µm⁻¹), ``k_over_s_y`` from the luminance factors,
+      ``k_over_s_max`` and ``k_over_s_max_wavelength_nm``, and over
+      (``geometry``, ``wavelength_nm``) ``r_inf``, ``s_per_um``,
+      ``k_per_um``, ``k_over_s`` and the white half's
+      ``ground_reflectance``; each with its ``*_se`` standard error where
+      the file has one (NaN elsewhere), units in ``attrs``. ``contrast_ratio``
+      (d/8 SCI where measured) is the shortcut to its value and error.
     """
 
     def __init__(self, path: "os.PathLike[str] | str"):
@@ -172,6 +183,7 @@ class Result:
             )
             self.realisations = _read_realisations(f) if "realisations" in f else None
             self.stack = _read_stack(f) if "stack" in f else None
+            self.hiding = _read_hiding(f) if "appearance/hiding" in f else None
             self.picture_png: Optional[bytes] = (
                 f["picture_png"][()].tobytes() if "picture_png" in f else None
             )
@@ -284,6 +296,18 @@ class Result:
             return None
         return self.appearance[keep]
 
+    @property
+    def contrast_ratio(self) -> Optional[tuple]:
+        """``(CR, standard error)`` over a hiding chart in d/8 SCI (ISO
+        6504-3's geometry; else the first geometry measured); the error is
+        NaN where the file has none. None without a chart."""
+        if self.hiding is None:
+            return None
+        geoms = list(self.hiding["geometry"].values)
+        g = "d/8 SCI" if "d/8 SCI" in geoms else geoms[0]
+        h = self.hiding.sel(geometry=g)
+        return float(h["contrast_ratio"]), float(h["contrast_ratio_se"])
+
     def to_datatree(self):
         """All parts as one ``xarray.DataTree`` (needs xarray ≥ 2024.10)."""
         try:
@@ -295,7 +319,7 @@ class Result:
         root.attrs["config"] = self.config or ""
         root.attrs["plan"] = self.plan or ""
         parts = {"/": root, "/solves": self.solves, "/orders": self.orders}
-        for name in ("appearance", "geometry", "statistics", "realisations", "stack"):
+        for name in ("appearance", "geometry", "statistics", "realisations", "stack", "hiding"):
             v = getattr(self, name)
             if v is not None:
                 parts["/" + name] = v
@@ -484,6 +508,50 @@ def _read_appearance(f: h5py.File) -> xr.Dataset:
         if u is not None:
             ds.attrs[k + "_units"] = u
     return ds
+
+
+# Datasets of each /appearance/hiding/<geometry> group, by their axes.
+_HIDING_SCALARS = ["contrast_ratio", "y_black", "y_white", "y_ground", "r_inf_y",
+                   "s_y_per_um", "k_y_per_um", "k_over_s_y", "k_over_s_max",
+                   "k_over_s_max_wavelength_nm"]
+_HIDING_SPECTRA = ["r_inf", "s_per_um", "k_per_um", "k_over_s", "ground_reflectance"]
+
+
+def _read_hiding(f: h5py.File) -> xr.Dataset:
+    """``/appearance/hiding`` (docs/FORMAT.md) over ``geometry`` (and
+    ``wavelength_nm``); a standard error the file lacks reads NaN."""
+    hg = f["appearance/hiding"]
+    groups = [hg[k] for k in hg.keys()]
+    geometry = [_py(g.attrs["geometry"]) for g in groups]
+    wl = f["appearance/wavelengths_nm"][()]
+    data: Dict[str, xr.Variable] = {}
+
+    def column(name: str, shape: tuple):
+        first = next((g[name] for g in groups if name in g), None)
+        out = np.full((len(groups),) + shape, np.nan)
+        for i, g in enumerate(groups):
+            if name in g:
+                out[i] = np.asarray(g[name][()], dtype=float).reshape(shape)
+        attrs = {} if first is None else _meta("appearance/hiding/" + name, first)
+        return out, attrs
+
+    for base, shape, dims in ([(n, (), ("geometry",)) for n in _HIDING_SCALARS]
+                              + [(n, (wl.size,), ("geometry", "wavelength_nm"))
+                                 for n in _HIDING_SPECTRA]):
+        for name in (base, base + "_se"):
+            if name.endswith("_se") and (base.startswith("y_") or base.endswith("_nm")
+                                         or base == "ground_reflectance"):
+                continue
+            values, attrs = column(name, shape)
+            if not attrs and name.endswith("_se"):
+                attrs = dict(data[base].attrs)
+                attrs["long_name"] = "standard error of " + attrs.get("long_name", base)
+            data[name] = xr.Variable(dims, values, attrs=attrs)
+    coords = {
+        "geometry": xr.Variable(("geometry",), np.asarray(geometry, dtype=object)),
+        "wavelength_nm": _coord("appearance/wavelengths_nm", wl, ("wavelength_nm",)),
+    }
+    return xr.Dataset(data, coords=coords, attrs=_attrs(hg))
 
 
 def _read_stack(f: h5py.File) -> xr.Dataset:

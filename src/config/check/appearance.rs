@@ -1,16 +1,17 @@
 //! `[appearance]` (products, viewing angles, BRDF cell, quadrature, colour
 //! conditions, measurement geometries and the classical baseline) and
-//! `[substrate]` (none, or paper of an albedo).
+//! `[substrate]` (none, paper, a black, white or measured ground, or a
+//! hiding chart).
 
 use super::Checker;
 use crate::config::raw::{RawAppearance, RawBaseline, RawProduct, RawSubstrate};
 use crate::config::{
-    Appearance, Baseline, ConfigError, Illuminant, Incidence, Measurement, Products,
-    StandardObserver, Substrate,
+    Appearance, Baseline, ConfigError, GroundReflectance, Illuminant, Incidence, Measurement,
+    Products, ReflectanceSpectrum, StandardObserver, Substrate, DEFAULT_PAPER_ALBEDO,
+    DEFAULT_WHITE_ALBEDO,
 };
-
-/// Paper albedo of the reference study (METHOD §8).
-pub const DEFAULT_PAPER_ALBEDO: f64 = 0.9;
+use std::path::Path;
+use std::sync::Arc;
 const DEFAULT_QUADRATURE_POINTS: i64 = 6;
 
 impl Checker<'_> {
@@ -158,23 +159,83 @@ impl Checker<'_> {
         Ok(out)
     }
 
-    pub(super) fn substrate(&self, raw: Option<&RawSubstrate>) -> Result<Substrate, ConfigError> {
+    /// `[substrate]`; a ground's spectrum must cover every wavelength of
+    /// the scene (`wavelengths_nm`), as a material's data must.
+    pub(super) fn substrate(
+        &self,
+        raw: Option<&RawSubstrate>,
+        wavelengths_nm: &[f64],
+    ) -> Result<Substrate, ConfigError> {
+        let albedo = |key: &str, a: Option<f64>, default: f64| {
+            let a = a.unwrap_or(default);
+            self.range(key, a, (0.0..=1.0).contains(&a), "[0, 1]")
+        };
         Ok(match raw {
-            Some(RawSubstrate::None) => Substrate::None,
+            Some(RawSubstrate::None {}) => Substrate::None,
             None => Substrate::Paper {
                 albedo: DEFAULT_PAPER_ALBEDO,
             },
-            Some(RawSubstrate::Paper { albedo }) => {
-                let a = albedo.unwrap_or(DEFAULT_PAPER_ALBEDO);
-                Substrate::Paper {
-                    albedo: self.range(
-                        "substrate.albedo",
-                        a,
-                        (0.0..=1.0).contains(&a),
-                        "[0, 1]",
-                    )?,
-                }
+            Some(RawSubstrate::Paper { albedo: a }) => Substrate::Paper {
+                albedo: albedo("substrate.albedo", *a, DEFAULT_PAPER_ALBEDO)?,
+            },
+            Some(RawSubstrate::Black {}) => Substrate::Black,
+            Some(RawSubstrate::White { albedo: a }) => Substrate::White {
+                albedo: albedo("substrate.albedo", *a, DEFAULT_WHITE_ALBEDO)?,
+            },
+            Some(RawSubstrate::Csv { file }) => {
+                Substrate::Csv(self.ground_spectrum("substrate.file", file, wavelengths_nm)?)
             }
+            Some(RawSubstrate::Chart {
+                white_albedo,
+                white_csv,
+            }) => Substrate::Chart {
+                white: match (white_albedo, white_csv) {
+                    (Some(_), Some(_)) => {
+                        return Err(self.invalid(
+                            "substrate.white_csv",
+                            "give the white half's albedo (white_albedo) or its spectrum \
+                             (white_csv), not both",
+                        ))
+                    }
+                    (_, Some(file)) => GroundReflectance::Spectrum(self.ground_spectrum(
+                        "substrate.white_csv",
+                        file,
+                        wavelengths_nm,
+                    )?),
+                    (a, None) => GroundReflectance::Constant(albedo(
+                        "substrate.white_albedo",
+                        *a,
+                        DEFAULT_WHITE_ALBEDO,
+                    )?),
+                },
+            },
         })
+    }
+
+    /// A ground's reflectance table `rel` (relative to the scene file),
+    /// covering every wavelength of the scene.
+    fn ground_spectrum(
+        &self,
+        key: &str,
+        rel: &str,
+        wavelengths_nm: &[f64],
+    ) -> Result<Arc<ReflectanceSpectrum>, ConfigError> {
+        if rel.trim().is_empty() {
+            return Err(self.invalid(key, "must not be empty"));
+        }
+        let path = self.file.parent().unwrap_or(Path::new("")).join(rel);
+        let s =
+            ReflectanceSpectrum::from_csv(&path).map_err(|e| self.invalid(key, e.to_string()))?;
+        if let Some(&wl) = wavelengths_nm.iter().find(|&&wl| !s.covers(wl)) {
+            let (lo, hi) = s.range_nm();
+            return Err(self.invalid(
+                key,
+                format!(
+                    "wavelength {wl} nm is outside the data range [{lo}, {hi}] nm of the \
+                     ground reflectance `{rel}` (tables are never extrapolated)"
+                ),
+            ));
+        }
+        Ok(Arc::new(s))
     }
 }

@@ -54,8 +54,6 @@ use super::raw::RawConfig;
 use super::{ConfigError, Scene};
 use std::path::Path;
 
-pub use appearance::DEFAULT_PAPER_ALBEDO;
-
 /// Largest polar angle, of illumination and of viewing.
 const MAX_POLAR_DEG: f64 = 89.0;
 /// Relative slack for ceilings and for landing on `stop` in a range.
@@ -137,7 +135,9 @@ const TAGGED: [(&str, &str); 6] = [
     ),
     (
         "RawSubstrate",
-        "a substrate: { kind = \"paper\", albedo } or { kind = \"none\" }",
+        "a substrate: { kind = \"paper\", albedo }, { kind = \"white\", albedo }, \
+         { kind = \"black\" }, { kind = \"csv\", file }, { kind = \"chart\", white_albedo \
+         or white_csv } or { kind = \"none\" }",
     ),
     (
         "RawStructure",

@@ -108,7 +108,21 @@ impl Checker<'_> {
                 "a target uncertainty of colour needs the colours: add \"tile\" to appearance.outputs, or give a count",
             ));
         }
-        let substrate = self.substrate(raw.substrate.as_ref())?;
+        let substrate = self.substrate(raw.substrate.as_ref(), &wavelengths_nm)?;
+        if stack
+            .as_ref()
+            .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent)
+            && matches!(substrate, Substrate::Csv(_) | Substrate::Chart { .. })
+        {
+            return Err(self.invalid(
+                "substrate.kind",
+                format!(
+                    "a {} ground is not available for an incoherent [[stack]] yet (its adding \
+                     method takes one constant albedo): use \"paper\", \"white\" or \"black\"",
+                    substrate.kind()
+                ),
+            ));
+        }
         if let Some(st) = &stack {
             self.stack_products(st, &appearance, realisation_target.is_some())?;
         }
@@ -138,8 +152,11 @@ impl Checker<'_> {
         if !appearance.baseline.is_empty() {
             let why = if structure.is_some() {
                 Some("the baseline is computed from the pigments' grains: an explicit structure has none")
-            } else if matches!(substrate, Substrate::None) {
-                Some("the baseline is a layer on paper: give substrate = { kind = \"paper\" }")
+            } else if substrate.ground().and_then(|g| g.constant()).is_none() {
+                Some(
+                    "the baseline is a layer on a ground of one albedo: give substrate = \
+                      { kind = \"paper\" } or { kind = \"white\" }, or a chart's white_albedo",
+                )
             } else if !appearance.products.tile {
                 Some("the baseline is reported beside the measured colours: add \"tile\" to appearance.outputs")
             } else {
@@ -196,6 +213,9 @@ impl Checker<'_> {
                 hasher.update(&bytes);
             }
             None => {}
+        }
+        if let Some(g) = substrate.spectrum() {
+            hasher.update(&g.bytes);
         }
         let mut input_hash = String::with_capacity(64);
         for b in hasher.finalize() {

@@ -180,7 +180,8 @@ pub(super) fn de00_standard_error(labs: &[[f64; 3]], center: [f64; 3]) -> f64 {
 
 /// BRDF of layer + substrate `(wavelength, illumination, viewing)` and the
 /// radiance factor under a white sky `(wavelength, viewing)` from the layer's
-/// diffuse BRDF, R and T (per above angle), and with paper its albedo, `R_dd↑`
+/// diffuse BRDF, R and T (per above angle), and with paper its albedo (per
+/// wavelength), `R_dd↑`
 /// and `T_d` (per wavelength). `illum_idx`/`view_idx` index the above angles.
 pub(super) fn layer_on_paper(
     illum_idx: &[usize],
@@ -188,7 +189,7 @@ pub(super) fn layer_on_paper(
     brdf_diffuse: &Array3<f64>,
     reflectance: &Array2<f64>,
     transmittance: &Array2<f64>,
-    paper: Option<(f64, &Array1<f64>, &Array1<f64>)>,
+    paper: Option<(&Array1<f64>, &Array1<f64>, &Array1<f64>)>,
 ) -> (Array3<f64>, Array2<f64>) {
     let nl = brdf_diffuse.dim().0;
     let mut total = brdf_diffuse.clone();
@@ -198,6 +199,7 @@ pub(super) fn layer_on_paper(
             sky[[l, o]] = reflectance[[l, vo]];
         }
         if let Some((albedo, rdd, td)) = paper {
+            let albedo = albedo[l];
             let denom = 1.0 - albedo * rdd[l];
             for (i, &ai) in illum_idx.iter().enumerate() {
                 for (o, &vo) in view_idx.iter().enumerate() {

@@ -30,6 +30,7 @@ pub use crate::config::Measurement;
 use super::colours::de00_standard_error;
 use super::proxy::{through_proxy, SlabOnPaper, SpectralProxy};
 use super::{find_entry, reduce, AppearanceError, AppearanceSpec, Estimate};
+use crate::config::GroundReflectance;
 use crate::optics::colour::{self, Observer};
 use crate::optics::farfield::table::{self, Part};
 use crate::optics::farfield::{Side, SolveEntry};
@@ -57,11 +58,16 @@ pub struct MeasuredColour {
     /// the same proxy (R ≥ 2; empty for one).
     pub realisation_xyz: Vec<[f64; 3]>,
     pub realisation_lab: Vec<[f64; 3]>,
+    /// Each realisation's reflectance factor at the solved wavelengths
+    /// (R ≥ 2; empty for one).
+    pub realisation_reflectance: Vec<Array1<f64>>,
 }
 
 /// The per-realisation quantities a measurement reads, besides the solves.
 pub(super) struct PaperPerRealisation<'a> {
-    pub albedo: f64,
+    pub ground: &'a GroundReflectance,
+    /// The ground's albedo at each solved wavelength.
+    pub albedo: &'a Array1<f64>,
     pub r_dd_up: &'a [Array1<f64>],
     pub t_d: &'a [Array1<f64>],
 }
@@ -104,17 +110,15 @@ fn reflectance_factor<'e>(
 }
 
 /// The same reflectance factor for the spectral proxy (the homogeneous slab
-/// on the same paper, whose reflection is all specular), on its fine grid.
-fn proxy_factor(m: Measurement, p: &SpectralProxy, albedo: f64, spec: &AppearanceSpec) -> Vec<f64> {
-    let h = spec
-        .below
-        .as_ref()
-        .expect("a proxy comes with paper and its quadrature");
+/// on the same ground, whose reflection is all specular; None: a ground that
+/// reflects nothing), on its fine grid.
+fn proxy_factor(m: Measurement, p: &SpectralProxy, ground: Option<&GroundReflectance>) -> Vec<f64> {
     p.wavelengths_nm
         .iter()
         .zip(&p.eps)
         .map(|(&wl, &eps)| {
-            let SlabOnPaper { rt, td, denom } = p.on_paper(wl, eps, albedo, h);
+            let albedo = ground.map_or(0.0, |g| g.at(wl));
+            let SlabOnPaper { rt, td, denom } = p.on_paper(wl, eps, albedo);
             match m {
                 Measurement::FortyFiveZero => albedo * rt(45.0).1 * rt(0.0).1 / denom,
                 Measurement::DiffuseEightSci => rt(8.0).0 + albedo * td * rt(8.0).1 / denom,
@@ -147,15 +151,15 @@ pub(super) fn measure(
                 let at = |polar: f64| find_entry(entries, Side::Above, r, w, polar);
                 let p = paper
                     .as_ref()
-                    .map(|p| (p.albedo, p.r_dd_up[r][l], p.t_d[r][l]));
+                    .map(|p| (p.albedo[l], p.r_dd_up[r][l], p.t_d[r][l]));
                 v[l] = reflectance_factor(m, spec, &at, p)?;
             }
             samples.push(v);
         }
-        let proxy = match (&spec.proxy, &paper) {
-            (Some(p), Some(pp)) => Some((p, proxy_factor(m, p, pp.albedo, spec))),
-            _ => None,
-        };
+        let proxy = spec
+            .proxy
+            .as_ref()
+            .map(|p| (p, proxy_factor(m, p, paper.as_ref().map(|pp| pp.ground))));
         let proxy = proxy
             .as_ref()
             .map(|(p, fine)| (&p.wavelengths_nm[..], &fine[..]));
@@ -235,5 +239,10 @@ pub fn colour_of_samples(
         de00_se,
         realisation_xyz,
         realisation_lab,
+        realisation_reflectance: if samples.len() >= 2 {
+            samples.to_vec()
+        } else {
+            Vec::new()
+        },
     })
 }

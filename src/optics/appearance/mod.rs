@@ -13,7 +13,8 @@
 //!   ([`crate::optics::farfield::table`]: power-preserving, orders (0,0) excluded) and
 //!   its values in the plane of incidence on the specular side
 //!   (`φ_o = φ_i`: the diagonal θo = θi holds the specular direction);
-//! - with paper: the layer's albedo for diffuse light from below `R_dd↑` and
+//! - with a reflecting ground (paper, a white or measured ground, a chart's
+//!   white half; its albedo may vary with wavelength): the layer's albedo for diffuse light from below `R_dd↑` and
 //!   its diffuse transmittance `T_d` (Gauss–Legendre in cos θ over the solves
 //!   from below; by reciprocity `2∫T_up μ dμ = 2∫T_down μ dμ`), the BRDF of
 //!   layer + paper `f = f_layer + ρ T(θi) T(θo) / (π (1 − ρ R_dd↑))`, and
@@ -22,6 +23,9 @@
 //!   included, by reciprocity);
 //! - colours (CIE 1931 2°, D65, sRGB) of the tile: the sky strip and `π f`
 //!   of the BRDF square, and CIELAB of the sky strip for comparing variants.
+//!
+//! - over a hiding chart: the measured colours over its black half too, and
+//!   the contrast ratio and Kubelka's S and K ([`crate::optics::hiding`]).
 //!
 //! Ensemble-mean quantities are combined (products of means), as METHOD §5
 //! describes the layer by its mean scattering functions.
@@ -34,10 +38,12 @@ pub use colours::{tile_colours, ColourSpread, Colours, ProxySpectra, TileSpectra
 pub use measure::{colour_of_samples, MeasuredColour, Measurement};
 pub use proxy::{SpectralProxy, PROXY_RATIO_SPREAD};
 
+use crate::config::GroundReflectance;
 use crate::optics::baseline::BaselineColour;
 use crate::optics::colour::{ColourError, Illuminant, Observer, StandardObserver};
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
+use crate::optics::hiding::{self, Hiding};
 use crate::optics::substrate::Hemisphere;
 use colours::layer_on_paper;
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
@@ -58,7 +64,15 @@ pub struct AppearanceSpec {
     pub above_deg: Vec<f64>,
     /// Quadrature for the solves from below (with paper), nodes = polar angles.
     pub below: Option<Hemisphere>,
-    pub paper_albedo: Option<f64>,
+    /// The Lambertian ground under the layer (paper, a white or measured
+    /// ground, a chart's white half); None: nothing is added to the layer's
+    /// own reflection (no substrate, a black ground).
+    pub ground: Option<GroundReflectance>,
+    /// A hiding chart: also measure over its black half (the layer alone)
+    /// and derive the contrast ratio and Kubelka's S and K.
+    pub chart: bool,
+    /// The layer's thickness (Kubelka's X), nm.
+    pub thickness_nm: f64,
     pub table: TableSpec,
     pub realisations: usize,
     /// Every realisation would be the same (a homogeneous layer or an
@@ -82,10 +96,13 @@ pub struct Estimate<D: Dimension> {
     pub se: Option<Array<f64, D>>,
 }
 
-/// The paper's part.
+/// The paper's (the reflecting ground's) part.
 #[derive(Debug, Clone)]
 pub struct PaperTerms {
-    pub albedo: f64,
+    /// The ground.
+    pub ground: GroundReflectance,
+    /// Its albedo at each solved wavelength.
+    pub albedo: Array1<f64>,
     /// Layer albedo for diffuse light from below, per wavelength.
     pub r_dd_up: Estimate<Ix1>,
     /// Layer diffuse transmittance, per wavelength.
@@ -119,8 +136,15 @@ pub struct Appearance {
     /// Radiance factor under a uniform white sky, (wavelength, viewing).
     pub natural: Option<Array2<f64>>,
     pub colours: Option<Colours>,
-    /// Colour in each of `spec.measurements`, in that order.
+    /// Colour in each of `spec.measurements`, in that order (over a chart:
+    /// over its white half).
     pub measured: Vec<MeasuredColour>,
+    /// Over a chart: the colours over its black half, in the same order
+    /// (empty otherwise).
+    pub measured_black: Vec<MeasuredColour>,
+    /// Over a chart: contrast ratio and Kubelka's S and K, one per geometry
+    /// of `spec.measurements` (empty otherwise).
+    pub hiding: Vec<Hiding>,
     /// The classical baselines' colours, model by model (in the scene's
     /// order) and in each measurement geometry, when the scene asked for
     /// them (filled in by the pipeline).
@@ -279,7 +303,7 @@ pub fn assemble(
                     );
                 }
             }
-            if let (Some(h), Some(_)) = (&spec.below, spec.paper_albedo) {
+            if let (Some(h), Some(_)) = (&spec.below, &spec.ground) {
                 let mut ru = Vec::with_capacity(h.mu.len());
                 let mut tu = Vec::with_capacity(h.mu.len());
                 for polar in h.polar_deg() {
@@ -325,9 +349,10 @@ pub fn assemble(
     let transmittance = reduce(&s_t);
     let absorption = reduce(&s_a);
     let brdf_diffuse = reduce(&s_brdf);
-    let paper = match (&spec.below, spec.paper_albedo) {
-        (Some(_), Some(albedo)) => Some(PaperTerms {
-            albedo,
+    let paper = match (&spec.below, &spec.ground) {
+        (Some(_), Some(ground)) => Some(PaperTerms {
+            ground: ground.clone(),
+            albedo: spec.wavelengths_nm.iter().map(|&w| ground.at(w)).collect(),
             r_dd_up: reduce(&s_rdd),
             t_d: reduce(&s_td),
         }),
@@ -346,7 +371,7 @@ pub fn assemble(
                 .as_ref()
                 .zip(rdd)
                 .zip(td)
-                .map(|((p, r), t)| (p.albedo, r, t));
+                .map(|((p, r), t)| (&p.albedo, r, t));
             layer_on_paper(&illum_idx, &view_idx, brdf, refl, trans, paper)
         };
         let (total, sky) = on_paper(
@@ -356,10 +381,10 @@ pub fn assemble(
             paper.as_ref().map(|p| &p.r_dd_up.mean),
             paper.as_ref().map(|p| &p.t_d.mean),
         );
-        let proxy = match (&spec.proxy, spec.paper_albedo, &spec.below) {
-            (Some(p), Some(albedo), Some(h)) => Some((p, p.spectra(spec, albedo, h))),
-            _ => None,
-        };
+        let proxy = spec
+            .proxy
+            .as_ref()
+            .map(|p| (p, p.spectra(spec, spec.ground.as_ref())));
         let proxy = proxy
             .as_ref()
             .map(|(p, (f, sky))| (&p.wavelengths_nm[..], f, sky));
@@ -388,12 +413,22 @@ pub fn assemble(
         spec,
         entries,
         paper.as_ref().map(|p| measure::PaperPerRealisation {
-            albedo: p.albedo,
+            ground: &p.ground,
+            albedo: &p.albedo,
             r_dd_up: &s_rdd,
             t_d: &s_td,
         }),
         observer,
     )?;
+    // The chart's black half: the same solves without the ground's term.
+    let (measured_black, hiding) = match (&paper, spec.chart) {
+        (Some(p), true) => {
+            let black = measure::measure(spec, entries, None, observer)?;
+            let hiding = hiding::of_chart(spec, &black, &measured, &p.ground, observer)?;
+            (black, hiding)
+        }
+        _ => (Vec::new(), Vec::new()),
+    };
 
     Ok(Appearance {
         spec: spec.clone(),
@@ -413,6 +448,8 @@ pub fn assemble(
         natural,
         colours,
         measured,
+        measured_black,
+        hiding,
         baseline: Vec::new(),
         colour_conditions: observer.conditions(),
     })

@@ -2,6 +2,7 @@
 //! pigments' absorption bands between the solved wavelengths.
 
 use super::AppearanceSpec;
+use crate::config::GroundReflectance;
 use crate::optics::substrate::Hemisphere;
 use crate::solver::airy;
 use ndarray::{Array2, Array3};
@@ -24,23 +25,27 @@ pub struct SpectralProxy {
     /// ⟨ε⟩ on the fine grid.
     pub eps: Vec<C64>,
     pub thickness_nm: f64,
+    /// Quadrature of the slab's diffuse terms (the scene's, as for the
+    /// solves from below).
+    pub quadrature: Hemisphere,
 }
 
 impl SpectralProxy {
     /// Proxy BRDF square `(fine λ, illumination, viewing)` and sky strip
-    /// `(fine λ, viewing)` of the slab on paper of albedo `albedo`.
+    /// `(fine λ, viewing)` of the slab on the ground `ground` (None: one that
+    /// reflects nothing).
     pub(super) fn spectra(
         &self,
         spec: &AppearanceSpec,
-        albedo: f64,
-        h: &Hemisphere,
+        ground: Option<&GroundReflectance>,
     ) -> (Array3<f64>, Array2<f64>) {
         let nf = self.wavelengths_nm.len();
         let (ni, nv) = (spec.illumination_deg.len(), spec.viewing_deg.len());
         let mut f = Array3::zeros((nf, ni, nv));
         let mut sky = Array2::zeros((nf, nv));
         for (l, (&wl, &eps)) in self.wavelengths_nm.iter().zip(&self.eps).enumerate() {
-            let SlabOnPaper { rt, td, denom } = self.on_paper(wl, eps, albedo, h);
+            let albedo = ground.map_or(0.0, |g| g.at(wl));
+            let SlabOnPaper { rt, td, denom } = self.on_paper(wl, eps, albedo);
             let ti: Vec<f64> = spec.illumination_deg.iter().map(|&a| rt(a).1).collect();
             for (o, &v) in spec.viewing_deg.iter().enumerate() {
                 let (ro, to) = rt(v);
@@ -55,14 +60,14 @@ impl SpectralProxy {
 
     /// The slab at `wl` (permittivity `eps`) on paper of albedo `albedo`:
     /// its power coefficients at any polar angle and its diffuse terms by the
-    /// quadrature `h`.
+    /// proxy's quadrature.
     pub(super) fn on_paper(
         &self,
         wl: f64,
         eps: C64,
         albedo: f64,
-        h: &Hemisphere,
     ) -> SlabOnPaper<impl Fn(f64) -> (f64, f64) + '_> {
+        let h = &self.quadrature;
         let thickness = self.thickness_nm;
         let rt = move |polar: f64| {
             let r = airy::slab(eps, thickness, wl, polar);

@@ -180,7 +180,17 @@ pub(super) fn write_appearance(
         write_estimate(s, &g, "btdf_diffuse", t, about("sr-1", description, LIV))?;
     }
     if let Some(p) = &a.paper {
-        write_scalar_attr(&g, "paper_albedo", p.albedo)?;
+        if let Some(albedo) = p.ground.constant() {
+            write_scalar_attr(&g, "paper_albedo", albedo)?;
+        }
+        let description = "albedo of the ground under the layer (paper, a white or measured \
+                           ground, a chart's white half) at the solved wavelengths; wavelength";
+        s.write(
+            &g,
+            "ground_albedo",
+            p.albedo.view(),
+            about("1", description, &[dim::WAVELENGTH]),
+        )?;
         let description =
             "albedo of the layer for diffuse light from below (the paper's side); wavelength";
         write_estimate(
@@ -227,6 +237,19 @@ pub(super) fn write_appearance(
             write_measured(s, &mg, m)?;
         }
     }
+    if !a.measured_black.is_empty() {
+        let mg = g.create_group("measured_black")?;
+        write_str_attr(
+            &mg,
+            "description",
+            "the colours over a hiding chart's black half (the layer alone), from the same \
+             solves as /appearance/measured (over its white half)",
+        )?;
+        for m in &a.measured_black {
+            write_measured(s, &mg, m)?;
+        }
+    }
+    super::hiding::write_hiding(s, &g, &a.hiding, sp.thickness_nm)?;
     write_baselines(s, &g, &a.baseline)?;
     if let Some(png) = tile_png {
         let description = "the tile picture as a PNG file (encoded bytes, no units); byte";

@@ -102,12 +102,28 @@ pub struct MeasuredRecord {
 /// illuminant and observer (degrees) they were computed for; `None` when the
 /// file has none.
 pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String, u32)>, IoError> {
+    read_measured_in(path, "measured")
+}
+
+/// Over a hiding chart: the measured colours over its black half
+/// (`/appearance/measured_black`), as [`read_measured`] gives those over
+/// its white half; `None` when the file has none.
+pub fn read_measured_black(
+    path: &Path,
+) -> Result<Option<(Vec<MeasuredRecord>, String, u32)>, IoError> {
+    read_measured_in(path, "measured_black")
+}
+
+fn read_measured_in(
+    path: &Path,
+    group: &str,
+) -> Result<Option<(Vec<MeasuredRecord>, String, u32)>, IoError> {
     let hdf = |source| IoError::Hdf5 {
         path: path.to_path_buf(),
         source,
     };
     let file = super::open(path).map_err(hdf)?;
-    if !file.link_exists("appearance/measured") {
+    if !file.link_exists(&format!("appearance/{group}")) {
         return Ok(None);
     }
     let g = file.group("appearance").map_err(hdf)?;
@@ -116,7 +132,7 @@ pub fn read_measured(path: &Path) -> Result<Option<(Vec<MeasuredRecord>, String,
         .attr("observer_deg")
         .and_then(|a| a.read_scalar())
         .map_err(hdf)?;
-    let mg = g.group("measured").map_err(hdf)?;
+    let mg = g.group(group).map_err(hdf)?;
     let mut out = Vec::new();
     for name in mg.member_names().map_err(hdf)? {
         let d = mg.group(&name).map_err(hdf)?;

@@ -33,6 +33,7 @@ mod attrs;
 mod described;
 mod file;
 mod geometry;
+mod hiding;
 mod result;
 mod scales;
 mod stack;
@@ -40,12 +41,13 @@ mod summary;
 
 pub use crate::output::error::IoError;
 pub use appearance_read::{
-    read_appearance, read_baseline, read_measured, read_optional, AppearanceArrays, BaselineRecord,
-    MeasuredRecord,
+    read_appearance, read_baseline, read_measured, read_measured_black, read_optional,
+    AppearanceArrays, BaselineRecord, MeasuredRecord,
 };
 pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};
 pub use geometry::GeometrySummary;
+pub use hiding::{read_hiding, HidingRecord};
 pub use result::{write_result, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};

@@ -281,8 +281,8 @@ fn sphere(img: &mut Canvas, s: &dyn Surface, x0: usize, y0: usize) {
 pub fn preview_png(a: &Appearance, obs: &Observer, name: &str) -> Result<Vec<u8>, RenderError> {
     let layer = Layer::new(a, obs).map_err(|e| RenderError::Preview(e.to_string()))?;
     let w = 2 * SPHERE_PX + 3 * PAD;
-    let paper = match a.spec.paper_albedo {
-        Some(p) => format!("on paper of albedo {p}"),
+    let paper = match &a.spec.ground {
+        Some(g) => format!("on a ground of {g}"),
         None => "alone".to_string(),
     };
     let caption = [

@@ -36,8 +36,13 @@ pub struct TileCaption<'a> {
     /// The observer and illuminant of the colours (named in the title, and
     /// used to map colours into the sRGB gamut).
     pub observer: &'a Observer,
-    /// Albedo of the paper under the layer, if any.
-    pub paper_albedo: Option<f64>,
+    /// What the layer lies on, as the title says it: `on paper of albedo
+    /// 0.9`, `without substrate`, `over the white half of a hiding chart …`
+    /// ([`crate::config::Substrate::on_phrase`]).
+    pub ground: &'a str,
+    /// Over a hiding chart: a line with the contrast ratio and its standard
+    /// error (the geometry and conditions named), drawn under the title.
+    pub hiding: Option<&'a str>,
     /// Azimuth of the plane of incidence, degrees.
     pub azimuth_deg: f64,
 }
@@ -51,20 +56,19 @@ impl TileCaption<'_> {
         }
     }
 
-    /// The two title lines.
-    pub fn lines(&self) -> [String; 2] {
-        let paper = match self.paper_albedo {
-            Some(a) => format!("on paper of albedo {}", fmt_num(a)),
-            None => "without substrate".into(),
-        };
-        [
-            format!("{} — colour {paper}", self.name),
+    /// The title lines: the name and ground, the conditions, and over a
+    /// chart the hiding line.
+    pub fn lines(&self) -> Vec<String> {
+        let mut lines = vec![
+            format!("{} — colour {}", self.name, self.ground),
             format!(
                 "{}; plane of incidence φ = {}°, viewing on the specular side",
                 self.conditions(),
                 fmt_num(self.azimuth_deg)
             ),
-        ]
+        ];
+        lines.extend(self.hiding.map(str::to_string));
+        lines
     }
 }
 
@@ -117,7 +121,7 @@ impl TileLayout {
             .collect();
         let body_right = x_patches + PATCH_PX + GAP_PX + ni * PATCH_PX;
         let y_title = MARGIN;
-        let y_axis = y_title + 2 * TITLE_HEIGHT + 10;
+        let y_axis = y_title + caption.lines().len() * TITLE_HEIGHT + 10;
         let y_heads = y_axis + GLYPH_HEIGHT + 4;
         let y_body = y_heads + GLYPH_HEIGHT + 6;
         let rows_y: Vec<usize> = (0..nv).map(|r| y_body + r * PATCH_PX).collect();
@@ -180,6 +184,15 @@ pub fn tile_png(
         DIM_TEXT,
         g,
     );
+    if let Some(line) = lines.get(2) {
+        img.text_px(
+            MARGIN as f64,
+            (MARGIN + 2 * TITLE_HEIGHT + 2) as f64,
+            line,
+            TEXT,
+            g,
+        );
+    }
 
     // Column axis: the sky strip, then θᵢ over the square.
     let y_axis = (l.column_heads.1 - GLYPH_HEIGHT - 4) as f64;
@@ -255,7 +268,7 @@ pub fn tile_png(
             DIM_TEXT,
         );
     }
-    img.encode_png(&format!("{} — {}", lines[0], lines[1]))
+    img.encode_png(&lines.join(" — "))
 }
 
 /// An axis title: `long` where it fits in `room` pixels at size `g`, else

@@ -1,7 +1,10 @@
 //! `summary.md`: the summary page's facts, effects table, plots, grids and
 //! variants in Markdown (see [`super::page`]).
 
-use super::page::{baseline_table, colour_cells, effect_table, PageInput, BASELINE_TEXT};
+use super::page::{
+    any_hiding, baseline_table, colour_cells, contrast_cell, effect_table, PageInput,
+    BASELINE_TEXT, CR_TEXT,
+};
 use std::fmt::Write as _;
 
 fn row(cells: &[String]) -> String {
@@ -54,13 +57,22 @@ pub(super) fn page(p: &PageInput) -> String {
             let _ = writeln!(md, "ΔE00 to the reference cell: ![{0}]({0})\n", p.rel(m));
         }
     }
+    let cr = any_hiding(p);
     md += "## Variants\n\nR, T, A: mean total reflectance, transmittance and absorption over \
-           the solves from above (for a stack combined by adding, of the whole stack in air over its angles); L*, C*ab, h°: the measured colour ± s.e.\n\n";
+           the solves from above (for a stack combined by adding, of the whole stack in air over its angles); L*, C*ab, h°: the measured colour ± s.e.";
+    if cr {
+        md += CR_TEXT;
+    }
+    md += "\n\n";
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
     head.extend(p.columns());
-    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
+    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour"] {
         head.push(h.into());
     }
+    if cr {
+        head.push("CR".into());
+    }
+    head.push("files".into());
     let rows: Vec<Vec<String>> = p
         .rows
         .iter()
@@ -79,6 +91,9 @@ pub(super) fn page(p: &PageInput) -> String {
                     cells.push(hex.unwrap_or_else(|| "—".into()));
                 }
                 None => cells.extend(["—", "—", "—", "—"].map(String::from)),
+            }
+            if cr {
+                cells.push(contrast_cell(r));
             }
             cells.push(
                 p.variant_files(r.v)

@@ -82,6 +82,23 @@ struct Row<'a> {
     measured: Option<Measured>,
     /// The classical baselines' colours in the geometry of `measured`.
     baseline: Vec<h5::BaselineRecord>,
+    /// Over a hiding chart: the contrast ratio and Kubelka's S and K in
+    /// [`HIDING_GEOMETRY`] (else the first geometry measured).
+    hiding: Option<h5::HidingRecord>,
+}
+
+/// The measurement geometry of the contrast ratio in the study's tables
+/// (ISO 6504-3's).
+const HIDING_GEOMETRY: &str = "d/8 SCI";
+
+/// A result's hiding power in [`HIDING_GEOMETRY`], else its first.
+fn hiding(path: &std::path::Path) -> Result<Option<h5::HidingRecord>, StudyError> {
+    let all = h5::read_hiding(path)?;
+    let k = all
+        .iter()
+        .position(|h| h.geometry == HIDING_GEOMETRY)
+        .or((!all.is_empty()).then_some(0));
+    Ok(k.map(|k| all[k].clone()))
 }
 
 /// The measurement geometry the plots, the effects table and the grid cards
@@ -173,6 +190,7 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             a,
             measured,
             baseline,
+            hiding: hiding(&path)?,
         });
     }
     let dir = &exp.study_dir;

@@ -225,6 +225,28 @@ pub fn colour_cells(r: &Row) -> Option<([String; 3], Option<String>)> {
     Some(([cell(0, 1), cell(1, 1), cell(2, 0)], hex))
 }
 
+/// A variant's contrast ratio cell (`0.912 ± 0.004 (d/8 SCI)`), `—`
+/// without a chart.
+pub fn contrast_cell(r: &Row) -> String {
+    match &r.hiding {
+        Some(h) => match h.contrast_ratio_se {
+            Some(se) => format!("{:.4} ± {se:.4}", h.contrast_ratio),
+            None => format!("{:.4}", h.contrast_ratio),
+        },
+        None => "—".into(),
+    }
+}
+
+/// Whether any variant has a contrast ratio (then the variants table has a
+/// CR column).
+pub fn any_hiding(p: &PageInput) -> bool {
+    p.rows.iter().any(|r| r.hiding.is_some())
+}
+
+/// The sentence the variants table adds for its CR column.
+pub const CR_TEXT: &str = " CR: contrast ratio Y(over black)/Y(over white) over a hiding chart \
+                           ± s.e., in d/8 SCI where measured.";
+
 /// The header cells of the effects table and each effect's cells.
 pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>) {
     let head = vec![
@@ -409,13 +431,19 @@ fn variants_html(p: &PageInput) -> String {
     let e = html_escape;
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
     head.extend(p.columns().iter().map(|a| e(a)));
-    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour", "files"] {
+    let cr = any_hiding(p);
+    for h in ["R", "T", "A", "L*", "C*ab", "h°", "colour"] {
         head.push(h.into());
     }
-    let mut s = String::from(
+    if cr {
+        head.push("CR".into());
+    }
+    head.push("files".into());
+    let mut s = format!(
         "<h2>Variants</h2>\n<p>R, T, A: mean total reflectance, transmittance and absorption \
          over the solves from above (for a stack combined by adding, of the whole stack in air over its angles). L*, C*ab, h°: the measured colour ± s.e.; swatch: sRGB \
-         under natural light at the first viewing angle.</p>\n<table>\n",
+         under natural light at the first viewing angle.{}</p>\n<table>\n",
+        if cr { CR_TEXT } else { "" }
     );
     s += &tr(&head, "th");
     for (i, r) in p.rows.iter().enumerate() {
@@ -430,6 +458,9 @@ fn variants_html(p: &PageInput) -> String {
                 }));
             }
             None => cells.extend(["—", "—", "—", "—"].map(String::from)),
+        }
+        if cr {
+            cells.push(contrast_cell(r));
         }
         cells.push(
             p.variant_files(r.v)

@@ -132,6 +132,7 @@ pub(super) fn write_summary_h5(
                 .map_err(h)?;
         }
         super::summary_values::write_axis_values(&f, study, rows, &scales).map_err(h)?;
+        super::summary_values::write_hiding(&f, rows, &scales).map_err(h)?;
         super::summary_values::write_colours(&f, rows, &scales)?;
         // The scales hold datasets open; the file closes with the last handle.
         drop(scales);

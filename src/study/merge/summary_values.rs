@@ -178,3 +178,81 @@ pub(super) fn write_colours(
     }
     Ok(())
 }
+
+/// `hiding/{contrast_ratio, s_y_per_um, k_y_per_um}` and their `_se` (n):
+/// each variant's contrast ratio and Kubelka's S and K at Y over a hiding
+/// chart (NaN for a variant without a chart, or a standard error with one
+/// realisation of a random layer), in the geometry named by the attribute
+/// `geometry` of each variant (`geometry`, labels); nothing when no variant
+/// has a chart.
+pub(super) fn write_hiding(f: &hdf5::File, rows: &[Row], scales: &Scales) -> hdf5::Result<()> {
+    if rows.iter().all(|r| r.hiding.is_none()) {
+        return Ok(());
+    }
+    let g = f.create_group("hiding")?;
+    let col = |pick: &dyn Fn(&h5::HidingRecord) -> Option<f64>| -> Array1<f64> {
+        rows.iter()
+            .map(|r| r.hiding.as_ref().and_then(pick).unwrap_or(f64::NAN))
+            .collect()
+    };
+    let sets: [(&str, Array1<f64>, &str, &str); 6] = [
+        (
+            "contrast_ratio",
+            col(&|h| Some(h.contrast_ratio)),
+            "1",
+            "contrast ratio Y(over black)/Y(over white) over the hiding chart; variant",
+        ),
+        (
+            "contrast_ratio_se",
+            col(&|h| h.contrast_ratio_se),
+            "1",
+            "standard error of the contrast ratio over the realisations; variant",
+        ),
+        (
+            "s_y_per_um",
+            col(&|h| Some(h.at_y[1].0)),
+            "um-1",
+            "Kubelka's scattering coefficient S from the luminance factors; variant",
+        ),
+        (
+            "s_y_per_um_se",
+            col(&|h| h.at_y[1].1),
+            "um-1",
+            "standard error of S over the realisations; variant",
+        ),
+        (
+            "k_y_per_um",
+            col(&|h| Some(h.at_y[2].0)),
+            "um-1",
+            "Kubelka's absorption coefficient K from the luminance factors; variant",
+        ),
+        (
+            "k_y_per_um_se",
+            col(&|h| h.at_y[2].1),
+            "um-1",
+            "standard error of K over the realisations; variant",
+        ),
+    ];
+    for (name, data, units, description) in sets {
+        scales.write(&g, name, &data, about(units, description, &[dim::VARIANT]))?;
+    }
+    let geometry: Vec<VarLenUnicode> = rows
+        .iter()
+        .map(|r| {
+            r.hiding
+                .as_ref()
+                .map_or("", |h| h.geometry.as_str())
+                .parse()
+                .expect("no NUL")
+        })
+        .collect();
+    let description = "the measurement geometry of each variant's hiding values (\"\": no \
+                       chart; labels, no units); variant";
+    scales.write(
+        &g,
+        "geometry",
+        &geometry[..],
+        about("", description, &[dim::VARIANT]),
+    )?;
+    Ok(())
+}

@@ -2,9 +2,9 @@
 //! hiding chart: exact checks of the contrast ratio against a closed form,
 //! of Kubelka's S and K against his forward formula, of a chart against its
 //! two halves run apart, and of a measured (CSV) ground against a white one.
+use inksim::optics::appearance::hiding::kubelka;
 use inksim::optics::appearance::{Appearance, MeasuredColour};
 use inksim::optics::colour::{xyz_from_reflectance, Observer};
-use inksim::optics::hiding::kubelka;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
 use std::path::Path;

@@ -19,6 +19,5 @@ pub mod baseline;
 pub mod colour;
 pub mod effective_medium;
 pub mod farfield;
-pub mod hiding;
 pub mod stack;
 pub mod substrate;

@@ -2,7 +2,7 @@
 //! the lines `inksim run` prints (contrast ratio, Kubelka's S and K at Y,
 //! and the K/S maximum, each ± its standard error).
 
-use crate::optics::hiding::{Hiding, Scalar};
+use crate::optics::appearance::hiding::{Hiding, Scalar};
 
 /// The geometry the tile and the study tables report: d/8° SCI where the
 /// scene measures it (ISO 6504-3's), else the first measured one.
@@ -29,6 +29,10 @@ pub fn sig4(v: f64) -> String {
 /// none.
 pub fn with_se(s: Scalar) -> String {
     match s.se {
+        Some(se) if se.is_nan() => format!(
+            "{} (no s.e.: in some realisation no Kubelka layer fits the two reflectances)",
+            sig4(s.value)
+        ),
         Some(se) => format!("{} ± {}", sig4(s.value), sig4_like(se, s.value)),
         None => format!("{} (no s.e.: one realisation)", sig4(s.value)),
     }
@@ -104,5 +108,13 @@ mod tests {
             se: None
         })
         .contains("no s.e."));
+        let unfit = with_se(Scalar {
+            value: 0.5,
+            se: Some(f64::NAN),
+        });
+        assert!(
+            unfit.contains("no Kubelka layer fits") && !unfit.contains("NaN"),
+            "{unfit}"
+        );
     }
 }

@@ -25,12 +25,13 @@
 //!   of the BRDF square, and CIELAB of the sky strip for comparing variants.
 //!
 //! - over a hiding chart: the measured colours over its black half too, and
-//!   the contrast ratio and Kubelka's S and K ([`crate::optics::hiding`]).
+//!   the contrast ratio and Kubelka's S and K ([`crate::optics::appearance::hiding`]).
 //!
 //! Ensemble-mean quantities are combined (products of means), as METHOD §5
 //! describes the layer by its mean scattering functions.
 
 mod colours;
+pub mod hiding;
 mod measure;
 mod proxy;
 
@@ -43,9 +44,9 @@ use crate::optics::baseline::BaselineColour;
 use crate::optics::colour::{ColourError, Illuminant, Observer, StandardObserver};
 use crate::optics::farfield::table::{self, AngularTable, Part, TableSpec};
 use crate::optics::farfield::{Side, SolveEntry};
-use crate::optics::hiding::{self, Hiding};
 use crate::optics::substrate::Hemisphere;
 use colours::layer_on_paper;
+use hiding::Hiding;
 use ndarray::{Array, Array1, Array2, Array3, Array4, Dimension, Ix1, Ix2, Ix3, Ix4};
 use num_complex::Complex64 as C64;
 

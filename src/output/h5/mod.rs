@@ -33,13 +33,13 @@ mod attrs;
 mod described;
 mod file;
 mod geometry;
-mod hiding;
 mod result;
 mod scales;
 mod stack;
 mod summary;
 
 pub use crate::output::error::IoError;
+pub use appearance::hiding::{read_hiding, HidingRecord};
 pub use appearance_read::{
     read_appearance, read_baseline, read_measured, read_measured_black, read_optional,
     AppearanceArrays, BaselineRecord, MeasuredRecord,
@@ -47,7 +47,6 @@ pub use appearance_read::{
 pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};
 pub use geometry::GeometrySummary;
-pub use hiding::{read_hiding, HidingRecord};
 pub use result::{write_result, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};

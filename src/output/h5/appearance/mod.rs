@@ -2,6 +2,8 @@
 //! with their standard errors), every dataset with its units, meaning and
 //! axes; read back by `appearance_read`.
 
+pub mod hiding;
+
 use ndarray::Array2;
 
 use super::attrs::{write_scalar_attr, write_str_attr};
@@ -249,7 +251,7 @@ pub(super) fn write_appearance(
             write_measured(s, &mg, m)?;
         }
     }
-    super::hiding::write_hiding(s, &g, &a.hiding, sp.thickness_nm)?;
+    hiding::write_hiding(s, &g, &a.hiding, sp.thickness_nm)?;
     write_baselines(s, &g, &a.baseline)?;
     if let Some(png) = tile_png {
         let description = "the tile picture as a PNG file (encoded bytes, no units); byte";

@@ -4,12 +4,12 @@
 
 use std::path::Path;
 
-use super::appearance::write_estimate;
-use super::appearance_read::read_optional;
-use super::attrs::{read_str_attr, write_scalar_attr, write_str_attr};
-use super::described::{about, dim, standard_error, Scales};
-use super::IoError;
-use crate::optics::hiding::{Hiding, Scalar};
+use super::super::appearance_read::read_optional;
+use super::super::attrs::{read_str_attr, write_scalar_attr, write_str_attr};
+use super::super::described::{about, dim, standard_error, Scales};
+use super::super::IoError;
+use super::write_estimate;
+use crate::optics::appearance::hiding::{Hiding, Scalar};
 
 /// Write every geometry's hiding power under `/appearance/hiding`.
 pub(super) fn write_hiding(
@@ -209,7 +209,7 @@ pub fn read_hiding(path: &Path) -> Result<Vec<HidingRecord>, IoError> {
         path: path.to_path_buf(),
         source,
     };
-    let file = super::open(path).map_err(hdf)?;
+    let file = super::super::open(path).map_err(hdf)?;
     if !file.link_exists("appearance/hiding") {
         return Ok(Vec::new());
     }

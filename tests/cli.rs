@@ -107,7 +107,8 @@ fn limits_and_numbers_read_as_written() {
     // The grain limit is the packer's, not (0, 1).
     expect_error(
         SceneToml::tiny().pvc(1.0),
-        "key `pigment[0].pvc`: must be in (0, 0.55] (the most the packer reaches), got 1",
+        "key `pigment[0].pvc`: must be in [0, 0.55] (the most the packer reaches; 0: absent, as the \
+         first step of a let-down series), got 1",
     );
     // Huge and tiny numbers in exponent form, not 301 digits.
     expect_error(SceneToml::tiny().diameter_nm(1e300), "got 1e300");

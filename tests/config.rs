@@ -266,7 +266,9 @@ fn other_ranges_are_checked() {
             base().raw("layer.fragment_nm", "[2000.0]"),
             "layer.fragment_nm",
         ),
-        (base().pvc(0.0), "pigment[0].pvc"),
+        (base().pvc(-0.1), "pigment[0].pvc"),
+        // 0 is a pigment left out, but one pigment must be present.
+        (base().pvc(0.0), "pigment[*].pvc"),
         (base().diameter_nm(1200.0), "pigment[0].diameter_nm"),
         (base().cell_nm(0.0), "grid.cell_nm"),
         (base().cell_nm(0.1), "grid.cell_nm"),

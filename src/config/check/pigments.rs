@@ -56,18 +56,23 @@ impl Checker<'_> {
                     shares.push(self.range(
                         &key("share"),
                         sh,
-                        sh > 0.0 && sh.is_finite(),
-                        "(0, inf)",
+                        sh >= 0.0 && sh.is_finite(),
+                        "[0, inf) (0: absent)",
                     )?);
                 }
             }
         }
+        let sum: f64 = shares.iter().sum();
+        // A negative or non-finite value is named by its own key below.
+        if sum == 0.0 {
+            return Err(self.invalid(
+                "pigment[*].pvc",
+                "every pigment is at 0: at least one needs a volume fraction above 0",
+            ));
+        }
         let fractions: Vec<f64> = match total_pvc {
             None => shares,
-            Some(t) => {
-                let sum: f64 = shares.iter().sum();
-                shares.iter().map(|s| t * s / sum).collect()
-            }
+            Some(t) => shares.iter().map(|s| t * s / sum).collect(),
         };
         let molecular: Vec<bool> = raw
             .iter()
@@ -111,15 +116,18 @@ impl Checker<'_> {
                 self.range(
                     &vf_key,
                     vf,
-                    vf > 0.0 && vf < 1.0,
-                    "(0, 1) (a dissolved dye)",
+                    (0.0..1.0).contains(&vf),
+                    "[0, 1) (a dissolved dye; 0: absent)",
                 )?
             } else {
                 self.range(
                     &vf_key,
                     vf,
-                    vf > 0.0 && vf <= MAX_PVC,
-                    &format!("(0, {MAX_PVC}] (the most the packer reaches)"),
+                    (0.0..=MAX_PVC).contains(&vf),
+                    &format!(
+                        "[0, {MAX_PVC}] (the most the packer reaches; 0: absent, as the first \
+                         step of a let-down series)"
+                    ),
                 )?
             };
             // A molecular pigment's diameter is not used (documented).

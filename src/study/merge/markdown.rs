@@ -2,8 +2,8 @@
 //! variants in Markdown (see [`super::page`]).
 
 use super::page::{
-    any_hiding, baseline_table, colour_cells, contrast_cell, effect_table, PageInput,
-    BASELINE_TEXT, CR_TEXT,
+    any_hiding, any_tint, baseline_table, colour_cells, effect_table, hiding_cells, PageInput,
+    BASELINE_TEXT, CR_TEXT, HIDING_HEAD, TINT_TEXT,
 };
 use std::fmt::Write as _;
 
@@ -29,7 +29,11 @@ pub(super) fn page(p: &PageInput) -> String {
            [summary.html](summary.html)\n\n## Effects\n\n\
            For each step an axis compares (its `compare` pairs, else each label to the next): \
            mean change of the measured colour over the pairs of variants that differ in that \
-           axis only, ± the standard error of the mean; ΔE00 range over the pairs.\n\n";
+           axis only, ± the standard error of the mean; ΔE00 range over the pairs.";
+    if any_tint(p.effects) {
+        md += TINT_TEXT;
+    }
+    md += "\n\n";
     let (head, rows) = effect_table(p.effects);
     if rows.is_empty() {
         md += "No pairs of variants with measured colours.\n\n";
@@ -70,7 +74,7 @@ pub(super) fn page(p: &PageInput) -> String {
         head.push(h.into());
     }
     if cr {
-        head.push("CR".into());
+        head.extend(HIDING_HEAD.map(String::from));
     }
     head.push("files".into());
     let rows: Vec<Vec<String>> = p
@@ -93,7 +97,7 @@ pub(super) fn page(p: &PageInput) -> String {
                 None => cells.extend(["—", "—", "—", "—"].map(String::from)),
             }
             if cr {
-                cells.push(contrast_cell(r));
+                cells.extend(hiding_cells(r));
             }
             cells.push(
                 p.variant_files(r.v)

@@ -225,31 +225,71 @@ pub fn colour_cells(r: &Row) -> Option<([String; 3], Option<String>)> {
     Some(([cell(0, 1), cell(1, 1), cell(2, 0)], hex))
 }
 
-/// A variant's contrast ratio cell (`0.912 ± 0.004 (d/8 SCI)`), `—`
-/// without a chart.
-pub fn contrast_cell(r: &Row) -> String {
-    match &r.hiding {
-        Some(h) => match h.contrast_ratio_se {
-            Some(se) => format!("{:.4} ± {se:.4}", h.contrast_ratio),
-            None => format!("{:.4}", h.contrast_ratio),
-        },
-        None => "—".into(),
+/// A value ± its standard error with `digits` decimals (`—` when not finite).
+fn value_se(value: f64, se: Option<f64>, digits: usize) -> String {
+    if !value.is_finite() {
+        return if value.is_nan() {
+            "—".into()
+        } else {
+            "∞".into()
+        };
+    }
+    match se.filter(|s| s.is_finite()) {
+        Some(se) => format!("{value:.digits$} ± {se:.digits$}"),
+        None => format!("{value:.digits$}"),
     }
 }
 
-/// Whether any variant has a contrast ratio (then the variants table has a
-/// CR column).
+/// The header cells of a variant's hiding power (with [`hiding_cells`]).
+pub const HIDING_HEAD: [&str; 4] = ["CR", "S (1/µm)", "K (1/µm)", "K/S max"];
+
+/// A variant's hiding power over a chart: the contrast ratio, Kubelka's S
+/// and K at Y, and the largest K/S over the solved wavelengths with where it
+/// is, each ± its standard error; `—` without a chart.
+pub fn hiding_cells(r: &Row) -> [String; 4] {
+    match &r.hiding {
+        Some(h) => [
+            value_se(h.contrast_ratio, h.contrast_ratio_se, 4),
+            value_se(h.at_y[1].0, h.at_y[1].1, 3),
+            value_se(h.at_y[2].0, h.at_y[2].1, 4),
+            format!(
+                "{} at {:.0} nm",
+                value_se(h.k_over_s_max, h.k_over_s_max_se, 3),
+                h.k_over_s_max_wavelength_nm
+            ),
+        ],
+        None => std::array::from_fn(|_| "—".into()),
+    }
+}
+
+/// Whether any variant has a contrast ratio (then the variants table has
+/// the [`HIDING_HEAD`] columns).
 pub fn any_hiding(p: &PageInput) -> bool {
     p.rows.iter().any(|r| r.hiding.is_some())
 }
 
-/// The sentence the variants table adds for its CR column.
-pub const CR_TEXT: &str = " CR: contrast ratio Y(over black)/Y(over white) over a hiding chart \
-                           ± s.e., in d/8 SCI where measured.";
+/// The sentence the variants table adds for its hiding columns.
+pub const CR_TEXT: &str = " CR: contrast ratio Y(over black)/Y(over white) over a hiding chart; \
+                           S, K: Kubelka's scattering and absorption coefficients per µm of \
+                           layer from the luminance factors over black and white (exact \
+                           hyperbolic solution); K/S max: the largest K/S over the solved \
+                           wavelengths (a colour pigment's absorption maximum); each ± s.e., in \
+                           d/8 SCI where measured.";
+
+/// The sentence the effects table adds for its tinting strength column.
+pub const TINT_TEXT: &str = " Tinting strength: 100 % × K/S of the step's second variant over \
+                             K/S of its first, at the wavelength where the first's K/S is \
+                             largest (its absorption maximum; d/8 SCI over the chart), ± s.e.";
+
+/// Whether any effect has a tinting strength.
+pub fn any_tint(effects: &[Effect]) -> bool {
+    effects.iter().any(|e| e.tinting_strength.is_some())
+}
 
 /// The header cells of the effects table and each effect's cells.
 pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>) {
-    let head = vec![
+    let tint = any_tint(effects);
+    let mut head = vec![
         "axis",
         "step",
         "pairs",
@@ -260,10 +300,13 @@ pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>)
         "ΔE00",
         "ΔE00 range",
     ];
+    if tint {
+        head.push("tinting strength (%)");
+    }
     let rows = effects
         .iter()
         .map(|e| {
-            vec![
+            let mut cells = vec![
                 e.axis.clone(),
                 format!("{} → {}", e.from, e.to),
                 e.pairs.to_string(),
@@ -273,7 +316,14 @@ pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>)
                 fmt_mean_se(&e.delta_lch[2], true),
                 fmt_mean_se(&e.delta_e00, false),
                 format!("{:.2} – {:.2}", e.delta_e00_range.0, e.delta_e00_range.1),
-            ]
+            ];
+            if tint {
+                cells.push(match e.tinting_strength {
+                    Some(t) => value_se(t.mean, t.se, 1),
+                    None => "—".into(),
+                });
+            }
+            cells
         })
         .collect();
     (head, rows)
@@ -357,12 +407,15 @@ pub(super) fn html_page(p: &PageInput) -> String {
     }
     body += "</table>\n<p>Files: <a href=\"summary.h5\">summary.h5</a> (every variant \
              linked), <a href=\"summary.md\">summary.md</a>.</p>\n";
-    body += "<h2>Effects</h2>\n<p>Each step an axis compares (its <code>compare</code> pairs, else each \
+    body += &format!(
+        "<h2>Effects</h2>\n<p>Each step an axis compares (its <code>compare</code> pairs, else each \
              label to the next): the \
              mean change of the measured colour over the pairs of variants that differ in that \
              axis only, ± the standard error of the mean from the variants' own standard \
              errors; the ΔE00 range over the pairs shows how much the effect depends on the \
-             other axes.</p>\n";
+             other axes.{}</p>\n",
+        if any_tint(p.effects) { TINT_TEXT } else { "" }
+    );
     let (head, rows) = effect_table(p.effects);
     if rows.is_empty() {
         body += "<p>No pairs of variants with measured colours.</p>\n";
@@ -436,7 +489,7 @@ fn variants_html(p: &PageInput) -> String {
         head.push(h.into());
     }
     if cr {
-        head.push("CR".into());
+        head.extend(HIDING_HEAD.map(String::from));
     }
     head.push("files".into());
     let mut s = format!(
@@ -460,7 +513,7 @@ fn variants_html(p: &PageInput) -> String {
             None => cells.extend(["—", "—", "—", "—"].map(String::from)),
         }
         if cr {
-            cells.push(contrast_cell(r));
+            cells.extend(hiding_cells(r));
         }
         cells.push(
             p.variant_files(r.v)

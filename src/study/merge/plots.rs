@@ -1,5 +1,6 @@
-//! The study plots: L* and C*ab of every variant's measured colour against
-//! each axis, one line per label of the series axis (the axis named
+//! The study plots: L* and C*ab of every variant's measured colour (and,
+//! over a hiding chart, Kubelka's S per unit pigment volume and the contrast
+//! ratio, `plots/hiding-<axis>….png`) against each axis, one line per label of the series axis (the axis named
 //! `pigment`, else the first), ± one standard error where the variants have
 //! two or more realisations. The axes that are neither the x axis nor the
 //! series axis split the plots: one picture per combination of their labels,
@@ -10,6 +11,7 @@
 //! equally spaced in axis order.
 
 use super::Row;
+use crate::config::GrainShape;
 use crate::optics::colour::{lab_to_lch, lch_se};
 use crate::output::render::plot::{self, Panel, PanelSize, Point, Scale, Series};
 use crate::output::render::Canvas;
@@ -46,6 +48,104 @@ pub(super) fn numeric_axis(axis: &Axis) -> Option<(String, Vec<f64>)> {
     Some((key.clone(), xs))
 }
 
+/// A variant's value of a plotted quantity and its standard error.
+type ValueOf = Box<dyn Fn(&Row) -> Option<(f64, Option<f64>)>>;
+
+/// One plotted quantity of a variant.
+struct Quantity {
+    /// Panel title ("lightness L*").
+    title: &'static str,
+    /// The y axis's label, with units.
+    axis_label: &'static str,
+    of: ValueOf,
+}
+
+/// One kind of study plot: a picture per x axis and combination of the
+/// other axes, one panel per quantity.
+struct Figure {
+    /// File name prefix ("" for the colour plots).
+    prefix: &'static str,
+    /// "L* and C*ab".
+    what: &'static str,
+    /// The note's first sentence(s).
+    note: String,
+    quantities: Vec<Quantity>,
+}
+
+/// The volume fraction of scattering grains in a variant's layer (its
+/// species' volume fractions, dissolved ones left out).
+fn grain_volume_fraction(r: &Row) -> f64 {
+    r.v.scene
+        .species
+        .iter()
+        .filter(|s| s.shape != GrainShape::Molecular)
+        .map(|s| s.volume_fraction)
+        .sum()
+}
+
+/// The figures drawn: the colour's L* and C*ab always; over a hiding chart
+/// (`hiding`: its geometry) also Kubelka's S per unit pigment volume and the
+/// contrast ratio.
+fn figures(geometry: &str, conditions: &str, hiding: Option<&str>) -> Vec<Figure> {
+    let colour = |k: usize| {
+        move |r: &Row| {
+            let m = r.measured.as_ref()?;
+            let lch = lab_to_lch(m.record.lab);
+            let se = m.record.lab_se.map(|se| lch_se(m.record.lab, se)[k]);
+            Some((lch[k], se))
+        }
+    };
+    let mut out = vec![Figure {
+        prefix: "",
+        what: "L* and C*ab",
+        note: format!("Each point: one variant's {geometry} colour ({conditions}); "),
+        quantities: vec![
+            Quantity {
+                title: "lightness L*",
+                axis_label: "L*",
+                of: Box::new(colour(0)),
+            },
+            Quantity {
+                title: "chroma C*ab",
+                axis_label: "C*ab",
+                of: Box::new(colour(1)),
+            },
+        ],
+    }];
+    if let Some(h) = hiding {
+        out.push(Figure {
+            prefix: "hiding-",
+            what: "scattering per pigment volume and contrast ratio",
+            note: format!(
+                "Over a hiding chart, {h} ({conditions}): Kubelka's S at Y per µm of layer \
+                 divided by the grains' volume fraction (the scattering power of the pigment \
+                 itself), and CR = Y(over black)/Y(over white); "
+            ),
+            quantities: vec![
+                Quantity {
+                    title: "S per pigment volume",
+                    axis_label: "S / PVC (1/µm)",
+                    of: Box::new(|r: &Row| {
+                        let h = r.hiding.as_ref()?;
+                        let f = grain_volume_fraction(r);
+                        let (s, se) = h.at_y[1];
+                        (f > 0.0).then(|| (s / f, se.map(|e| e / f)))
+                    }),
+                },
+                Quantity {
+                    title: "contrast ratio",
+                    axis_label: "CR",
+                    of: Box::new(|r: &Row| {
+                        let h = r.hiding.as_ref()?;
+                        Some((h.contrast_ratio, h.contrast_ratio_se))
+                    }),
+                },
+            ],
+        });
+    }
+    out
+}
+
 /// The (file name, title, picture) of every study plot.
 pub(super) fn draw_plots(
     study: &Study,
@@ -62,6 +162,9 @@ pub(super) fn draw_plots(
     }) else {
         return Ok(vec![]);
     };
+    let hiding_geometry = rows
+        .iter()
+        .find_map(|r| r.hiding.as_ref().map(|h| h.geometry.clone()));
     let multi = study.axes.len() > 1;
     let mut out = vec![];
     for x_ax in study
@@ -118,7 +221,7 @@ pub(super) fn draw_plots(
                     .collect(),
                 None => vec![(String::new(), rows.iter().filter(in_combo).collect())],
             };
-            let series_for = |k: usize| -> Vec<Series> {
+            let series_for = |value: &Quantity| -> Vec<Series> {
                 lines
                     .iter()
                     .enumerate()
@@ -126,11 +229,13 @@ pub(super) fn draw_plots(
                         let mut points: Vec<Point> = rs
                             .iter()
                             .filter_map(|r| {
-                                let m = r.measured.as_ref()?;
                                 let x = x_of(r.v.label(&x_ax.name)?)?;
-                                let lch = lab_to_lch(m.record.lab);
-                                let se = m.record.lab_se.map(|se| lch_se(m.record.lab, se)[k]);
-                                lch[k].is_finite().then_some(Point { x, y: lch[k], se })
+                                let (y, se) = (value.of)(r)?;
+                                y.is_finite().then_some(Point {
+                                    x,
+                                    y,
+                                    se: se.filter(|s| s.is_finite()),
+                                })
                             })
                             .collect();
                         points.sort_by(|a, b| a.x.total_cmp(&b.x));
@@ -162,26 +267,6 @@ pub(super) fn draw_plots(
                     Some(x_ax.values.iter().map(|v| v.label.clone()).collect()),
                 ),
             };
-            let mut panels = vec![];
-            for (k, what) in [(0, "lightness L*"), (1, "chroma C*ab")] {
-                let series = series_for(k);
-                let Some(y) = Scale::covering_linear(series.iter().flat_map(|s| s.values()), false)
-                else {
-                    continue;
-                };
-                panels.push(Panel {
-                    title: format!("{what} against {}", x_ax.name),
-                    x_label: x_label.clone(),
-                    y_label: what.split(' ').next_back().unwrap_or(what).to_string(),
-                    x,
-                    y,
-                    x_categories: cats.clone(),
-                    series,
-                });
-            }
-            if panels.is_empty() {
-                continue;
-            }
             let fixed: Vec<String> = rest
                 .iter()
                 .zip(&combo)
@@ -192,43 +277,68 @@ pub(super) fn draw_plots(
                 .zip(&combo)
                 .map(|(a, l)| format!("__{}-{}", sanitise(&a.name), sanitise(l.unwrap_or("none"))))
                 .collect();
-            let title = format!(
-                "{} {profile}: L* and C*ab against {}{}",
-                study.name,
-                x_ax.name,
-                if fixed.is_empty() {
-                    String::new()
-                } else {
-                    format!(" ({})", fixed.join(", "))
+            for figure in figures(&geometry, &conditions, hiding_geometry.as_deref()) {
+                let mut panels = vec![];
+                for q in &figure.quantities {
+                    let series = series_for(q);
+                    let Some(y) =
+                        Scale::covering_linear(series.iter().flat_map(|s| s.values()), false)
+                    else {
+                        continue;
+                    };
+                    panels.push(Panel {
+                        title: format!("{} against {}", q.title, x_ax.name),
+                        x_label: x_label.clone(),
+                        y_label: q.axis_label.to_string(),
+                        x,
+                        y,
+                        x_categories: cats.clone(),
+                        series,
+                    });
                 }
-            );
-            let with_se = panels[0]
-                .series
-                .iter()
-                .any(|s| s.points.iter().any(|p| p.se.is_some()));
-            let notes = [format!(
-                "Each point: one variant's {geometry} colour ({conditions}); {}{}",
-                match series_ax {
-                    Some(s) => format!("one line per {}. ", s.name),
-                    None => String::new(),
-                },
-                if with_se {
-                    "Bars: ± one standard error over the variant's realisations."
-                } else {
-                    "One realisation per variant: no standard error."
+                if panels.is_empty() {
+                    continue;
                 }
-            )];
-            let legend: Vec<_> = panels[0]
-                .series
-                .iter()
-                .map(|s| (s.label.clone(), s.colour, s.dashed))
-                .collect();
-            let canvas = plot::figure(&title, &notes, &panels, 2, PANEL, &legend)?;
-            out.push((
-                format!("{}{suffix}.png", sanitise(&x_ax.name)),
-                title,
-                canvas,
-            ));
+                let title = format!(
+                    "{} {profile}: {} against {}{}",
+                    study.name,
+                    figure.what,
+                    x_ax.name,
+                    if fixed.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({})", fixed.join(", "))
+                    }
+                );
+                let with_se = panels[0]
+                    .series
+                    .iter()
+                    .any(|s| s.points.iter().any(|p| p.se.is_some()));
+                let notes = [format!(
+                    "{}{}{}",
+                    figure.note,
+                    match series_ax {
+                        Some(s) => format!("one line per {}. ", s.name),
+                        None => String::new(),
+                    },
+                    if with_se {
+                        "Bars: ± one standard error over the variant's realisations."
+                    } else {
+                        "One realisation per variant: no standard error."
+                    }
+                )];
+                let legend: Vec<_> = panels[0]
+                    .series
+                    .iter()
+                    .map(|s| (s.label.clone(), s.colour, s.dashed))
+                    .collect();
+                let canvas = plot::figure(&title, &notes, &panels, 2, PANEL, &legend)?;
+                out.push((
+                    format!("{}{}{suffix}.png", figure.prefix, sanitise(&x_ax.name)),
+                    title,
+                    canvas,
+                ));
+            }
         }
     }
     Ok(out)

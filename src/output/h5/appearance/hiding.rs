@@ -191,8 +191,10 @@ pub struct HidingRecord {
     pub k_over_s_max: f64,
     pub k_over_s_max_se: Option<f64>,
     pub k_over_s_max_wavelength_nm: f64,
-    /// At the solved wavelengths (`/appearance/wavelengths_nm`): R∞, S, K
-    /// and K/S, each with its standard errors.
+    /// The solved wavelengths (`/appearance/wavelengths_nm`), nm.
+    pub wavelengths_nm: Vec<f64>,
+    /// At [`Self::wavelengths_nm`]: R∞, S, K and K/S, each with its
+    /// standard errors.
     pub spectral: [(Vec<f64>, Option<Vec<f64>>); 4],
 }
 
@@ -214,6 +216,10 @@ pub fn read_hiding(path: &Path) -> Result<Vec<HidingRecord>, IoError> {
         return Ok(Vec::new());
     }
     let hg = file.group("appearance/hiding").map_err(hdf)?;
+    let wavelengths_nm = read_optional::<f64, ndarray::Ix1>(&file, "appearance/wavelengths_nm")
+        .map_err(hdf)?
+        .map(|v| v.to_vec())
+        .unwrap_or_default();
     let mut out = Vec::new();
     for name in hg.member_names().map_err(hdf)? {
         let g = hg.group(&name).map_err(hdf)?;
@@ -250,6 +256,7 @@ pub fn read_hiding(path: &Path) -> Result<Vec<HidingRecord>, IoError> {
             k_over_s_max: must("k_over_s_max")?,
             k_over_s_max_se: one("k_over_s_max_se")?,
             k_over_s_max_wavelength_nm: must("k_over_s_max_wavelength_nm")?,
+            wavelengths_nm: wavelengths_nm.clone(),
             spectral: [
                 spectral(SPECTRAL[0])?,
                 spectral(SPECTRAL[1])?,

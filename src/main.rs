@@ -218,7 +218,8 @@ enum Command {
     /// stops it. Nothing is fetched from the network.
     View {
         /// Result files (.h5), a study's folder (its variants/) or its
-        /// summary.h5; the first is A.
+        /// summary.h5; the first is A. A scene file (.toml) is recomputed
+        /// live by its radiative-transfer baseline as its controls move.
         #[arg(required = true)]
         inputs: Vec<PathBuf>,
         /// Port to listen on (0: any free port).

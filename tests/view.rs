@@ -283,3 +283,82 @@ fn the_page_draws_the_results_colour_and_answers_its_controls() {
         std::fs::copy(&shot, keep).unwrap();
     }
 }
+
+/// One GET of `url` (`http://127.0.0.1:PORT/path`) over a plain socket: the
+/// body and the wall-clock time it took.
+fn get(url: &str) -> (String, f64) {
+    use std::io::{Read, Write};
+    let rest = url.strip_prefix("http://").unwrap();
+    let (host, path) = rest.split_at(rest.find('/').unwrap());
+    let t0 = std::time::Instant::now();
+    let mut s = std::net::TcpStream::connect(host).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.0\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut text = String::new();
+    s.read_to_string(&mut text).unwrap();
+    let ms = t0.elapsed().as_secs_f64() * 1e3;
+    let body = text
+        .split_once("\r\n\r\n")
+        .map(|x| x.1)
+        .unwrap_or("")
+        .to_string();
+    (body, ms)
+}
+
+#[test]
+fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = SceneToml::grains().paper(0.9).output(d, "live").write(d);
+    let served = serve(&[&scene]);
+    let url = &served.1;
+    let (params, _) = get(&format!("{url}/api/live"));
+    assert!(
+        params.contains("\"key\":\"pvc0\"") && params.contains("thickness_nm"),
+        "{params}"
+    );
+    // Every change a user makes is one request: time a sweep of the
+    // pigment's volume fraction, server work and HTTP round trip together.
+    let mut worst: f64 = 0.0;
+    let mut l_star = vec![];
+    for k in 1..=10 {
+        let pvc = 0.03 * k as f64;
+        let (body, ms) = get(&format!(
+            "{url}/api/live/compute?pvc0={pvc}&thickness_nm=2000"
+        ));
+        worst = worst.max(ms);
+        let j = Json::parse(&body);
+        let c = &j.get("result").arr("colours")[0];
+        assert_eq!(c.str("geometry"), "45/0");
+        l_star.push(c.arr("lab")[0].as_num());
+    }
+    eprintln!("live recompute, 10 changes: slowest {worst:.1} ms (limit 200); L* {l_star:.1?}");
+    assert!(worst < 200.0, "{worst} ms");
+    // More pigment, darker: the model answers the control.
+    assert!(l_star.windows(2).all(|w| w[1] < w[0]), "{l_star:?}");
+
+    let Some(chrome) = chromium() else {
+        eprintln!("SKIPPED the page part: no chromium on PATH");
+        return;
+    };
+    let p = probe(
+        &chrome,
+        d,
+        &format!("{url}/?probe=live&theta=45&phi=0&sky=0&ev=0"),
+    );
+    let after = p.get("after");
+    let (before_px, after_px) = (rgb(&p.arr("centres")[0]), rgb(&after.arr("centres")[0]));
+    assert_ne!(
+        before_px, after_px,
+        "the picture did not follow the control"
+    );
+    assert_ne!(
+        p.str("colours"),
+        after.str("colours"),
+        "the numbers did not follow"
+    );
+    assert!(p.str("readout").contains("ΔE00"), "{}", p.str("readout"));
+}

@@ -13,10 +13,13 @@
 //! - [`table`]: the BRDF, sky and specular tables the shader reads;
 //! - [`result`]: a result file loaded for the page;
 //! - [`source`]: which results a command line names (files, a study's folder);
+//! - [`live`]: the recompute hook ([`live::LiveModel`]) and the scenes' radiative-transfer
+//!   baselines recomputed as a control moves;
 //! - [`server`]: the HTTP server and its routes; [`page`]: the embedded page.
 //!
 //! Imports from every earlier stage; nothing imports from it.
 
+pub mod live;
 pub mod page;
 pub mod result;
 pub mod server;
@@ -37,6 +40,10 @@ pub enum ViewError {
     NoBrdf(PathBuf),
     #[error("{}: no result files (*.h5) in this folder or its variants/", .0.display())]
     NoResults(PathBuf),
+    #[error("{}: cannot be recomputed live: {why}", .path.display())]
+    NotLive { path: PathBuf, why: String },
+    #[error("recompute: {0}")]
+    Live(String),
     #[error(transparent)]
     Io(#[from] IoError),
     #[error("BRDF: {0}")]

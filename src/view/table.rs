@@ -66,10 +66,16 @@ fn polar(theta_deg: f64, phi_deg: f64) -> [f64; 3] {
     [t.sin() * p.cos(), t.sin() * p.sin(), t.cos()]
 }
 
+/// Linear sRGB of the CIELAB colour `lab` (under `obs`) as sRGB shows it:
+/// gamut mapped as the tile draws it.
+pub fn display_rgb(obs: &Observer, lab: [f64; 3]) -> [f64; 3] {
+    gamut::lab_to_linear_srgb(obs, gamut::map_lab(obs, lab).lab)
+}
+
 /// Per-channel gains taking `π f(45°, 0°)` to the gamut-mapped 45°/0° colour
 /// `lab` (CIELAB under `obs`).
 fn gains_to(brdf: &RgbBrdf, obs: &Observer, lab: [f64; 3]) -> [f64; 3] {
-    let target = gamut::lab_to_linear_srgb(obs, gamut::map_lab(obs, lab).lab);
+    let target = display_rgb(obs, lab);
     let solved = brdf.eval(polar(45.0, 0.0), [0.0, 0.0, 1.0]);
     std::array::from_fn(|ch| {
         let s = std::f64::consts::PI * solved[ch];
@@ -82,6 +88,28 @@ fn gains_to(brdf: &RgbBrdf, obs: &Observer, lab: [f64; 3]) -> [f64; 3] {
 }
 
 impl PageBrdf {
+    /// A Lambertian body of reflectance `rgb` (linear sRGB) under a flat
+    /// surface whose specular reflectance against the polar angle (deg) is
+    /// `specular`: `f = rgb/π` everywhere, `sky = rgb`.
+    pub fn lambertian(rgb: [f64; 3], specular: &dyn Fn(f64) -> f64, anchor: String) -> PageBrdf {
+        let thetas = nodes(THETA_STEP_DEG, 90.0);
+        let phis = nodes(PHI_STEP_DEG, 180.0);
+        let f = rgb.map(|v| (v / std::f64::consts::PI) as f32);
+        let n = thetas.len() * thetas.len() * phis.len();
+        PageBrdf {
+            n_theta: thetas.len(),
+            n_phi: phis.len(),
+            brdf: (0..n).flat_map(|_| f).collect(),
+            sky: thetas.iter().flat_map(|_| rgb.map(|v| v as f32)).collect(),
+            specular: thetas
+                .iter()
+                .flat_map(|&t| [specular(t) as f32; 3])
+                .collect(),
+            gain: [1.0; 3],
+            anchor,
+        }
+    }
+
     /// The table of `brdf`; `anchor_45_0` is the result's measured 45°/0°
     /// colour (CIELAB) and the observer it is under, when it has one.
     pub fn new(brdf: &RgbBrdf, anchor_45_0: Option<([f64; 3], &Observer)>) -> PageBrdf {

@@ -434,6 +434,55 @@ async function select() {
   panel();
 }
 
+// ---------- live recompute ----------
+// Each control change asks the server for the model at the new values; while
+// one request is out, only the latest change waits (no queue builds up).
+const live = { id: -1, params: [], busy: false, pending: null, last: null };
+
+function liveValues() {
+  return live.params.map((p) => `${encodeURIComponent(p.key)}=${Number($("live-" + p.key).value)}`).join("&");
+}
+
+async function liveCompute(t0) {
+  if (live.busy) { live.pending = t0; return; }
+  live.busy = true;
+  try {
+    const r = await fetch(`/api/live/compute?${liveValues()}`);
+    if (!r.ok) throw new Error(await r.text());
+    const j = await r.json();
+    state.data[live.id] = j.result;
+    if (state.a === live.id) uploadResult(0, j.result);
+    if (state.b === live.id) uploadResult(1, j.result);
+    draw();
+    panel();
+    const ms = performance.now() - t0;
+    live.last = { server_ms: j.compute_ms, total_ms: ms };
+    $("live-time").textContent = `last change: model ${j.compute_ms.toFixed(1)} ms on the server, ` +
+      `${ms.toFixed(0)} ms from the control to the new picture`;
+  } catch (e) {
+    $("live-time").textContent = `recompute failed: ${e.message}`;
+  } finally {
+    live.busy = false;
+    if (live.pending !== null) { const t = live.pending; live.pending = null; liveCompute(t); }
+  }
+}
+
+async function initLive() {
+  const r = await fetch("/api/live");
+  if (!r.ok) return;
+  const j = await r.json();
+  live.id = j.id;
+  live.params = j.params;
+  $("live").style.display = "";
+  $("live-params").innerHTML = j.params.map((p) =>
+    `<label>${p.label} <input type="range" id="live-${p.key}" min="${p.min}" max="${p.max}" step="${p.step}" value="${p.value}"> ` +
+    `<span id="live-${p.key}-v" class="num">${p.value}</span>${p.unit === "1" ? "" : " " + p.unit}</label><br>`).join("");
+  for (const p of j.params) {
+    const el = $("live-" + p.key);
+    el.addEventListener("input", () => { $("live-" + p.key + "-v").textContent = el.value; liveCompute(performance.now()); });
+  }
+}
+
 // ---------- controls ----------
 function bindRange(id, key, digits) {
   const el = $(id);
@@ -535,6 +584,19 @@ function probe(kind) {
     el.dispatchEvent(new Event("input"));
     out.after = { theta: state.theta, centres: centres().map(([x, y, id]) => ({ x, y, id, rgb: pixel(x, y) })), readout: $("readout").textContent };
   }
+  if (kind === "live" && live.params.length) {
+    // Move the first live control as a user would; report once the picture changed.
+    const p = live.params[0], el = $("live-" + p.key);
+    el.value = String(Math.min(p.max, Number(el.value) / 2 + p.min / 2));
+    const before = live.last;
+    el.dispatchEvent(new Event("input"));
+    const wait = () => new Promise((res) => setTimeout(res, 20));
+    return (async () => {
+      for (let k = 0; k < 500 && (live.busy || live.last === before); k++) await wait();
+      out.after = { centres: centres().map(([x, y, id]) => ({ x, y, id, rgb: pixel(x, y) })), readout: $("readout").textContent, latency: live.last, colours: $("colours").textContent };
+      $("probe").textContent = JSON.stringify(out);
+    })();
+  }
   $("probe").textContent = JSON.stringify(out);
 }
 
@@ -552,8 +614,9 @@ async function main() {
     $("title").textContent = state.results.length === 1 ? state.results[0].name : `${state.results.length} results`;
     bindControls();
     syncLightSliders();
+    await initLive();
     await select();
-    if (q.has("probe")) probe(q.get("probe"));
+    if (q.has("probe")) await probe(q.get("probe"));
   } catch (e) {
     $("error").textContent = `error: ${e.message}`;
     $("probe").textContent = JSON.stringify({ error: e.message });

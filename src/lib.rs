@@ -6,7 +6,7 @@
 //! [`config`] → [`geometry`] → [`raster`] → [`solver`] → [`optics`] (far
 //! field, substrate, colour, appearance) → [`output`] (atomic writes, HDF5,
 //! pictures, MERL, progress) → [`pipeline`] (one scene) → [`study`] (a sweep
-//! of scenes). `tests/layering.rs` checks the rule on the source: no import
+//! of scenes) → [`view`] (the interactive page of `inksim view`). `tests/layering.rs` checks the rule on the source: no import
 //! from a later stage and no import cycle anywhere.
 //!
 //! The physics and numerics are explained in `docs/METHOD.md` (the module
@@ -21,6 +21,7 @@ pub mod pipeline;
 pub mod raster;
 pub mod solver;
 pub mod study;
+pub mod view;
 
 /// Version string embedded in every result file.
 pub const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("INKSIM_COMMIT"));

@@ -209,6 +209,31 @@ enum Command {
     /// whose wavelengths leave a material's range is refused by `check` and
     /// `run` before any work. Your own data: `material = { csv = "file.csv" }`.
     Materials,
+    /// Serve an interactive page that draws results on an object: a sphere,
+    /// a curved panel or your OBJ under a lamp you drag and a uniform sky,
+    /// beside the tile, the spectra and the measured colours; two results
+    /// side by side or split on one object (A/B). See docs/VIEW.md.
+    ///
+    /// Listens on 127.0.0.1 (loopback only) and prints the address; Ctrl-C
+    /// stops it. Nothing is fetched from the network.
+    View {
+        /// Result files (.h5), a study's folder (its variants/) or its
+        /// summary.h5; the first is A. A scene file (.toml) is recomputed
+        /// live by its radiative-transfer baseline as its controls move.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// Port to listen on (0: any free port).
+        #[arg(long, default_value_t = 8017)]
+        port: u16,
+        /// Address to listen on. Anything but a loopback address needs
+        /// --allow-remote.
+        #[arg(long, default_value = "127.0.0.1")]
+        host: std::net::IpAddr,
+        /// Allow listening on a non-loopback address (the page and the
+        /// results become reachable from other machines).
+        #[arg(long)]
+        allow_remote: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -311,6 +336,12 @@ fn real_main() -> Result<ExitCode> {
             to,
         } => cli::export::export(&target, profile.as_deref(), output_dir, to)?,
         Command::Materials => cli::materials::materials()?,
+        Command::View {
+            inputs,
+            port,
+            host,
+            allow_remote,
+        } => cli::view::view(&inputs, host, port, allow_remote)?,
         Command::Check { config } => {
             let config = cli::ConfigFile::read(&config)?;
             if config.is_study() {

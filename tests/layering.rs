@@ -18,8 +18,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The library's stages, earliest first.
-const STAGES: [&str; 8] = [
-    "config", "geometry", "raster", "solver", "optics", "output", "pipeline", "study",
+const STAGES: [&str; 9] = [
+    "config", "geometry", "raster", "solver", "optics", "output", "pipeline", "study", "view",
 ];
 
 /// A module path such as `["solver", "methods", "gmres"]`.

@@ -13,6 +13,7 @@ use inksim::output::render::plot::palette;
 use inksim::output::render::Canvas;
 
 mod common;
+use common::browser::chromium;
 use common::cli::inksim_in;
 
 /// Two pigments × two PVCs, two realisations each, 8 × 8 × 4 grids.
@@ -135,20 +136,6 @@ fn finished_study_writes_plots_and_a_page_whose_links_resolve() {
         .expect("the pvc step's row");
     assert!(row.contains(&cell), "{cell} not in {row}");
     assert!(row.contains("<td>2</td>"), "two pairs: {row}");
-}
-
-/// A Chromium (or Chrome) on this machine, if any.
-fn chromium() -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    for dir in std::env::split_paths(&path) {
-        for name in ["chromium", "chromium-browser", "google-chrome"] {
-            let p = dir.join(name);
-            if p.is_file() {
-                return Some(p);
-            }
-        }
-    }
-    None
 }
 
 #[test]

@@ -9,6 +9,7 @@
 //!   memory.
 //! - [`slurm`]: `slurm`, the sbatch job-array script.
 //! - [`materials`]: `materials`, the stand-ins and the material library.
+//! - [`view`]: `view`, the interactive page.
 //!
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
@@ -19,6 +20,7 @@ pub mod plan;
 pub mod scene;
 pub mod slurm;
 pub mod study;
+pub mod view;
 
 use anyhow::Result;
 use inksim::study::run::Shard;
@@ -48,6 +50,10 @@ pub fn exit_quietly_on_broken_pipe() {
 /// are written atomically), say what is done and how to resume, exit 130.
 pub fn exit_cleanly_on_interrupt() {
     let _ = ctrlc::set_handler(|| {
+        if view::SERVING.load(std::sync::atomic::Ordering::SeqCst) {
+            eprintln!("\n[inksim] view stopped");
+            std::process::exit(0);
+        }
         let removed = inksim::output::atomic::remove_unfinished();
         let status = inksim::output::progress::status();
         let status = if status.is_empty() {

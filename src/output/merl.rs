@@ -26,7 +26,8 @@
 
 use crate::optics::appearance::Appearance;
 use crate::optics::colour::{self, Observer};
-use crate::optics::farfield::table;
+use crate::optics::farfield::table::{self, TableSpec};
+use ndarray::{Array2, Array4};
 use std::f64::consts::PI;
 
 const N_TH: usize = 90;
@@ -100,11 +101,56 @@ fn directions(ih: usize, id: usize, ip: usize) -> ([f64; 3], [f64; 3]) {
     (wi, wo)
 }
 
+/// What the RGB BRDF is evaluated from: the solved angles, the diffuse
+/// density tables, the transmittance and specular reflectance from above and
+/// the paper term; taken from an assembled [`Appearance`]
+/// ([`BrdfData::of`]) or read back from a result file
+/// (`output::h5::read_brdf_data`).
+#[derive(Debug, Clone)]
+pub struct BrdfData {
+    pub wavelengths_nm: Vec<f64>,
+    /// Azimuth of the plane of incidence (deg).
+    pub azimuth_deg: f64,
+    pub illumination_deg: Vec<f64>,
+    pub above_deg: Vec<f64>,
+    pub table: TableSpec,
+    /// Density tables (wavelength, illumination, j, i), ensemble mean.
+    pub density: Array4<f64>,
+    /// (wavelength, above angle), ensemble means.
+    pub transmittance: Array2<f64>,
+    /// Specular (0,0) order, coherent plus incoherent (wavelength, above angle).
+    pub specular: Array2<f64>,
+    /// With a reflecting ground: its albedo and the layer's albedo from
+    /// below `R_dd↑`, per wavelength.
+    pub paper: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+impl BrdfData {
+    /// The data of an assembled appearance.
+    pub fn of(a: &Appearance) -> BrdfData {
+        let sp = &a.spec;
+        BrdfData {
+            wavelengths_nm: sp.wavelengths_nm.clone(),
+            azimuth_deg: sp.azimuth_deg,
+            illumination_deg: sp.illumination_deg.clone(),
+            above_deg: sp.above_deg.clone(),
+            table: sp.table,
+            density: a.brdf_table.mean.clone(),
+            transmittance: a.transmittance.mean.clone(),
+            specular: &a.specular_coherent + &a.specular_incoherent,
+            paper: a
+                .paper
+                .as_ref()
+                .map(|p| (p.albedo.to_vec(), p.r_dd_up.mean.to_vec())),
+        }
+    }
+}
+
 /// The diffuse BRDF of layer + substrate in linear sRGB (D65, white
 /// balanced), at any pair of directions: what the MERL table samples and
 /// the preview renders (the approximations of the module docs).
-pub struct RgbBrdf<'a> {
-    a: &'a Appearance,
+pub struct RgbBrdf {
+    d: BrdfData,
     /// Linear sRGB weights of each wavelength.
     w: Vec<[f64; 3]>,
     /// RGB density tables, (illumination, j, i) flattened.
@@ -115,41 +161,46 @@ pub struct RgbBrdf<'a> {
     paper: Option<Vec<f64>>,
 }
 
-impl<'a> RgbBrdf<'a> {
-    pub fn new(a: &'a Appearance) -> Result<Self, MerlError> {
-        let sp = &a.spec;
-        let (nl, ni) = (sp.wavelengths_nm.len(), sp.illumination_deg.len());
-        if ni == 0 || nl == 0 {
+impl RgbBrdf {
+    /// The BRDF of an assembled appearance.
+    pub fn new(a: &Appearance) -> Result<Self, MerlError> {
+        RgbBrdf::from_data(BrdfData::of(a))
+    }
+
+    /// The BRDF of `d`.
+    pub fn from_data(d: BrdfData) -> Result<Self, MerlError> {
+        let (nl, ni) = (d.wavelengths_nm.len(), d.illumination_deg.len());
+        if ni == 0 || nl == 0 || d.above_deg.is_empty() {
             return Err(MerlError::NoData);
         }
         let obs = Observer::cie1931_d65();
-        let w = channel_weights(&obs, &sp.wavelengths_nm)?;
-        let nt = sp.table.n();
-        let tab = &a.brdf_table.mean;
+        let w = channel_weights(&obs, &d.wavelengths_nm)?;
+        let nt = d.table.n();
+        let tab = &d.density;
         let mut rgb_tab = vec![[0.0f64; 3]; ni * nt * nt];
         for i in 0..ni {
             for k in 0..nt * nt {
                 let (j, q) = (k / nt, k % nt);
                 let mut c = [0.0; 3];
                 for (l, wl) in w.iter().enumerate() {
-                    let d = tab[[l, i, j, q]];
+                    let v = tab[[l, i, j, q]];
                     for ch in 0..3 {
-                        c[ch] += wl[ch] * d;
+                        c[ch] += wl[ch] * v;
                     }
                 }
                 rgb_tab[i * nt * nt + k] = c;
             }
         }
-        let paper: Option<Vec<f64>> = a.paper.as_ref().map(|p| {
+        let paper: Option<Vec<f64>> = d.paper.as_ref().map(|(albedo, rdd)| {
             (0..nl)
-                .map(|l| p.albedo[l] / (PI * (1.0 - p.albedo[l] * p.r_dd_up.mean[l])))
+                .map(|l| albedo[l] / (PI * (1.0 - albedo[l] * rdd[l])))
                 .collect()
         });
         let coverage: Vec<f64> = (0..nt * nt)
-            .map(|k| table::node_coverage(sp.table, k % nt, k / nt))
+            .map(|k| table::node_coverage(d.table, k % nt, k / nt))
             .collect();
         Ok(RgbBrdf {
-            a,
+            d,
             w,
             rgb_tab,
             coverage,
@@ -157,12 +208,45 @@ impl<'a> RgbBrdf<'a> {
         })
     }
 
+    /// The angles solved from above (deg).
+    pub fn above_deg(&self) -> &[f64] {
+        &self.d.above_deg
+    }
+
+    /// The illumination angles of the tables (deg).
+    pub fn illumination_deg(&self) -> &[f64] {
+        &self.d.illumination_deg
+    }
+
+    /// Directional-hemispherical reflectance of the diffuse BRDF for the
+    /// viewing angle `theta_o_deg` (by reciprocity, the radiance under a
+    /// uniform sky of radiance 1), by the midpoint rule in μ = cos θi and φ.
+    pub fn sky(&self, theta_o_deg: f64) -> [f64; 3] {
+        let (nm, np) = (24, 48);
+        let t = theta_o_deg.min(89.5).to_radians();
+        let wo = [t.sin(), 0.0, t.cos()];
+        let mut acc = [0.0; 3];
+        for im in 0..nm {
+            let mu = (im as f64 + 0.5) / nm as f64;
+            let s = (1.0 - mu * mu).sqrt();
+            for ip in 0..np {
+                let p = (ip as f64 + 0.5) / np as f64 * 2.0 * PI;
+                let f = self.eval([s * p.cos(), s * p.sin(), mu], wo);
+                for ch in 0..3 {
+                    acc[ch] += f[ch] * mu;
+                }
+            }
+        }
+        let w = (1.0 / nm as f64) * (2.0 * PI / np as f64);
+        acc.map(|v| v * w)
+    }
+
     /// Transmittance from above at polar angle `theta` (deg), wavelength `l`.
     fn t_of(&self, l: usize, theta: f64) -> f64 {
-        let sp = &self.a.spec;
-        let (k, f) = bracket(&sp.above_deg, theta);
-        let t = &self.a.transmittance.mean;
-        if sp.above_deg.len() == 1 {
+        let above = &self.d.above_deg;
+        let (k, f) = bracket(above, theta);
+        let t = &self.d.transmittance;
+        if above.len() == 1 {
             t[[l, 0]]
         } else {
             t[[l, k]] * (1.0 - f) + t[[l, k + 1]] * f
@@ -171,9 +255,9 @@ impl<'a> RgbBrdf<'a> {
 
     /// RGB density of illumination angle `i` at projected direction (sx, sy).
     fn density(&self, i: usize, sx: f64, sy: f64) -> [f64; 3] {
-        let sp = &self.a.spec;
-        let nt = sp.table.n();
-        let (cell, half) = (sp.table.cell, sp.table.half as f64);
+        let tb = &self.d.table;
+        let nt = tb.n();
+        let (cell, half) = (tb.cell, tb.half as f64);
         let (x, y) = (sx / cell + half, sy / cell + half);
         let max = (nt - 1) as f64;
         if !(x >= 0.0 && y >= 0.0 && x <= max && y <= max) {
@@ -213,9 +297,8 @@ impl<'a> RgbBrdf<'a> {
         if wi[2] <= 0.0 || wo[2] <= 0.0 {
             return [0.0; 3];
         }
-        let sp = &self.a.spec;
-        let ni = sp.illumination_deg.len();
-        let az = sp.azimuth_deg.to_radians();
+        let ni = self.d.illumination_deg.len();
+        let az = self.d.azimuth_deg.to_radians();
         let theta_i = wi[2].min(1.0).acos().to_degrees();
         let theta_o = wo[2].min(1.0).acos().to_degrees();
         // Light travels along −wi; rotate so it travels along the solved
@@ -224,7 +307,7 @@ impl<'a> RgbBrdf<'a> {
         let rot = az - phi_travel;
         let (s, c) = rot.sin_cos();
         let (sx, sy) = (c * wo[0] - s * wo[1], s * wo[0] + c * wo[1]);
-        let (k, f) = bracket(&sp.illumination_deg, theta_i);
+        let (k, f) = bracket(&self.d.illumination_deg, theta_i);
         let d0 = self.density(k, sx, sy);
         let d1 = if ni > 1 {
             self.density(k + 1, sx, sy)
@@ -250,14 +333,12 @@ impl<'a> RgbBrdf<'a> {
     /// coherent plus incoherent, linear sRGB; interpolated between the
     /// angles solved from above, held beyond them.
     pub fn specular(&self, theta: f64) -> [f64; 3] {
-        let sp = &self.a.spec;
-        let (k, f) = bracket(&sp.above_deg, theta);
-        let r = |l: usize, a: usize| {
-            self.a.specular_coherent[[l, a]] + self.a.specular_incoherent[[l, a]]
-        };
+        let above = &self.d.above_deg;
+        let (k, f) = bracket(above, theta);
+        let r = |l: usize, a: usize| self.d.specular[[l, a]];
         let mut rgb = [0.0; 3];
         for (l, wl) in self.w.iter().enumerate() {
-            let v = if sp.above_deg.len() == 1 {
+            let v = if above.len() == 1 {
                 r(l, 0)
             } else {
                 r(l, k) * (1.0 - f) + r(l, k + 1) * f

@@ -32,7 +32,7 @@
 
 pub mod accuracy;
 mod appearance;
-mod baseline;
+pub mod baseline;
 pub mod disk;
 mod eps;
 mod fine_bodies;

@@ -13,6 +13,8 @@
 //! - `summary`: the reader of identity and per-solve numbers;
 //! - `appearance`: the `/appearance` group's writer, `appearance_read` its
 //!   readers;
+//! - `brdf_read`: what drawing the layer on an object needs (the RGB
+//!   BRDF's data, the measured spectra, the tile);
 //! - `attrs`: scalar and string attribute helpers shared by all of them;
 //! - `described`: every dataset's `units`, `description` and axis names,
 //!   written with it; `scales`: the HDF5 dimension scales behind the axes;
@@ -30,6 +32,7 @@
 mod appearance;
 mod appearance_read;
 mod attrs;
+mod brdf_read;
 mod described;
 mod file;
 mod geometry;
@@ -44,6 +47,7 @@ pub use appearance_read::{
     read_appearance, read_baseline, read_measured, read_measured_black, read_optional,
     AppearanceArrays, BaselineRecord, MeasuredRecord,
 };
+pub use brdf_read::{read_brdf_data, read_measured_spectra, read_tile_png, MeasuredSpectrum};
 pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};
 pub use geometry::GeometrySummary;

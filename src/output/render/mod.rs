@@ -52,7 +52,7 @@ pub mod canvas;
 mod colour_bar;
 mod geometry;
 pub mod plot;
-mod preview;
+pub mod preview;
 mod spectra;
 pub mod tile;
 

@@ -93,8 +93,8 @@ trait Surface {
 }
 
 /// The layer on its substrate.
-struct Layer<'a> {
-    brdf: RgbBrdf<'a>,
+struct Layer {
+    brdf: RgbBrdf,
     /// Directional-hemispherical reflectance at θo = 0°, 2°, …, 90°.
     sky: Vec<[f64; 3]>,
     /// Per-channel gain of the reflection, `None` where no tile colour
@@ -104,32 +104,11 @@ struct Layer<'a> {
 
 const SKY_STEP_DEG: f64 = 2.0;
 
-impl<'a> Layer<'a> {
-    fn new(a: &'a Appearance, obs: &Observer) -> Result<Self, MerlError> {
+impl Layer {
+    fn new(a: &Appearance, obs: &Observer) -> Result<Self, MerlError> {
         let brdf = RgbBrdf::new(a)?;
-        // Midpoint rule in μ = cos θi and in φ.
-        let (nm, np) = (24, 48);
         let n = (90.0 / SKY_STEP_DEG) as usize + 1;
-        let sky = (0..n)
-            .map(|k| {
-                let t = (k as f64 * SKY_STEP_DEG).min(89.5).to_radians();
-                let wo = [t.sin(), 0.0, t.cos()];
-                let mut acc = [0.0; 3];
-                for im in 0..nm {
-                    let mu = (im as f64 + 0.5) / nm as f64;
-                    let s = (1.0 - mu * mu).sqrt();
-                    for ip in 0..np {
-                        let p = (ip as f64 + 0.5) / np as f64 * 2.0 * PI;
-                        let f = brdf.eval([s * p.cos(), s * p.sin(), mu], wo);
-                        for ch in 0..3 {
-                            acc[ch] += f[ch] * mu;
-                        }
-                    }
-                }
-                let w = (1.0 / nm as f64) * (2.0 * PI / np as f64);
-                acc.map(|v| v * w)
-            })
-            .collect();
+        let sky = (0..n).map(|k| brdf.sky(k as f64 * SKY_STEP_DEG)).collect();
         let mut layer = Layer {
             brdf,
             sky,
@@ -169,7 +148,7 @@ impl<'a> Layer<'a> {
     }
 }
 
-impl Surface for Layer<'_> {
+impl Surface for Layer {
     fn brdf(&self, wi: [f64; 3], wo: [f64; 3]) -> [f64; 3] {
         let (f, g) = (self.brdf.eval(wi, wo), self.gain());
         std::array::from_fn(|ch| f[ch] * g[ch])

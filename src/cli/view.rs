@@ -1,0 +1,55 @@
+//! `inksim view`: load the results, bind the server, print the address,
+//! serve until Ctrl-C.
+
+use anyhow::{bail, Result};
+use inksim::view::live::{LiveModel, RadiativeTransfer};
+use inksim::view::{result, server, source};
+use std::net::IpAddr;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Set while the page is being served: Ctrl-C then ends quietly (exit 0).
+pub static SERVING: AtomicBool = AtomicBool::new(false);
+
+/// Serve `inputs` (result files, study folders, summary files, and at most
+/// one scene file recomputed live) on `host`:`port`.
+pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> Result<()> {
+    let mut results = vec![];
+    let mut live: Option<Box<dyn LiveModel>> = None;
+    for input in inputs {
+        if input.extension().and_then(|e| e.to_str()) == Some("toml") {
+            let config = super::ConfigFile::read(input)?;
+            if config.is_study() {
+                bail!(
+                    "{}: a study file; give its results' folder (<output_dir>/<profile>) or its summary.h5",
+                    config.display()
+                );
+            }
+            if live.is_some() {
+                bail!(
+                    "{}: one scene is recomputed live at a time",
+                    input.display()
+                );
+            }
+            live = Some(Box::new(RadiativeTransfer::new(&config.scene()?)?));
+            continue;
+        }
+        for path in source::result_files(input)? {
+            results.push(result::load(&path)?);
+        }
+    }
+    let (srv, addr) = server::bind(server::Listen {
+        host,
+        port,
+        allow_remote,
+    })?;
+    let mut site = server::Site::new(results);
+    if let Some(model) = live {
+        site = site.with_live(model)?;
+    }
+    println!("inksim view: http://{addr}/  (Ctrl-C stops it)");
+    SERVING.store(true, Ordering::SeqCst);
+    let stop = AtomicBool::new(false);
+    server::serve(&srv, &site, &stop);
+    Ok(())
+}

@@ -1,0 +1,201 @@
+//! Live recompute: scenes a fast model recomputes in milliseconds, with the
+//! parameters the page offers as controls.
+//!
+//! [`LiveModel`] is the hook: a model names its parameters ([`Param`]) and
+//! gives the page's data for any values of them. [`RadiativeTransfer`] is
+//! the classical baseline of a scene (`appearance.baseline`, its first
+//! model; Kubelka–Munk when it names none): the pigments' volume fractions,
+//! the layer's thickness and the paper's albedo are its controls. The
+//! baseline's body is diffuse: the page draws it as a Lambertian body of the
+//! baseline's 45°/0° colour (gamut mapped) under the binder's flat surface,
+//! whose specular reflectance is Fresnel's (`optics::baseline::fresnel`,
+//! the law the model uses), and says so.
+
+use serde::Serialize;
+
+use super::result::{page_colours, rgb_to_xyz, PageResult};
+use super::table::{display_rgb, PageBrdf};
+use super::ViewError;
+use crate::config::{Baseline, Measurement, Scene};
+use crate::optics::baseline::{self, BaselineInput};
+use crate::optics::colour::Observer;
+use crate::output::h5::{MeasuredRecord, MeasuredSpectrum};
+use crate::pipeline::baseline::baseline_input;
+
+/// One control of a live model.
+#[derive(Debug, Clone, Serialize)]
+pub struct Param {
+    pub key: String,
+    pub label: String,
+    pub unit: String,
+    pub min: f64,
+    pub max: f64,
+    pub step: f64,
+    pub value: f64,
+}
+
+/// A model the server recomputes when a control moves.
+pub trait LiveModel: Send {
+    /// What it is, in words, for the page.
+    fn describe(&self) -> String;
+    /// Its controls, with their starting values.
+    fn params(&self) -> Vec<Param>;
+    /// The page's data at `values` (one per parameter, in order, already
+    /// within their ranges).
+    fn compute(&self, values: &[f64]) -> Result<PageResult, ViewError>;
+}
+
+/// Why a scene cannot be recomputed live.
+fn not_live(scene: &Scene, why: &str) -> ViewError {
+    ViewError::NotLive {
+        path: scene.path().to_path_buf(),
+        why: why.to_string(),
+    }
+}
+
+/// A scene's radiative-transfer baseline (module docs).
+pub struct RadiativeTransfer {
+    name: String,
+    model: Baseline,
+    input: BaselineInput,
+    names: Vec<String>,
+    observer: Observer,
+}
+
+impl RadiativeTransfer {
+    pub fn new(scene: &Scene) -> Result<RadiativeTransfer, ViewError> {
+        if scene.stack.is_some() {
+            return Err(not_live(scene, "a stack (one layer only, for now)"));
+        }
+        let input = baseline_input(scene)
+            .map_err(|e| not_live(scene, &e.to_string()))?
+            .ok_or_else(|| not_live(scene, "the baselines need paper of one albedo"))?;
+        Ok(RadiativeTransfer {
+            name: scene.output.name.clone(),
+            model: scene
+                .appearance
+                .baseline
+                .first()
+                .copied()
+                .unwrap_or(Baseline::KubelkaMunk),
+            names: scene.species.iter().map(|s| s.name.clone()).collect(),
+            input,
+            observer: Observer::standard(scene.appearance.illuminant, scene.appearance.observer),
+        })
+    }
+}
+
+impl LiveModel for RadiativeTransfer {
+    fn describe(&self) -> String {
+        format!(
+            "radiative transfer ({}), recomputed live; drawn as a Lambertian body of its 45°/0° \
+             colour under the binder's Fresnel surface",
+            self.model.name()
+        )
+    }
+
+    fn params(&self) -> Vec<Param> {
+        let mut p: Vec<Param> = self
+            .input
+            .species
+            .iter()
+            .zip(&self.names)
+            .enumerate()
+            .map(|(k, (s, name))| Param {
+                key: format!("pvc{k}"),
+                label: format!("volume fraction of {name}"),
+                unit: "1".into(),
+                min: 0.0,
+                max: 0.55,
+                step: 0.005,
+                value: s.volume_fraction,
+            })
+            .collect();
+        p.push(Param {
+            key: "thickness_nm".into(),
+            label: "layer thickness".into(),
+            unit: "nm".into(),
+            min: 100.0,
+            max: 20000.0,
+            step: 50.0,
+            value: self.input.thickness_nm,
+        });
+        p.push(Param {
+            key: "paper_albedo".into(),
+            label: "paper albedo".into(),
+            unit: "1".into(),
+            min: 0.0,
+            max: 1.0,
+            step: 0.01,
+            value: self.input.paper_albedo,
+        });
+        p
+    }
+
+    fn compute(&self, values: &[f64]) -> Result<PageResult, ViewError> {
+        let mut input = self.input.clone();
+        let ns = input.species.len();
+        for (s, v) in input.species.iter_mut().zip(values) {
+            s.volume_fraction = *v;
+        }
+        if let Some(&t) = values.get(ns) {
+            input.thickness_nm = t;
+        }
+        if let Some(&a) = values.get(ns + 1) {
+            input.paper_albedo = a;
+        }
+        let geometries = Measurement::ALL;
+        let colours =
+            baseline::baseline_colours(self.model, &input, &geometries, &|_| None, &self.observer)
+                .map_err(|e| ViewError::Live(e.to_string()))?;
+        let records: Vec<MeasuredRecord> = colours
+            .iter()
+            .map(|c| MeasuredRecord {
+                geometry: c.geometry.name().to_string(),
+                lab: c.lab,
+                xyz: [f64::NAN; 3],
+                lab_se: None,
+                de00_se: None,
+            })
+            .collect();
+        let spectra: Vec<MeasuredSpectrum> = colours
+            .iter()
+            .map(|c| MeasuredSpectrum {
+                geometry: c.geometry.name().to_string(),
+                wavelengths_nm: c.spectrum_wavelengths_nm.clone(),
+                spectrum: c.reflectance_factor.clone(),
+                solved_nm: vec![],
+                solved: vec![],
+            })
+            .collect();
+        let obs = &self.observer;
+        let colours = page_colours(&records, &spectra, obs);
+        let lab = colours
+            .iter()
+            .find(|c| c.geometry == Measurement::FortyFiveZero.name())
+            .map(|c| c.lab)
+            .ok_or_else(|| ViewError::Live("no 45°/0° colour".into()))?;
+        let fresnel = baseline::surfaces(self.model, input.equation);
+        let n = input.binder_index;
+        let brdf = PageBrdf::lambertian(
+            display_rgb(obs, lab),
+            &|t| fresnel.external(n, t.min(89.9)),
+            "Lambertian body of the model's 45°/0° colour (gamut mapped) under the binder's \
+             Fresnel surface"
+                .into(),
+        );
+        Ok(PageResult {
+            name: format!("{} (live)", self.name),
+            model: self.describe(),
+            conditions: match obs.conditions() {
+                Some((ill, o)) => format!("{ill}, {}°", o.degrees()),
+                None => "custom observer".into(),
+            },
+            colours,
+            brdf,
+            labels: vec![],
+            rgb_to_xyz: rgb_to_xyz(obs),
+            white_xyz: obs.white_xyz(),
+        })
+    }
+}

@@ -1,0 +1,364 @@
+//! `inksim view`: the server refuses what it must (a non-loopback address
+//! unless asked, a missing or corrupt result) with one line; and the page,
+//! served by `inksim view` and drawn by headless Chromium in software WebGL2
+//! (skipped, saying so, where no Chromium is installed), is not blank, draws
+//! the object's centre under a 45° lamp in the result's 45°/0° colour as sRGB
+//! shows it (within ΔE00 2, the pixel read back from the page and converted
+//! here, independently of the page's own arithmetic), changes picture and
+//! numbers when a control moves, and shows both results of an A/B.
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use inksim::config::{Illuminant, StandardObserver};
+use inksim::optics::colour::{delta_e2000, gamut, srgb_decode, xyz_to_lab, Observer};
+use inksim::output::h5::read_measured;
+use inksim::output::render::Canvas;
+
+mod common;
+use common::browser::chromium;
+use common::cli::inksim_in;
+use common::json::Json;
+use common::scene::{PigmentToml, SceneToml};
+
+/// A small result of `pigment` in `dir` (`dir/<pigment>.h5`).
+fn result(dir: &Path, pigment: &str) -> PathBuf {
+    let sub = dir.join(pigment);
+    std::fs::create_dir_all(&sub).unwrap();
+    SceneToml::tiny()
+        .pigment(PigmentToml::builtin(pigment).pvc(0.15).diameter_nm(150.0))
+        .output(dir, pigment)
+        .run(&sub);
+    dir.join(format!("{pigment}.h5"))
+}
+
+/// `inksim view` serving `files` on a free loopback port; the child and its
+/// address (`http://127.0.0.1:PORT`).
+struct Served(Child, String);
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Start `inksim view args…`: the child and the first line it printed.
+fn start(args: &[&str]) -> (Child, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_inksim"))
+        .arg("view")
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    (child, line)
+}
+
+fn serve(files: &[&Path]) -> Served {
+    let mut args: Vec<&str> = files.iter().map(|f| f.to_str().unwrap()).collect();
+    args.extend(["--port", "0"]);
+    let (child, line) = start(&args);
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .trim_end_matches('/')
+        .to_string();
+    Served(child, url)
+}
+
+/// Headless Chromium with software WebGL2, in a fresh profile under `dir`.
+fn browser(chrome: &Path, dir: &Path) -> Command {
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = RUNS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let profile = dir.join(format!("chromium-profile-{n}"));
+    let mut c = Command::new(chrome);
+    c.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--use-gl=angle",
+        "--use-angle=swiftshader",
+        "--enable-unsafe-swiftshader",
+        "--virtual-time-budget=15000",
+    ])
+    .arg(format!("--user-data-dir={}", profile.display()));
+    c
+}
+
+/// The page at `url` (with a `probe` in its query): what it wrote into #probe.
+fn probe(chrome: &Path, dir: &Path, url: &str) -> Json {
+    let out = browser(chrome, dir)
+        .arg("--dump-dom")
+        .arg(url)
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let start = dom
+        .find("<pre id=\"probe\"")
+        .and_then(|i| dom[i..].find('>').map(|j| i + j + 1))
+        .unwrap_or_else(|| panic!("no probe in the page: {dom}"));
+    let end = start + dom[start..].find("</pre>").unwrap();
+    let text = dom[start..end]
+        .replace("&quot;", "\"")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&amp;", "&");
+    let j = Json::parse(&text);
+    if let Json::Obj(m) = &j {
+        assert!(
+            !m.iter().any(|(k, _)| k == "error"),
+            "the page failed: {text}"
+        );
+    }
+    j
+}
+
+/// The 45°/0° colour of a result file as sRGB shows it (gamut mapped) and
+/// the observer it is under.
+fn colour_45_0(path: &Path) -> ([f64; 3], Observer) {
+    let (records, ill, deg) = read_measured(path).unwrap().unwrap();
+    let obs = Observer::standard(
+        Illuminant::from_name(&ill).unwrap(),
+        StandardObserver::from_degrees(deg).unwrap(),
+    );
+    let m = records.iter().find(|m| m.geometry == "45/0").unwrap();
+    (gamut::map_lab(&obs, m.lab).lab, obs)
+}
+
+/// CIELAB under `obs` of an 8-bit sRGB pixel: decoded, then XYZ by solving
+/// `obs.linear_srgb(xyz) = rgb` (a linear map) by Gaussian elimination.
+fn lab_of_pixel(obs: &Observer, rgb8: [u8; 3]) -> [f64; 3] {
+    let rgb = rgb8.map(|v| srgb_decode(v as f64 / 255.0));
+    let mut a = [[0.0; 4]; 3];
+    for k in 0..3 {
+        let mut e = [0.0; 3];
+        e[k] = 1.0;
+        let col = obs.linear_srgb(e);
+        for r in 0..3 {
+            a[r][k] = col[r];
+        }
+    }
+    for r in 0..3 {
+        a[r][3] = rgb[r];
+    }
+    for c in 0..3 {
+        let p = (c..3)
+            .max_by(|&x, &y| a[x][c].abs().total_cmp(&a[y][c].abs()))
+            .unwrap();
+        a.swap(c, p);
+        for r in 0..3 {
+            if r != c {
+                let (pivot, f) = (a[c], a[r][c] / a[c][c]);
+                for (v, p) in a[r].iter_mut().zip(pivot).skip(c) {
+                    *v -= f * p;
+                }
+            }
+        }
+    }
+    let xyz = [a[0][3] / a[0][0], a[1][3] / a[1][1], a[2][3] / a[2][2]];
+    xyz_to_lab(xyz, obs.white_xyz())
+}
+
+fn rgb(j: &Json) -> [u8; 3] {
+    let v = j.arr("rgb");
+    std::array::from_fn(|k| v[k].as_num() as u8)
+}
+
+#[test]
+fn view_refuses_remote_binds_and_bad_results_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let one_line = |args: &[&str], want: &str| {
+        let (ok, out, err) = inksim_in(d, args);
+        assert!(!ok, "{args:?} succeeded: {out}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    };
+    one_line(
+        &["view", "missing.h5", "--port", "0"],
+        "missing.h5: no such file",
+    );
+    std::fs::write(d.join("corrupt.h5"), b"not an HDF5 file at all").unwrap();
+    one_line(&["view", "corrupt.h5", "--port", "0"], "corrupt.h5");
+    let ok = result(d, "yellow");
+    let ok = ok.to_str().unwrap();
+    one_line(
+        &["view", ok, "--host", "0.0.0.0", "--port", "0"],
+        "refusing to listen on 0.0.0.0",
+    );
+    // Asked explicitly, it binds (and is stopped here).
+    let (mut child, line) = start(&[ok, "--host", "0.0.0.0", "--port", "0", "--allow-remote"]);
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(line.contains("http://0.0.0.0:"), "{line}");
+    // Nothing was written beside the inputs.
+    let mut names: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.starts_with("yellow"))
+        .collect();
+    names.sort();
+    assert_eq!(names, ["corrupt.h5"]);
+}
+
+#[test]
+fn the_page_draws_the_results_colour_and_answers_its_controls() {
+    let Some(chrome) = chromium() else {
+        eprintln!(
+            "SKIPPED the_page_draws_the_results_colour_and_answers_its_controls: no chromium, \
+             chromium-browser or google-chrome on PATH (scripts/setup.sh --with-browser \
+             installs it)"
+        );
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (a, b) = (result(d, "yellow"), result(d, "blue"));
+    let served = serve(&[&a, &b]);
+    let url = &served.1;
+
+    // One object under the lamp at 45° from the view, no sky, 0 EV; then the
+    // lamp's slider moved to 15°.
+    let p = probe(
+        &chrome,
+        d,
+        &format!("{url}/?probe=move&theta=45&phi=0&sky=0&ev=0"),
+    );
+    let (w, h) = (p.num("width"), p.num("height"));
+    let object = p.num("object_pixels");
+    assert!(object > 0.2 * w * h, "blank: {object} of {} pixels", w * h);
+    let centre = rgb(&p.arr("centres")[0]);
+    let (want, obs) = colour_45_0(&a);
+    let de = delta_e2000(lab_of_pixel(&obs, centre), want);
+    eprintln!("page centre {centre:?} vs the result's 45°/0° colour: ΔE00 {de:.2}");
+    assert!(de < 2.0, "centre {centre:?}: ΔE00 {de:.2} to {want:?}");
+    let after = p.get("after");
+    let moved = rgb(&after.arr("centres")[0]);
+    assert_ne!(moved, centre, "moving the lamp changed nothing");
+    assert_ne!(after.str("readout"), p.str("readout"));
+    assert!(p.str("readout").contains("ΔE00"), "{}", p.str("readout"));
+
+    // A/B side by side and split: each half in its own result's colour.
+    let (want_b, obs_b) = colour_45_0(&b);
+    for mode in ["side", "split"] {
+        let p = probe(
+            &chrome,
+            d,
+            &format!("{url}/?probe=ab&a=0&b=1&mode={mode}&theta=45&phi=0&sky=0&ev=0"),
+        );
+        let c = p.arr("centres");
+        assert_eq!(c.len(), 2, "{mode}");
+        let (ca, cb) = (rgb(&c[0]), rgb(&c[1]));
+        let da = delta_e2000(lab_of_pixel(&obs, ca), want);
+        let db = delta_e2000(lab_of_pixel(&obs_b, cb), want_b);
+        eprintln!("A/B {mode}: A {ca:?} ΔE00 {da:.2}, B {cb:?} ΔE00 {db:.2}");
+        assert!(da < 2.0 && db < 2.0, "{mode}: {da:.2} {db:.2}");
+        assert!(p.str("colours").contains("A: yellow") && p.str("colours").contains("B: blue"));
+    }
+
+    // A screenshot of the whole page, kept for looking at when asked.
+    let shot = d.join("view.png");
+    browser(&chrome, d)
+        .args(["--window-size=1300,1100"])
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("{url}/?a=0&b=1"))
+        .output()
+        .unwrap();
+    let img = Canvas::decode_png(&std::fs::read(&shot).unwrap()).unwrap();
+    let distinct: std::collections::HashSet<&[u8]> = img.px.chunks_exact(3).collect();
+    assert!(distinct.len() > 500, "{} colours", distinct.len());
+    if let Some(keep) = std::env::var_os("INKSIM_VIEW_SHOT") {
+        std::fs::copy(&shot, keep).unwrap();
+    }
+}
+
+/// One GET of `url` (`http://127.0.0.1:PORT/path`) over a plain socket: the
+/// body and the wall-clock time it took.
+fn get(url: &str) -> (String, f64) {
+    use std::io::{Read, Write};
+    let rest = url.strip_prefix("http://").unwrap();
+    let (host, path) = rest.split_at(rest.find('/').unwrap());
+    let t0 = std::time::Instant::now();
+    let mut s = std::net::TcpStream::connect(host).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.0\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut text = String::new();
+    s.read_to_string(&mut text).unwrap();
+    let ms = t0.elapsed().as_secs_f64() * 1e3;
+    let body = text
+        .split_once("\r\n\r\n")
+        .map(|x| x.1)
+        .unwrap_or("")
+        .to_string();
+    (body, ms)
+}
+
+#[test]
+fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = SceneToml::grains().paper(0.9).output(d, "live").write(d);
+    let served = serve(&[&scene]);
+    let url = &served.1;
+    let (params, _) = get(&format!("{url}/api/live"));
+    assert!(
+        params.contains("\"key\":\"pvc0\"") && params.contains("thickness_nm"),
+        "{params}"
+    );
+    // Every change a user makes is one request: time a sweep of the
+    // pigment's volume fraction, server work and HTTP round trip together.
+    let mut worst: f64 = 0.0;
+    let mut l_star = vec![];
+    for k in 1..=10 {
+        let pvc = 0.03 * k as f64;
+        let (body, ms) = get(&format!(
+            "{url}/api/live/compute?pvc0={pvc}&thickness_nm=2000"
+        ));
+        worst = worst.max(ms);
+        let j = Json::parse(&body);
+        let c = &j.get("result").arr("colours")[0];
+        assert_eq!(c.str("geometry"), "45/0");
+        l_star.push(c.arr("lab")[0].as_num());
+    }
+    eprintln!("live recompute, 10 changes: slowest {worst:.1} ms (limit 200); L* {l_star:.1?}");
+    assert!(worst < 200.0, "{worst} ms");
+    // More pigment, darker: the model answers the control.
+    assert!(l_star.windows(2).all(|w| w[1] < w[0]), "{l_star:?}");
+
+    let Some(chrome) = chromium() else {
+        eprintln!("SKIPPED the page part: no chromium on PATH");
+        return;
+    };
+    let p = probe(
+        &chrome,
+        d,
+        &format!("{url}/?probe=live&theta=45&phi=0&sky=0&ev=0"),
+    );
+    let after = p.get("after");
+    let (before_px, after_px) = (rgb(&p.arr("centres")[0]), rgb(&after.arr("centres")[0]));
+    assert_ne!(
+        before_px, after_px,
+        "the picture did not follow the control"
+    );
+    assert_ne!(
+        p.str("colours"),
+        after.str("colours"),
+        "the numbers did not follow"
+    );
+    assert!(p.str("readout").contains("ΔE00"), "{}", p.str("readout"));
+}

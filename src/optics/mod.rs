@@ -19,5 +19,6 @@ pub mod baseline;
 pub mod colour;
 pub mod effective_medium;
 pub mod farfield;
+pub mod flakes;
 pub mod stack;
 pub mod substrate;

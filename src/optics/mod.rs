@@ -9,6 +9,9 @@
 //!   and the estimated error of replacing grains by it;
 //! - [`appearance`]: ensemble means with standard errors, natural light and
 //!   the colours of a result;
+//! - [`flakes`]: effect pigments (metallic and pearlescent flakes) in a
+//!   multilayer paint by adding–doubling in azimuthal Fourier terms, and
+//!   multi-angle colour;
 //! - [`baseline`]: classical colours of the same scene (Kubelka–Munk, and
 //!   radiative transfer by adding–doubling) beside the wave solution's.
 //!
@@ -19,5 +22,6 @@ pub mod baseline;
 pub mod colour;
 pub mod effective_medium;
 pub mod farfield;
+pub mod flakes;
 pub mod stack;
 pub mod substrate;

@@ -27,6 +27,14 @@
 //! `O(Δτ³/μ³)` per layer, `O(τ Δτ²/μ³)` after the doublings. The start is
 //! `Δτ ≤ 10⁻⁶ μ_min` ([`START_THICKNESS`]).
 //!
+//! **Kernels.** The thin layer and the doublings work on any medium that is
+//! alike from both faces, given per unit thickness in the flux basis
+//! ([`FluxKernel`]): a direction-dependent attenuation of the unscattered
+//! light and the flux scattered from bin to bin. The isotropic medium above
+//! is one; oriented flakes, whose extinction depends on the direction and
+//! whose azimuthal Fourier terms `m > 0` share the same equations, are
+//! another (`optics::flakes`).
+//!
 //! **Doubling.** Two equal layers: `R₂ = R + T (I − R R)⁻¹ R T`,
 //! `T₂ = T (I − R R)⁻¹ T` (a homogeneous slab reflects alike from both
 //! faces), with the unscattered part kept apart ([`Homogeneous`]).
@@ -127,22 +135,23 @@ pub fn direct(ords: &Ordinates, mu_ext: f64, thickness_nm: f64) -> Slab {
 
 /// A homogeneous slab's matrices during doubling, the unscattered light
 /// kept apart: `T = diag(direct) + scattered`. The direct part is the exact
-/// `e^{−τ/μ}` of the current thickness (not squared from the thin layer's:
-/// squaring doubles a relative error, 30 squarings make 10⁻¹⁶ into 10⁻⁷),
-/// and the scattered parts start small, so no `1 − small` is formed and
-/// rounding does not grow with the number of layers.
+/// `e^{−e_i z}` of the current thickness `z` (not squared from the thin
+/// layer's: squaring doubles a relative error, 30 squarings make 10⁻¹⁶ into
+/// 10⁻⁷), and the scattered parts start small, so no `1 − small` is formed
+/// and rounding does not grow with the number of layers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Homogeneous {
     /// Reflection (alike from both faces).
     pub r: Matrix,
     /// Transmission of scattered light.
     pub scattered: Matrix,
-    /// Transmission of unscattered light per bin, `e^{−τ/μ_i}`.
+    /// Transmission of unscattered light per bin, `e^{−e_i z}`.
     pub direct: Vec<f64>,
-    /// The nodes' `μ`.
-    pub mu: Vec<f64>,
-    /// Optical thickness τ.
-    pub tau: f64,
+    /// Attenuation of the unscattered light per unit thickness and bin,
+    /// `e_i` (`1/μ_i` when the thickness is an optical thickness).
+    pub rate: Vec<f64>,
+    /// The thickness `z`, in the unit `rate` is per.
+    pub depth: f64,
 }
 
 impl Homogeneous {
@@ -153,6 +162,55 @@ impl Homogeneous {
             t[(i, i)] += d;
         }
         Slab::symmetric(self.r.clone(), t)
+    }
+}
+
+/// A medium per unit thickness in the flux basis, for a layer that is
+/// alike from both faces (its upside-down is itself): the unscattered
+/// light in bin `i` decays as `e^{−e_i z}` and the flux scattered out of
+/// bin `j` into bin `i` per unit thickness is `same_ij` (same hemisphere)
+/// or `opposite_ij` (the other one); without absorption
+/// `Σ_i (same + opposite)_ij = e_j`. Its radiative transfer equation for
+/// bin fluxes reads `dF⁺_i/dz = −e_i F⁺_i + Σ_j same_ij F⁺_j + opposite_ij F⁻_j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FluxKernel {
+    pub rate: Vec<f64>,
+    pub same: Matrix,
+    pub opposite: Matrix,
+}
+
+impl FluxKernel {
+    /// The kernel of an isotropic medium of single-scattering albedo
+    /// `albedo` and phase moments `chi`, per unit optical thickness:
+    /// `e_i = 1/μ_i`, `same_ij = ω w_i p(μ_i, μ_j)/(2 μ_j)` (and `p(−μ_i,
+    /// μ_j)` for `opposite`), the phase matrices of [`phase_matrices`].
+    pub fn isotropic(ords: &Ordinates, albedo: f64, chi: &[f64]) -> FluxKernel {
+        let n = ords.len();
+        let rate: Vec<f64> = ords.mu.iter().map(|mu| 1.0 / mu).collect();
+        if albedo <= 0.0 {
+            return FluxKernel {
+                rate,
+                same: Matrix::zeros(n),
+                opposite: Matrix::zeros(n),
+            };
+        }
+        let (same, opposite) = phase_matrices(ords, chi);
+        let flux = |p: &Matrix| {
+            Matrix::from_fn(n, |i, j| {
+                0.5 * albedo * ords.weight[i] * p[(i, j)] / ords.mu[j]
+            })
+        };
+        FluxKernel {
+            rate,
+            same: flux(&same),
+            opposite: flux(&opposite),
+        }
+    }
+
+    /// True when nothing is scattered.
+    pub fn scatters_nothing(&self) -> bool {
+        self.same.column_sums().iter().all(|&v| v == 0.0)
+            && self.opposite.column_sums().iter().all(|&v| v == 0.0)
     }
 }
 
@@ -172,19 +230,31 @@ pub fn homogeneous(
         return Ok(Slab::transparent(ords.len()));
     }
     let albedo = if mu_e > 0.0 { mu_s / mu_e } else { 0.0 };
-    let mu_min = ords.mu.iter().copied().fold(1.0, f64::min);
-    let target = START_THICKNESS * mu_min;
-    let mut doublings = 0u32;
-    let mut dtau = tau;
-    while dtau > target && doublings < 200 {
-        dtau *= 0.5;
-        doublings += 1;
+    let kernel = FluxKernel::isotropic(ords, albedo, &chi);
+    Ok(slab(&kernel, tau, START_THICKNESS)?.to_slab())
+}
+
+/// The slab of `kernel`, `depth` thick, by doubling from a thin layer whose
+/// largest attenuation `max_i e_i Δz` is at most `start`.
+pub fn slab(kernel: &FluxKernel, depth: f64, start: f64) -> Result<Homogeneous, BaselineError> {
+    let rate_max = kernel.rate.iter().copied().fold(0.0, f64::max);
+    if !(depth.is_finite() && depth >= 0.0 && rate_max.is_finite()) {
+        return Err(BaselineError::Thickness(depth * rate_max));
     }
-    let mut layer = thin(ords, albedo, &chi, dtau)?;
+    let target = start / rate_max.max(f64::MIN_POSITIVE);
+    let mut doublings = 0u32;
+    let mut dz = depth;
+    if !kernel.scatters_nothing() {
+        while dz > target && doublings < 200 {
+            dz *= 0.5;
+            doublings += 1;
+        }
+    }
+    let mut layer = thin_flux(kernel, dz)?;
     for _ in 0..doublings {
         layer = double(&layer)?;
     }
-    Ok(layer.to_slab())
+    Ok(layer)
 }
 
 /// The thin layer's optical thickness in units of the smallest node's `μ`:
@@ -200,35 +270,41 @@ pub fn thin(
     chi: &[f64],
     dtau: f64,
 ) -> Result<Homogeneous, BaselineError> {
-    let n = ords.len();
-    let direct: Vec<f64> = ords.mu.iter().map(|mu| (-dtau / mu).exp()).collect();
-    if albedo <= 0.0 {
+    thin_flux(&FluxKernel::isotropic(ords, albedo, chi), dtau)
+}
+
+/// A thin layer `dz` thick of `kernel` by the diamond scheme (the bin
+/// fluxes inside taken as the mean of their values on both faces, a linear
+/// system of `2N` unknowns per incident bin, solved for the scattered part
+/// only); the unscattered light exactly, `e^{−e_i Δz}`.
+pub fn thin_flux(kernel: &FluxKernel, dz: f64) -> Result<Homogeneous, BaselineError> {
+    let n = kernel.rate.len();
+    let direct: Vec<f64> = kernel.rate.iter().map(|e| (-e * dz).exp()).collect();
+    if kernel.scatters_nothing() {
         return Ok(Homogeneous {
             r: Matrix::zeros(n),
             scattered: Matrix::zeros(n),
             direct,
-            mu: ords.mu.clone(),
-            tau: dtau,
+            rate: kernel.rate.clone(),
+            depth: dz,
         });
     }
-    let (same, opposite) = phase_matrices(ords, chi);
-    // h = Δτ/(2μ_i); Ã = (ω/2) P⁺⁺ W, B = (ω/2) P⁺⁻ W, A = I − Ã.
-    let h: Vec<f64> = ords.mu.iter().map(|mu| 0.5 * dtau / mu).collect();
-    let at = |i: usize, j: usize| 0.5 * albedo * same[(i, j)] * ords.weight[j];
-    let b = |i: usize, j: usize| 0.5 * albedo * opposite[(i, j)] * ords.weight[j];
-    // The diamond system for (I⁺₁, I⁻₀) given I⁺₀:
-    // [[I + hA, −hB], [−hB, I + hA]] x = [[I − hA], [hB]].
+    // s = Δz/2, h_i = s e_i; the diamond system for (F⁺₁, F⁻₀) given F⁺₀:
+    // [[I + H − sQ⁺, −sQ⁻], [−sQ⁻, I + H − sQ⁺]] x = [[I − H + sQ⁺], [sQ⁻]].
+    let s = 0.5 * dz;
+    let h: Vec<f64> = kernel.rate.iter().map(|e| s * e).collect();
+    let (same, opposite) = (&kernel.same, &kernel.opposite);
     let m = 2 * n;
     let lhs = Matrix::from_fn(m, |r, c| {
         let (ri, ci) = (r % n, c % n);
         if (r < n) == (c < n) {
-            (r == c) as u8 as f64 * (1.0 + h[ri]) - h[ri] * at(ri, ci)
+            (r == c) as u8 as f64 * (1.0 + h[ri]) - s * same[(ri, ci)]
         } else {
-            -h[ri] * b(ri, ci)
+            -s * opposite[(ri, ci)]
         }
     });
     // Less its unscattered solution x₀ = (diag e_d, 0), e_d = (1 − h)/(1 + h):
-    // the right side becomes [[hÃ(I + E_d)], [hB(I + E_d)]], all small.
+    // the right side becomes [[sQ⁺(I + E_d)], [sQ⁻(I + E_d)]], all small.
     let rhs = Matrix::from_fn(m, |r, c| {
         if c >= n {
             return 0.0;
@@ -236,20 +312,18 @@ pub fn thin(
         let ri = r % n;
         let grow = 1.0 + (1.0 - h[c]) / (1.0 + h[c]);
         if r < n {
-            h[ri] * at(ri, c) * grow
+            s * same[(ri, c)] * grow
         } else {
-            h[ri] * b(ri, c) * grow
+            s * opposite[(ri, c)] * grow
         }
     });
     let x = lhs.solve(&rhs)?;
-    // Radiance → flux: F_ij = c_i X_ij / c_j.
-    let c = &ords.flux_weight;
     Ok(Homogeneous {
-        r: Matrix::from_fn(n, |i, j| c[i] * x[(n + i, j)] / c[j]),
-        scattered: Matrix::from_fn(n, |i, j| c[i] * x[(i, j)] / c[j]),
+        r: Matrix::from_fn(n, |i, j| x[(n + i, j)]),
+        scattered: Matrix::from_fn(n, |i, j| x[(i, j)]),
         direct,
-        mu: ords.mu.clone(),
-        tau: dtau,
+        rate: kernel.rate.clone(),
+        depth: dz,
     })
 }
 
@@ -276,12 +350,12 @@ pub fn double(s: &Homogeneous) -> Result<Homogeneous, BaselineError> {
             scattered[(i, j)] += (s.direct[i] + s.direct[j]) * s.scattered[(i, j)];
         }
     }
-    let tau = 2.0 * s.tau;
+    let depth = 2.0 * s.depth;
     Ok(Homogeneous {
         r,
         scattered,
-        direct: s.mu.iter().map(|mu| (-tau / mu).exp()).collect(),
-        mu: s.mu.clone(),
-        tau,
+        direct: s.rate.iter().map(|e| (-e * depth).exp()).collect(),
+        rate: s.rate.clone(),
+        depth,
     })
 }

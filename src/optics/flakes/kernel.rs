@@ -1,0 +1,400 @@
+//! A paint layer's scattering in the azimuthal Fourier terms of the
+//! adding–doubling directions: the flux kernels ([`FluxKernel`]) of every
+//! term `m = 0, 1, …` per unit thickness, from its flakes and its ordinary
+//! pigments.
+//!
+//! **Fourier terms.** An azimuthally isotropic layer scatters light from
+//! azimuth `φ'` to `φ` by a kernel of `cos(φ − φ')`, so the azimuthal
+//! Fourier terms of the radiance do not mix: term `m` of a flux arriving in
+//! bin `j` goes to term `m` in bin `i` with weight `Q^m_ij = ∫ q_ij(Δφ)
+//! cos(mΔφ) dΔφ`, `q_ij(Δφ)` the flux scattered per unit thickness and per
+//! radian of azimuth. Each term is a slab problem of its own with the same
+//! directions, the same unscattered light and the same flat interfaces
+//! (which keep the azimuth); a Lambertian ground has only `m = 0`. With the
+//! convention `f(φ) = (1/2π)[f₀ + 2 Σ_{m≥1} f_m cos mφ]`, a convolution in
+//! azimuth is a product of terms, so adding and doubling apply term by term.
+//!
+//! **Flakes.** A ray along `ω` meets, per unit path, projected flake area
+//! `a ∫ D(m) |ω·m| dω_m` ([`super::normals`], `a` the flakes' projected area
+//! per unit volume); a flake with normal `m` reflects `R_f(|ω·m|)` of it
+//! into `ω − 2(ω·m)m`, lets `T_f` go on undeviated and absorbs the rest.
+//! Changing variables from the normal to the reflected direction
+//! (`dω_o = 4 |ω·h| dω_h`, `h` the half vector), the flux scattered per unit
+//! path into `dω_o` is `(a/4) D(h) R_f(|ω·h|) dω_o`, smooth in `ω_o` for a
+//! spread σ > 0. For the incident direction of node `j` (azimuth 0) it is
+//! integrated against each node's hat function in `μ_o` (linear between
+//! neighbouring nodes, so power is kept however narrow the lobe;
+//! Gauss–Legendre on each interval, finer than σ) and against `cos mφ_o`
+//! (midpoint rule in azimuth, finer than σ). Aligned flakes (σ = 0) reflect
+//! each direction into its mirror image exactly: one node each.
+//! The discrete kernel is then made reciprocal exactly,
+//! `Q_ij c_j = Q_ji c_i` (`c` the nodes' flux weights), by averaging it with
+//! its transpose, and the flakes' extinction is set to what the kernel
+//! scatters (its term-0 column sums) plus what they absorb, so that a layer
+//! without absorption returns all the light (white furnace) on the nodes.
+//! Along the normal (the node `μ = 1`) a radiance has no azimuth, so the
+//! terms `m ≥ 1` of that node's rows and columns are zero.
+//!
+//! **Pigments** (absorption `μa`, scattering `μs`, phase moments `χ_l` of
+//! the baseline's grain models, δ-M truncated): term 0 is the baseline's
+//! azimuth-averaged phase matrix with its energy correction; term `m ≥ 1` is
+//! `μs w_i p_m(μ_i, μ_j)/(2 μ_j)` with `p_m = (1/2π) ∫ p(cos Θ) cos(mΔφ)
+//! dΔφ` by the trapezoidal rule on enough azimuths to be exact for the
+//! Legendre series (a trigonometric polynomial of degree `L` in `Δφ`).
+
+use super::normals::Orientation;
+use super::reflector::LocalTable;
+use crate::optics::baseline::doubling::{phase_matrices, FluxKernel, Medium};
+use crate::optics::baseline::matrix::Matrix;
+use crate::optics::baseline::ordinates::{gauss_legendre, Ordinates};
+use std::f64::consts::PI;
+
+/// Flakes in a layer at one wavelength.
+#[derive(Debug, Clone)]
+pub struct FlakeMedium {
+    /// Projected flake area per unit volume, 1/nm.
+    pub area_per_nm: f64,
+    pub orientation: Orientation,
+    /// The flake's `R`, `T` against the local angle.
+    pub table: LocalTable,
+}
+
+/// Resolution of the quadrature over normals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalQuadrature {
+    pub tilts: usize,
+    pub azimuths: usize,
+}
+
+impl Default for NormalQuadrature {
+    fn default() -> Self {
+        NormalQuadrature {
+            tilts: 24,
+            azimuths: 96,
+        }
+    }
+}
+
+/// The kernels of terms `0..modes` of a layer: flakes and pigments.
+pub fn layer_kernels(
+    ords: &Ordinates,
+    pigments: &Medium,
+    flakes: Option<&FlakeMedium>,
+    modes: usize,
+    quadrature: NormalQuadrature,
+) -> Vec<FluxKernel> {
+    let mut out = pigment_kernels(ords, pigments, modes);
+    if let Some(f) = flakes {
+        let flake = flake_kernels(ords, f, modes, quadrature);
+        for (k, f) in out.iter_mut().zip(flake) {
+            k.same = k.same.add(&f.same);
+            k.opposite = k.opposite.add(&f.opposite);
+            for (r, e) in k.rate.iter_mut().zip(&f.rate) {
+                *r += e;
+            }
+        }
+    }
+    out
+}
+
+/// The ordinary pigments' kernels per nm of thickness.
+pub fn pigment_kernels(ords: &Ordinates, medium: &Medium, modes: usize) -> Vec<FluxKernel> {
+    let n = ords.len();
+    let (mu_s, chi) = medium.delta_m(2 * n);
+    let mu_e = medium.mu_a + mu_s;
+    let rate: Vec<f64> = ords.mu.iter().map(|mu| mu_e / mu).collect();
+    let empty = |rate: Vec<f64>| FluxKernel {
+        rate,
+        same: Matrix::zeros(n),
+        opposite: Matrix::zeros(n),
+    };
+    if mu_s <= 0.0 {
+        return (0..modes).map(|_| empty(rate.clone())).collect();
+    }
+    let mut out = Vec::with_capacity(modes);
+    // Term 0: the baseline's phase matrices, energy-corrected.
+    let (same0, opp0) = phase_matrices(ords, &chi);
+    let flux = |p: &Matrix| {
+        Matrix::from_fn(n, |i, j| {
+            0.5 * mu_s * ords.weight[i] * p[(i, j)] / ords.mu[j]
+        })
+    };
+    out.push(FluxKernel {
+        rate: rate.clone(),
+        same: flux(&same0),
+        opposite: flux(&opp0),
+    });
+    if modes <= 1 {
+        return out;
+    }
+    // Terms m ≥ 1 by the trapezoidal rule in Δφ.
+    let degree = chi.len();
+    let steps = 2 * (degree + modes) + 8;
+    let sin: Vec<f64> = ords
+        .mu
+        .iter()
+        .map(|mu| (1.0 - mu * mu).max(0.0).sqrt())
+        .collect();
+    let phase = |x: f64| {
+        let (mut p0, mut p1) = (1.0, x);
+        let mut s = chi[0];
+        for (l, c) in chi.iter().enumerate().skip(1) {
+            s += (2 * l + 1) as f64 * c * p1;
+            let p2 = ((2 * l + 1) as f64 * x * p1 - l as f64 * p0) / (l + 1) as f64;
+            p0 = p1;
+            p1 = p2;
+        }
+        s
+    };
+    let mut terms_same = vec![Matrix::zeros(n); modes];
+    let mut terms_opp = vec![Matrix::zeros(n); modes];
+    let azimuths: Vec<(f64, Vec<f64>)> = (0..steps)
+        .map(|q| {
+            let dphi = 2.0 * PI * q as f64 / steps as f64;
+            (
+                dphi.cos(),
+                (0..modes).map(|m| (m as f64 * dphi).cos()).collect(),
+            )
+        })
+        .collect();
+    for i in 0..n {
+        for j in 0..n {
+            for (cos_dphi, cs) in &azimuths {
+                let ss = sin[i] * sin[j] * cos_dphi;
+                let ps = phase(ords.mu[i] * ords.mu[j] + ss);
+                let po = phase(-ords.mu[i] * ords.mu[j] + ss);
+                for m in 1..modes {
+                    terms_same[m][(i, j)] += ps * cs[m] / steps as f64;
+                    terms_opp[m][(i, j)] += po * cs[m] / steps as f64;
+                }
+            }
+        }
+    }
+    for m in 1..modes {
+        out.push(FluxKernel {
+            rate: rate.clone(),
+            same: flux(&terms_same[m]),
+            opposite: flux(&terms_opp[m]),
+        });
+    }
+    out
+}
+
+/// The flakes' kernels per nm of thickness (reciprocal, energy-consistent).
+pub fn flake_kernels(
+    ords: &Ordinates,
+    flakes: &FlakeMedium,
+    modes: usize,
+    quadrature: NormalQuadrature,
+) -> Vec<FluxKernel> {
+    let n = ords.len();
+    let normals = flakes
+        .orientation
+        .nodes(quadrature.tilts, quadrature.azimuths);
+    let a = flakes.area_per_nm;
+    let mut same = vec![Matrix::zeros(n); modes];
+    let mut opp = vec![Matrix::zeros(n); modes];
+    let mut absorbed = vec![0.0; n];
+    let mut cos_m = vec![0.0; modes];
+    let aligned = flakes.orientation.sigma_rad <= 0.0;
+    if !aligned {
+        integrate_lobes(ords, flakes, modes, &mut same, &mut opp);
+    }
+    for j in 0..n {
+        let mu_j = ords.mu[j];
+        let w = [(1.0 - mu_j * mu_j).max(0.0).sqrt(), 0.0, mu_j];
+        for node in &normals {
+            let m = node.m;
+            let dot = w[0] * m[0] + w[1] * m[1] + w[2] * m[2];
+            let local = dot.abs();
+            let p = flakes.table.at(local);
+            let hit = a * node.weight * local / mu_j;
+            absorbed[j] += hit * (1.0 - p.r - p.t).max(0.0);
+            let flux = hit * p.r;
+            if flux <= 0.0 || !aligned {
+                continue;
+            }
+            let o = [
+                w[0] - 2.0 * dot * m[0],
+                w[1] - 2.0 * dot * m[1],
+                w[2] - 2.0 * dot * m[2],
+            ];
+            let mu_o = o[2].abs();
+            let phi = o[1].atan2(o[0]);
+            // cos(mφ) by the recurrence.
+            let c1 = phi.cos();
+            for (k, c) in cos_m.iter_mut().enumerate() {
+                *c = match k {
+                    0 => 1.0,
+                    1 => c1,
+                    _ => 0.0,
+                };
+            }
+            for k in 2..modes {
+                cos_m[k] = 2.0 * c1 * cos_m[k - 1] - cos_m[k - 2];
+            }
+            let target = if o[2] > 0.0 { &mut same } else { &mut opp };
+            for (i, share) in bracket(&ords.mu, mu_o) {
+                for k in 0..modes {
+                    target[k][(i, j)] += flux * share * cos_m[k];
+                }
+            }
+        }
+    }
+    // Reciprocity: Q_ij c_j = Q_ji c_i.
+    let c = &ords.flux_weight;
+    let symmetric =
+        |q: &Matrix| Matrix::from_fn(n, |i, j| 0.5 * (q[(i, j)] + q[(j, i)] * c[i] / c[j]));
+    // Along the normal the radiance has no azimuth: terms m ≥ 1 vanish there.
+    let axial: Vec<usize> = (0..n).filter(|&i| ords.mu[i] >= 1.0 - 1e-12).collect();
+    let clean = |k: usize, q: Matrix| {
+        let mut q = symmetric(&q);
+        if k > 0 {
+            for &a in &axial {
+                for b in 0..n {
+                    q[(a, b)] = 0.0;
+                    q[(b, a)] = 0.0;
+                }
+            }
+        }
+        q
+    };
+    let same: Vec<Matrix> = same
+        .into_iter()
+        .enumerate()
+        .map(|(k, q)| clean(k, q))
+        .collect();
+    let opp: Vec<Matrix> = opp
+        .into_iter()
+        .enumerate()
+        .map(|(k, q)| clean(k, q))
+        .collect();
+    let scattered: Vec<f64> = same[0]
+        .column_sums()
+        .iter()
+        .zip(opp[0].column_sums())
+        .map(|(a, b)| a + b)
+        .collect();
+    let rate: Vec<f64> = scattered
+        .iter()
+        .zip(&absorbed)
+        .map(|(s, a)| s + a)
+        .collect();
+    same.into_iter()
+        .zip(opp)
+        .map(|(same, opposite)| FluxKernel {
+            rate: rate.clone(),
+            same,
+            opposite,
+        })
+        .collect()
+}
+
+/// The spread flakes' kernels by integrating the reflected radiance over
+/// the view directions: per unit path the flux scattered into `dω_o` is
+/// `(a/4) D(h) R_f(|ω·h|) dω_o` (`h` the half vector, `dω_o = 4 |ω·h| dω_h`),
+/// integrated against each node's hat function in `μ_o` (Gauss–Legendre on
+/// every interval between nodes, finer than σ) and against `cos mφ` in
+/// azimuth (midpoint rule on `[0, π]`, finer than σ).
+fn integrate_lobes(
+    ords: &Ordinates,
+    flakes: &FlakeMedium,
+    modes: usize,
+    same: &mut [Matrix],
+    opp: &mut [Matrix],
+) {
+    let n = ords.len();
+    let sigma = flakes.orientation.sigma_rad;
+    let density = flakes.orientation.density();
+    let a = flakes.area_per_nm;
+    let azimuths = ((8.0 * PI / sigma).ceil() as usize).clamp(128, 2048);
+    let dphi = PI / azimuths as f64;
+    let phis: Vec<(f64, f64)> = (0..azimuths)
+        .map(|q| {
+            let phi = (q as f64 + 0.5) * dphi;
+            (phi.cos(), phi.sin())
+        })
+        .collect();
+    let cos_table: Vec<f64> = (0..azimuths)
+        .flat_map(|q| {
+            let phi = (q as f64 + 0.5) * dphi;
+            (0..modes).map(move |m| (m as f64 * phi).cos())
+        })
+        .collect();
+    // Intervals of μ_o: [0, μ_0] (all to node 0), then between nodes.
+    let mut intervals: Vec<(f64, f64, usize, usize)> = vec![(0.0, ords.mu[0], 0, 0)];
+    for k in 0..n - 1 {
+        intervals.push((ords.mu[k], ords.mu[k + 1], k, k + 1));
+    }
+    let mut profile = vec![0.0; azimuths];
+    let mut coefficients = vec![0.0; modes];
+    for j in 0..n {
+        let mu_j = ords.mu[j];
+        let wj = [(1.0 - mu_j * mu_j).max(0.0).sqrt(), 0.0, mu_j];
+        for &(lo, hi, k0, k1) in &intervals {
+            let span = (lo.clamp(0.0, 1.0).acos() - hi.clamp(0.0, 1.0).acos()).abs();
+            let points = ((2.0 * span / sigma).ceil() as usize).clamp(3, 24);
+            let (x, w) = gauss_legendre(points);
+            for (x, w) in x.iter().zip(&w) {
+                let mu_o = lo + 0.5 * (hi - lo) * (x + 1.0);
+                let weight = 0.5 * (hi - lo) * w;
+                let share1 = if k1 == k0 {
+                    0.0
+                } else {
+                    (mu_o - lo) / (hi - lo)
+                };
+                let sin_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
+                for (sign, target) in [(1.0, &mut *same), (-1.0, &mut *opp)] {
+                    let mut any = false;
+                    for (q, &(c, s)) in phis.iter().enumerate() {
+                        let o = [sin_o * c, sin_o * s, sign * mu_o];
+                        let v = [wj[0] - o[0], wj[1] - o[1], wj[2] - o[2]];
+                        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                        profile[q] = 0.0;
+                        if len < 1e-12 {
+                            continue;
+                        }
+                        let d = density((v[2] / len).abs().clamp(0.0, 1.0).acos());
+                        if d == 0.0 {
+                            continue;
+                        }
+                        let local = (wj[0] * v[0] + wj[2] * v[2]).abs() / len;
+                        profile[q] = 0.25 * a * d * flakes.table.at(local).r / mu_j;
+                        any = true;
+                    }
+                    if !any {
+                        continue;
+                    }
+                    coefficients.iter_mut().for_each(|c| *c = 0.0);
+                    for (q, g) in profile.iter().enumerate() {
+                        if *g == 0.0 {
+                            continue;
+                        }
+                        let row = &cos_table[q * modes..(q + 1) * modes];
+                        for (c, cm) in coefficients.iter_mut().zip(row) {
+                            *c += 2.0 * g * cm * dphi;
+                        }
+                    }
+                    for (m, c) in coefficients.iter().enumerate() {
+                        target[m][(k0, j)] += weight * (1.0 - share1) * c;
+                        target[m][(k1, j)] += weight * share1 * c;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The two nodes bracketing `mu` (ascending `nodes`) with linear shares.
+fn bracket(nodes: &[f64], mu: f64) -> [(usize, f64); 2] {
+    let last = nodes.len() - 1;
+    if mu <= nodes[0] {
+        return [(0, 1.0), (0, 0.0)];
+    }
+    if mu >= nodes[last] {
+        return [(last, 1.0), (last, 0.0)];
+    }
+    let k = nodes.partition_point(|&x| x <= mu) - 1;
+    let f = (mu - nodes[k]) / (nodes[k + 1] - nodes[k]);
+    [(k, 1.0 - f), (k + 1, f)]
+}

@@ -1,0 +1,129 @@
+//! The orientation distribution of the flakes' normals and the quadrature
+//! over it.
+//!
+//! A flake's normal `m` (taken in the upper hemisphere: a flake reflects
+//! alike from both faces) leans from the layer normal `ẑ` by `θ_m`, its
+//! azimuth uniform. The density is **Gaussian in angle**,
+//! `D(m) = C exp(−θ_m²/(2σ²))` on `0 ≤ θ_m ≤ 90°`, normalised as a
+//! distribution of facets, `∫ D(m) (m·ẑ) dω = 1`: `a D(m) (m·ẑ) dω` is then
+//! the area, projected on the layer's plane, of the flakes whose normals lie
+//! in `dω`, per unit volume, when `a` is the flakes' projected area per unit
+//! volume. `σ = 0` is the aligned limit, every normal along `ẑ`.
+//!
+//! Small flakes add the **diffraction lobe** of a disc to their mirror
+//! reflection ([`Orientation::with_diffraction`]): below ~20 µm it is
+//! comparable to the orientation spread.
+//!
+//! The quadrature: Gauss–Legendre in `θ_m` over `[0, min(90°, 6σ)]` and the
+//! trapezoidal rule in azimuth; its weights are renormalised so that the
+//! discrete `Σ W (m·ẑ) = 1` holds exactly.
+
+use crate::optics::baseline::ordinates::gauss_legendre;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// A Gaussian-in-angle distribution of normals of spread `sigma_rad` (≥ 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orientation {
+    pub sigma_rad: f64,
+}
+
+/// One node of the quadrature over normals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalNode {
+    /// The unit normal (upper hemisphere).
+    pub m: [f64; 3],
+    /// Weight: `D(m) dω` of the node's cell.
+    pub weight: f64,
+}
+
+impl Orientation {
+    /// The spread `sigma_rad` of the flakes' tilts broadened by the
+    /// diffraction of a disc of `diameter_nm` at `wavelength_nm` in a
+    /// lacquer of index `lacquer`. A disc's far field is Airy's pattern,
+    /// intensity `(2 J₁(x)/x)²`, `x = π n D sin ψ / λ` (first zero at
+    /// `sin ψ = 1.22 λ/(n D)`); its central lobe, `1 − x²/4 + …`, is the
+    /// Gaussian `exp(−x²/4)` of equal curvature, a spread of the deviation
+    /// `ψ` of `σ_ψ = √2 λ/(π n D)`. Reflection doubles a tilt, so the
+    /// normals' equivalent spread is `σ_ψ/2`, added in quadrature:
+    /// `σ_eff² = σ² + λ²/(2 π² n² D²)`. (The rings beyond the first zero,
+    /// 16 % of the power, are folded into the Gaussian's tail.)
+    pub fn with_diffraction(
+        sigma_rad: f64,
+        diameter_nm: f64,
+        wavelength_nm: f64,
+        lacquer: f64,
+    ) -> Orientation {
+        let d = wavelength_nm / (std::f64::consts::SQRT_2 * PI * lacquer * diameter_nm);
+        Orientation {
+            sigma_rad: (sigma_rad * sigma_rad + d * d).sqrt(),
+        }
+    }
+
+    /// The largest tilt the quadrature covers.
+    fn extent(&self) -> f64 {
+        (6.0 * self.sigma_rad).min(FRAC_PI_2)
+    }
+
+    /// `∫₀^{extent} exp(−θ²/2σ²) cos θ sin θ dθ` by Gauss–Legendre.
+    fn radial_integral(&self, nodes: usize) -> f64 {
+        let (x, w) = gauss_legendre(nodes);
+        let e = self.extent();
+        x.iter()
+            .zip(&w)
+            .map(|(x, w)| {
+                let t = 0.5 * e * (x + 1.0);
+                0.5 * e * w * self.profile(t) * t.cos() * t.sin()
+            })
+            .sum()
+    }
+
+    /// `exp(−θ²/2σ²)`.
+    fn profile(&self, theta: f64) -> f64 {
+        let s = self.sigma_rad;
+        (-(theta * theta) / (2.0 * s * s)).exp()
+    }
+
+    /// `D` against the tilt (rad), its normalisation computed once; not
+    /// defined for the aligned limit.
+    pub fn density(&self) -> impl Fn(f64) -> f64 + '_ {
+        let c = 1.0 / (2.0 * PI * self.radial_integral(96));
+        move |theta| {
+            if theta > self.extent() {
+                0.0
+            } else {
+                c * self.profile(theta)
+            }
+        }
+    }
+
+    /// The quadrature over normals: `tilts` Gauss–Legendre nodes in `θ_m`,
+    /// `azimuths` in `φ_m`; one node along `ẑ` when `σ = 0`.
+    pub fn nodes(&self, tilts: usize, azimuths: usize) -> Vec<NormalNode> {
+        if self.sigma_rad <= 0.0 {
+            return vec![NormalNode {
+                m: [0.0, 0.0, 1.0],
+                weight: 1.0,
+            }];
+        }
+        let (x, w) = gauss_legendre(tilts.max(1));
+        let e = self.extent();
+        let dphi = 2.0 * PI / azimuths.max(1) as f64;
+        let mut out = Vec::with_capacity(x.len() * azimuths);
+        for (x, w) in x.iter().zip(&w) {
+            let t = 0.5 * e * (x + 1.0);
+            let cell = 0.5 * e * w * t.sin() * dphi * self.profile(t);
+            for k in 0..azimuths.max(1) {
+                let phi = (k as f64 + 0.5) * dphi;
+                out.push(NormalNode {
+                    m: [t.sin() * phi.cos(), t.sin() * phi.sin(), t.cos()],
+                    weight: cell,
+                });
+            }
+        }
+        let norm: f64 = out.iter().map(|n| n.weight * n.m[2]).sum();
+        for n in &mut out {
+            n.weight /= norm;
+        }
+        out
+    }
+}

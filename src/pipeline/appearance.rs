@@ -2,7 +2,7 @@
 //! angles, the table, the substrate, the products, and the spectral proxy
 //! (the molecular-mixture slab on a fine wavelength grid) for colour.
 
-use crate::config::{GrainShape, Scene, Substrate};
+use crate::config::{Scene, Substrate};
 use crate::optics::appearance::{AppearanceSpec, SpectralProxy};
 use crate::optics::substrate::Hemisphere;
 
@@ -58,11 +58,6 @@ fn spectral_proxy(scene: &Scene) -> Option<SpectralProxy> {
         eps,
         thickness_nm: scene.layer.thickness_nm,
         quadrature: Hemisphere::new(scene.appearance.quadrature_points),
-        // The layer is the slab only where every pigment is dissolved.
-        coherent: scene
-            .species
-            .iter()
-            .all(|s| s.shape == GrainShape::Molecular),
     })
 }
 

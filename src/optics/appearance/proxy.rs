@@ -28,17 +28,6 @@ pub struct SpectralProxy {
     /// Quadrature of the slab's diffuse terms (the scene's, as for the
     /// solves from below).
     pub quadrature: Hemisphere,
-    /// Whether the slab is coherent (Airy: thin-film fringes) or
-    /// phase-averaged (incoherent: the same interfaces and absorption, no
-    /// fringes). Coherent where the layer *is* the slab (dissolved
-    /// pigments), so that the proxy is exact; incoherent where grains make
-    /// the layer, whose fringes between two solved wavelengths are unknown:
-    /// a coherent proxy imprints the slab's fringes, scaled by the layer's
-    /// ratio to it, onto the spectrum between them, which for a scattering
-    /// (white) layer over black, reflecting 5–10× what the clear slab does,
-    /// made impossible colours (L* 91, a* −63 for a white drawdown at a
-    /// 100 nm step).
-    pub coherent: bool,
 }
 
 impl SpectralProxy {
@@ -80,14 +69,9 @@ impl SpectralProxy {
     ) -> SlabOnPaper<impl Fn(f64) -> (f64, f64) + '_> {
         let h = &self.quadrature;
         let thickness = self.thickness_nm;
-        let coherent = self.coherent;
         let rt = move |polar: f64| {
-            if coherent {
-                let r = airy::slab(eps, thickness, wl, polar);
-                (r.r.norm_sqr(), r.t.norm_sqr())
-            } else {
-                incoherent_slab(eps, thickness, wl, polar)
-            }
+            let r = airy::slab(eps, thickness, wl, polar);
+            (r.r.norm_sqr(), r.t.norm_sqr())
         };
         let nodes: Vec<(f64, f64)> = h.polar_deg().into_iter().map(&rt).collect();
         let rdd = h.diffuse(&nodes.iter().map(|x| x.0).collect::<Vec<_>>());
@@ -98,32 +82,6 @@ impl SpectralProxy {
             denom: 1.0 - albedo * rdd,
         }
     }
-}
-
-/// `(R, T)` of a slab of permittivity `eps` and thickness `thickness_nm` in
-/// vacuum, lit at `polar_deg`, with the multiple reflections between its
-/// faces added in power (the phase average of the Airy slab): the scalar
-/// (s) Fresnel reflectance `ρ = |(γ₀ − γ)/(γ₀ + γ)|²` at each face, the
-/// single-pass attenuation `a = exp(−2 Im γ H)`, and
-/// `R = ρ + (1 − ρ)² ρ a² / (1 − ρ² a²)`, `T = (1 − ρ)² a / (1 − ρ² a²)`.
-pub fn incoherent_slab(
-    eps: C64,
-    thickness_nm: f64,
-    wavelength_nm: f64,
-    polar_deg: f64,
-) -> (f64, f64) {
-    let k0 = 2.0 * PI / wavelength_nm;
-    let s = polar_deg.to_radians().sin();
-    let g0 = k0 * polar_deg.to_radians().cos();
-    let mut g = k0 * (eps - s * s).sqrt();
-    if g.im < 0.0 {
-        g = -g;
-    }
-    let rho = ((g0 - g) / (g0 + g)).norm_sqr();
-    let a = (-2.0 * g.im * thickness_nm).exp();
-    let den = 1.0 - rho * rho * a * a;
-    let t1 = (1.0 - rho) * (1.0 - rho);
-    (rho + t1 * rho * a * a / den, t1 * a / den)
 }
 
 /// A homogeneous slab on Lambertian paper at one wavelength.
@@ -270,41 +228,6 @@ fn fill_of(v0: f64, v1: f64, p0: f64, p1: f64, r0: f64, r1: f64) -> Fill {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_incoherent_slab_is_the_airy_slab_averaged_over_its_phase() {
-        // A clear slab: the Airy slab's R and T depend on the thickness only
-        // through the round-trip phase 2γH (period π/γ in H); their mean
-        // over one period (trapezoid rule, spectrally exact for a smooth
-        // periodic function) is the power sum of the multiple reflections.
-        for (eps, wl, polar) in [(2.25, 550.0, 0.0), (7.3, 450.0, 8.0), (1.9, 650.0, 60.0)] {
-            let eps = C64::new(eps, 0.0);
-            let s = f64::to_radians(polar).sin();
-            let gamma = 2.0 * PI / wl * (eps.re - s * s).sqrt();
-            let n = 64;
-            let (mut r, mut t) = (0.0, 0.0);
-            for k in 0..n {
-                let h = 1000.0 + (k as f64 / n as f64) * PI / gamma;
-                let a = airy::slab(eps, h, wl, polar);
-                r += a.r.norm_sqr() / n as f64;
-                t += a.t.norm_sqr() / n as f64;
-            }
-            let (ri, ti) = incoherent_slab(eps, 1000.0, wl, polar);
-            assert!(
-                (ri - r).abs() < 1e-12 && (ti - t).abs() < 1e-12,
-                "{ri} {r} {ti} {t}"
-            );
-            assert!((ri + ti - 1.0).abs() < 1e-14);
-        }
-        // Absorbing: Beer's attenuation between Fresnel faces, below the
-        // clear slab's transmittance, and no fringes (smooth in λ).
-        let eps = C64::new(2.25, 0.05);
-        let (r, t) = incoherent_slab(eps, 1000.0, 550.0, 0.0);
-        let (_, t_clear) = incoherent_slab(C64::new(2.25, 0.0), 1000.0, 550.0, 0.0);
-        assert!(t < t_clear && r > 0.0 && r + t < 1.0);
-        let near = incoherent_slab(eps, 1000.0, 551.0, 0.0).0;
-        assert!((near - r).abs() < 1e-3 * r, "{near} {r}");
-    }
 
     /// A fine grid of 10 nm, solves every 100 nm, and a proxy with a band at
     /// 430 nm, a deep band at 600 nm and a peak above its 700 nm value at

@@ -103,6 +103,16 @@ pub const PROXY_RATIO_SPREAD: f64 = 10.0;
 /// model's slope to be determined by the two solved values.
 pub const AFFINE_MIN_PROXY_CHANGE: f64 = 0.01;
 
+/// Largest gain a fill may give the proxy's shape: the affine model's `b`
+/// and the ratio model's layer / proxy at both ends. A layer reflecting many
+/// times what the clear slab does (a scattering white over black: 5–10×)
+/// owes the excess to its grains, whose spectrum is smooth; the slab's
+/// thin-film fringes between two solved wavelengths, scaled by that much,
+/// made impossible colours (a rutile drawdown over black at 450/550/650 nm:
+/// L* 91, a* −63 from solved reflectances of 0.49–0.61). Beyond this gain the
+/// interval is interpolated linearly.
+pub const MAX_PROXY_GAIN: f64 = 2.0;
+
 /// How one interval between solved wavelengths is filled in.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Fill {
@@ -209,7 +219,7 @@ fn fill_of(v0: f64, v1: f64, p0: f64, p1: f64, r0: f64, r1: f64) -> Fill {
         // Round-off: a layer that is exactly c × proxy gives a ≈ 0 of
         // either sign.
         let tiny = 1e-12 * v0.abs().max(v1.abs());
-        if b > 0.0 && b.is_finite() && a >= -tiny {
+        if b > 0.0 && b <= MAX_PROXY_GAIN && a >= -tiny {
             return Fill::Affine { a: a.max(0.0), b };
         }
     }
@@ -217,7 +227,8 @@ fn fill_of(v0: f64, v1: f64, p0: f64, p1: f64, r0: f64, r1: f64) -> Fill {
         && r1.is_finite()
         && r0 > 0.0
         && r1 > 0.0
-        && r0.max(r1) <= PROXY_RATIO_SPREAD * r0.min(r1);
+        && r0.max(r1) <= PROXY_RATIO_SPREAD * r0.min(r1)
+        && r0.max(r1) <= MAX_PROXY_GAIN;
     if ratio_fits {
         Fill::Ratio
     } else {
@@ -283,6 +294,23 @@ mod tests {
             ratio_model > 4.0,
             "the ratio model overshoots: {ratio_model}"
         );
+    }
+
+    #[test]
+    fn a_layer_far_brighter_than_the_proxy_is_not_given_its_shape() {
+        let (fine, wl, proxy) = setup();
+        let p = |x: f64| proxy[fine.iter().position(|&f| f == x).unwrap()];
+        let at = |out: &[f64], x: f64| out[fine.iter().position(|&f| f == x).unwrap()];
+        // Five times the proxy (b = 5 > MAX_PROXY_GAIN): linear, not 5 ×
+        // the proxy's band between the solved wavelengths.
+        let values: Vec<f64> = wl.iter().map(|&w| 5.0 * p(w)).collect();
+        let out = through_proxy(&wl, &values, &fine, &proxy);
+        let lin = 0.7 * values[0] + 0.3 * values[1];
+        assert!((at(&out, 430.0) - lin).abs() < 1e-12, "{}", at(&out, 430.0));
+        // At twice the proxy the shape is kept.
+        let values: Vec<f64> = wl.iter().map(|&w| 2.0 * p(w)).collect();
+        let out = through_proxy(&wl, &values, &fine, &proxy);
+        assert!((at(&out, 430.0) - 2.0 * p(430.0)).abs() < 1e-12);
     }
 
     #[test]

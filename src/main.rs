@@ -182,8 +182,8 @@ enum Command {
         /// given to `run --output-dir`).
         #[arg(long)]
         output_dir: Option<PathBuf>,
-        /// Write the CSV files into this folder instead (default: beside the
-        /// result file; the study folder).
+        /// Write the files (CSV, or with --mitsuba the BSDF) into this folder
+        /// instead (default: beside the result file; the study folder).
         #[arg(long)]
         to: Option<PathBuf>,
         /// Result file: write its BRDF as a Mitsuba 3 `measured` BSDF

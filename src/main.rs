@@ -182,10 +182,17 @@ enum Command {
         /// given to `run --output-dir`).
         #[arg(long)]
         output_dir: Option<PathBuf>,
-        /// Write the CSV files into this folder instead (default: beside the
-        /// result file; the study folder).
+        /// Write the files (CSV, or with --mitsuba the BSDF) into this folder
+        /// instead (default: beside the result file; the study folder).
         #[arg(long)]
         to: Option<PathBuf>,
+        /// Result file: write its BRDF as a Mitsuba 3 `measured` BSDF
+        /// instead, <name>.bsdf (an RGL tensor file, spectral at the
+        /// result's wavelengths, the diffuse part), with
+        /// <name>-bsdf-samples.csv, inksim's own evaluations at a set of
+        /// directions to check a renderer's reading against (docs/FORMAT.md).
+        #[arg(long)]
+        mitsuba: bool,
     },
     /// Validate a scene (or every variant of a study) and print what a run
     /// would compute, without running it.
@@ -334,7 +341,8 @@ fn real_main() -> Result<ExitCode> {
             profile,
             output_dir,
             to,
-        } => cli::export::export(&target, profile.as_deref(), output_dir, to)?,
+            mitsuba,
+        } => cli::export::export(&target, profile.as_deref(), output_dir, to, mitsuba)?,
         Command::Materials => cli::materials::materials()?,
         Command::View {
             inputs,

@@ -14,17 +14,7 @@ use std::path::Path;
 
 mod common;
 use common::airy::{airy_power, airy_rt};
-use common::scene::{PigmentToml, SceneToml};
-
-/// A CSV material of constant index n + 0i over 380–780 nm.
-fn constant_material(dir: &Path, name: &str, n: f64) -> String {
-    let mut text = String::from("wavelength_nm,n,k\n");
-    for wl in (380..=780).step_by(20) {
-        text.push_str(&format!("{wl},{n},0\n"));
-    }
-    std::fs::write(dir.join(format!("{name}.csv")), text).unwrap();
-    format!("{name}.csv")
-}
+use common::scene::{constant_material, PigmentToml, SceneToml};
 
 /// A homogeneous (molecular) layer of index `n` in a binder of the same
 /// index: a plain slab, on paper of albedo 0.9.

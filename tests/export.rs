@@ -1,11 +1,14 @@
 //! `inksim export`: the CSV tables hold exactly the numbers of the result
-//! files, one row per solve, per spectrum point and per colour.
+//! files, one row per solve, per spectrum point and per colour; the Mitsuba
+//! 3 measured BSDF is a tensor file of the layout and shapes the `measured`
+//! plugin requires, holding albedo/π · cos θo for bare paper at every node.
 use std::collections::HashMap;
+use std::f64::consts::PI;
 use std::path::Path;
 
 mod common;
 use common::cli::inksim_in;
-use common::scene::{PigmentToml, SceneToml};
+use common::scene::{constant_material, PigmentToml, SceneToml};
 use common::study::StudyToml;
 use inksim::output::h5::{read_appearance, read_baseline, read_measured, read_summary};
 
@@ -292,4 +295,183 @@ fn a_result_with_the_earlier_single_model_layout_still_reads() {
     assert_eq!(read[0].geometry, "45/0");
     assert_eq!(read[0].lab, [50.0, 10.0, -5.0]);
     assert_eq!(read[0].de00_to_wave, Some(3.5));
+}
+
+/// A field of a tensor file as read back here: type code, shape, bytes.
+struct TensorField {
+    dtype: u8,
+    shape: Vec<usize>,
+    data: Vec<u8>,
+}
+
+impl TensorField {
+    fn f32s(&self) -> Vec<f32> {
+        assert_eq!(self.dtype, 10);
+        self.data
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    }
+}
+
+/// A tensor file read as Mitsuba 3's `TensorFile` reads it: the header,
+/// then each field's name, shape, type and offset; fields in file order.
+fn read_tensor_file(bytes: &[u8]) -> Vec<(String, TensorField)> {
+    assert_eq!(&bytes[..12], b"tensor_file\0");
+    assert_eq!(&bytes[12..14], &[1, 0]);
+    let mut at = 14;
+    let mut take = |n: usize| {
+        let s = &bytes[at..at + n];
+        at += n;
+        s
+    };
+    let u = |s: &[u8]| s.iter().rev().fold(0u64, |a, &b| (a << 8) | b as u64) as usize;
+    let n = u(take(4));
+    (0..n)
+        .map(|_| {
+            let len = u(take(2));
+            let name = String::from_utf8(take(len).to_vec()).unwrap();
+            let ndim = u(take(2));
+            let dtype = take(1)[0];
+            let offset = u(take(8));
+            let shape: Vec<usize> = (0..ndim).map(|_| u(take(8))).collect();
+            let size = match dtype {
+                1 => 1,
+                10 => 4,
+                t => panic!("{name}: type {t}"),
+            };
+            let end = offset + size * shape.iter().product::<usize>();
+            assert_eq!(offset % 8, 0, "{name} at {offset}");
+            let data = bytes[offset..end].to_vec();
+            (name, TensorField { dtype, shape, data })
+        })
+        .collect()
+}
+
+#[test]
+fn tensor_files_read_back_as_written() {
+    use inksim::output::tensor_file::{encode, Field, Values};
+    let fields = vec![
+        Field::new("name", &[3], Values::U8(b"abc".to_vec())).unwrap(),
+        Field::new("empty", &[0], Values::U8(vec![])).unwrap(),
+        Field::new(
+            "grid",
+            &[2, 3],
+            Values::F32(vec![1.0, -2.5, 3.0, 4.0, 5.0, 1e-7]),
+        )
+        .unwrap(),
+    ];
+    assert!(Field::new("bad", &[2, 2], Values::F32(vec![1.0])).is_none());
+    let back = read_tensor_file(&encode(&fields));
+    assert_eq!(back.len(), 3);
+    for (f, (name, r)) in fields.iter().zip(&back) {
+        assert_eq!(&f.name, name);
+        assert_eq!(f.shape, r.shape);
+        match &f.values {
+            Values::U8(v) => assert_eq!((r.dtype, &r.data), (1, v)),
+            Values::F32(v) => assert_eq!(&r.f32s(), v),
+        }
+    }
+}
+
+#[test]
+fn bare_paper_exports_a_mitsuba_bsdf_of_albedo_over_pi() {
+    // A vacuum layer (binder and pigment of index 1) on paper of albedo
+    // 0.9: the BRDF is 0.9/π everywhere, so every node of `spectra` holds
+    // 0.9/π · cos θo, θo from the node's half vector as the file's layout
+    // defines it.
+    let dir = tempfile::tempdir().unwrap();
+    let csv = constant_material(dir.path(), "plain", 1.0);
+    let cfg = SceneToml::slab()
+        .seed(3)
+        .fragment_nm(1000.0)
+        .binder_index(1.0)
+        .pigment(PigmentToml::csv("dissolved", &csv).pvc(0.2).molecular())
+        .cell_nm(50.0)
+        .polar_deg(&[0.0, 40.0])
+        .paper(0.9)
+        .outputs(&["tile"])
+        .output(&dir.path().join("out"), "slab")
+        .write(dir.path());
+    let (ok, _, err) = inksim_in(dir.path(), &["run", cfg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let h5 = dir.path().join("out/slab.h5");
+    let (ok, out, err) = inksim_in(dir.path(), &["export", h5.to_str().unwrap(), "--mitsuba"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("slab.bsdf"), "{out}");
+    let fields = read_tensor_file(&std::fs::read(dir.path().join("out/slab.bsdf")).unwrap());
+    let f = |n: &str| &fields.iter().find(|(name, _)| name == n).unwrap().1;
+    // What the `measured` plugin checks.
+    let (ti, pi, wl) = (f("theta_i").f32s(), f("phi_i"), f("wavelengths").f32s());
+    assert_eq!(
+        (f("description").dtype, &f("description").data[..]),
+        (1, &b"slab"[..])
+    );
+    assert_eq!(
+        (f("jacobian").dtype, &f("jacobian").data[..]),
+        (1, &[0u8][..])
+    );
+    assert_eq!(pi.f32s(), vec![-std::f32::consts::PI, std::f32::consts::PI]);
+    assert_eq!(wl, vec![450.0, 550.0, 650.0]);
+    for solved in [0.0f32, 40.0] {
+        assert!(ti.iter().any(|t| (t.to_degrees() - solved).abs() < 1e-4));
+    }
+    assert!(
+        ti.windows(2).all(|w| w[0] < w[1]) && *ti.last().unwrap() < std::f32::consts::FRAC_PI_2
+    );
+    let (nt, nl) = (ti.len(), wl.len());
+    assert_eq!(f("ndf").shape.len(), 2);
+    assert_eq!(f("sigma").shape.len(), 2);
+    assert_eq!(&f("vndf").shape[..2], &[2, nt]);
+    let n = f("spectra").shape[4];
+    assert_eq!(f("spectra").shape, vec![2, nt, nl, n, n]);
+    assert_eq!(f("luminance").shape, vec![2, nt, n, n]);
+    assert!(f("luminance").f32s().iter().all(|&v| v > 0.0));
+    let spectra = f("spectra").f32s();
+    let (half, _) = spectra.split_at(spectra.len() / 2);
+    assert_eq!(&spectra[spectra.len() / 2..], half);
+    let mut above = 0;
+    for (it, t) in ti.iter().enumerate() {
+        let t = *t as f64;
+        let wi = [t.sin(), 0.0, t.cos()];
+        for y in 0..n {
+            for x in 0..n {
+                let u = x as f64 / (n - 1) as f64;
+                let (tm, pm) = (
+                    u * u * PI / 2.0,
+                    (y as f64 / (n - 1) as f64) * 2.0 * PI - PI,
+                );
+                let m = [tm.sin() * pm.cos(), tm.sin() * pm.sin(), tm.cos()];
+                let d = 2.0 * (m[0] * wi[0] + m[2] * wi[2]);
+                let cos_o = d * m[2] - wi[2];
+                let want = if cos_o > 0.0 { 0.9 / PI * cos_o } else { 0.0 };
+                above += usize::from(cos_o > 0.0);
+                for l in 0..nl {
+                    let got = spectra[((it * nl + l) * n + y) * n + x] as f64;
+                    assert!(
+                        (got - want).abs() < 1e-6,
+                        "θi {t} x {x} y {y}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(above > nt * n * n / 3);
+    // The reference evaluations: 0.9/π, and times cos θo.
+    for row in table(&dir.path().join("out/slab-bsdf-samples.csv")) {
+        assert!((num(&row, "brdf_per_sr") - 0.9 / PI).abs() < 1e-9);
+        let c = num(&row, "theta_o_deg").to_radians().cos();
+        assert!((num(&row, "brdf_cos") - 0.9 / PI * c).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn mitsuba_export_refuses_a_study_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let study = StudyToml::new("t", 5, "out", &scene()).axis("pvc", "pigment.0.pvc", "[0.1, 0.2]");
+    std::fs::write(dir.path().join("study.toml"), study.toml()).unwrap();
+    let (ok, _, err) = inksim_in(dir.path(), &["export", "study.toml", "--mitsuba"]);
+    assert!(!ok);
+    assert!(err.contains("--mitsuba exports a result file"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
 }

@@ -169,12 +169,23 @@ impl RgbBrdf {
 
     /// The BRDF of `d`.
     pub fn from_data(d: BrdfData) -> Result<Self, MerlError> {
-        let (nl, ni) = (d.wavelengths_nm.len(), d.illumination_deg.len());
-        if ni == 0 || nl == 0 || d.above_deg.is_empty() {
+        if d.wavelengths_nm.is_empty() {
             return Err(MerlError::NoData);
         }
         let obs = Observer::cie1931_d65();
         let w = channel_weights(&obs, &d.wavelengths_nm)?;
+        RgbBrdf::with_channels(d, w)
+    }
+
+    /// The BRDF of `d` in three channels of any linear weights `w` of its
+    /// spectrum (`w[l]`, one per wavelength): `eval` and `specular` then
+    /// return `Σ_l w[l] f_l`. A one-hot `w` picks wavelengths, which is how
+    /// the spectral exports evaluate the BRDF three wavelengths at a time.
+    pub fn with_channels(d: BrdfData, w: Vec<[f64; 3]>) -> Result<Self, MerlError> {
+        let (nl, ni) = (d.wavelengths_nm.len(), d.illumination_deg.len());
+        if ni == 0 || nl == 0 || d.above_deg.is_empty() || w.len() != nl {
+            return Err(MerlError::NoData);
+        }
         let nt = d.table.n();
         let tab = &d.density;
         let mut rgb_tab = vec![[0.0f64; 3]; ni * nt * nt];

@@ -425,3 +425,13 @@ impl PrimitiveToml {
         self
     }
 }
+
+/// A CSV material of constant index n + 0i over 380–780 nm.
+pub fn constant_material(dir: &Path, name: &str, n: f64) -> String {
+    let mut text = String::from("wavelength_nm,n,k\n");
+    for wl in (380..=780).step_by(20) {
+        text.push_str(&format!("{wl},{n},0\n"));
+    }
+    std::fs::write(dir.join(format!("{name}.csv")), text).unwrap();
+    format!("{name}.csv")
+}

@@ -3,7 +3,8 @@
 #
 # Creates (or reuses) the virtual environment .venv in the repository root
 # (ignored by git), installs the package as a user would (`pip install
-# ./python`) with pytest, and runs its tests with INKSIM_BIN pointing at
+# ./python`) with pytest and Mitsuba 3 (which loads the exported BSDF in
+# python/tests/test_mitsuba.py), and runs its tests with INKSIM_BIN pointing at
 # target/release/inksim (built here with `cargo build --release` if missing;
 # set INKSIM_BIN yourself to test another binary). Extra arguments go to
 # pytest, e.g. `bash scripts/test_python.sh -k study`.
@@ -35,8 +36,8 @@ if [[ ! -x .venv/bin/python ]]; then
     fi
 fi
 
-say "installing ./python and pytest into .venv"
-.venv/bin/python -m pip install --quiet --disable-pip-version-check ./python pytest
+say "installing ./python, pytest and mitsuba (the BSDF export's check) into .venv"
+.venv/bin/python -m pip install --quiet --disable-pip-version-check ./python pytest "mitsuba>=3.5"
 
 if [[ -z ${INKSIM_BIN:-} ]]; then
     INKSIM_BIN=$PWD/target/release/inksim

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 mod common;
-use common::airy::{airy_power, airy_rt};
+use common::airy::{airy_power, airy_rt, hemispherical};
 use common::scene::{constant_material, PigmentToml, SceneToml};
 
 /// A homogeneous (molecular) layer of index `n` in a binder of the same
@@ -55,25 +55,6 @@ fn bare_paper_renders_its_albedo_as_grey() {
         assert!((v - 0.9 / PI).abs() < 1e-12);
     }
     assert!(rep.entries.iter().all(|e| e.record.method == Method::Airy));
-}
-
-/// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points.
-fn hemispherical(f: impl Fn(f64) -> f64) -> f64 {
-    let n = 20_000;
-    let h = 1.0 / n as f64;
-    let mut s = 0.0;
-    for i in 0..=n {
-        let mu = i as f64 * h;
-        let w = if i == 0 || i == n {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        s += w * f(mu) * mu;
-    }
-    2.0 * s * h / 3.0
 }
 
 #[test]

@@ -10,27 +10,8 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 mod common;
-use common::airy::airy_power;
+use common::airy::{airy_power, hemispherical};
 use common::scene::{PigmentToml, SceneToml};
-
-/// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points.
-fn hemispherical(f: impl Fn(f64) -> f64) -> f64 {
-    let n = 20_000;
-    let h = 1.0 / n as f64;
-    let mut s = 0.0;
-    for i in 0..=n {
-        let mu = i as f64 * h;
-        let w = if i == 0 || i == n {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        s += w * f(mu) * mu;
-    }
-    2.0 * s * h / 3.0
-}
 
 /// A dissolved absorbing dye (n = 1.6 + 0.05i, 20 %) in a 1 µm binder of
 /// index 1.5: a homogeneous slab, solved in closed form.

@@ -18,14 +18,14 @@
 //! weak, not merely sparse.
 
 use inksim::config::Method;
-use inksim::geometry::{Geometry, Particle, Sphere};
 use inksim::optics::baseline::sphere::{amplitude, coefficients};
 use inksim::optics::farfield::efficiencies;
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Problem};
-use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
+
+mod common;
+use common::layers::one_sphere_lattice;
 
 #[test]
 fn lossless_sphere_obeys_the_optical_theorem() {
@@ -58,28 +58,7 @@ fn rayleigh_limit_of_the_partial_waves() {
 /// scattering, for one sphere per period on a grid of `cells` lateral cells.
 fn worst_error(eps_s: C64, polar_deg: f64, l: f64, cells: usize) -> f64 {
     let (h, a, wl) = (200.0, 80.0, 500.0);
-    let geom = Geometry {
-        size_nm: [l, l, h],
-        particles: vec![Particle {
-            species: 0,
-            spheres: vec![Sphere {
-                center: [0.37 * l, 0.61 * l, 0.5 * h],
-                radius: a,
-            }],
-        }],
-        stats: Default::default(),
-    };
-    let nz = (h / (l / cells as f64)).round() as usize;
-    let grid = Grid {
-        nx: cells,
-        ny: cells,
-        nz,
-        size_nm: [l, l, h],
-    };
-    let raster = rasterize(&geom, &grid, 4);
-    let mut eps = Array3::zeros((nz, cells, cells));
-    raster.epsilon_into(C64::new(1.0, 0.0), &[eps_s], &mut eps);
-    let lattice = Problem::lattice([cells, cells, nz], [l, l, h], wl, polar_deg, 0.0);
+    let (eps, lattice) = one_sphere_lattice(l, h, a, cells, eps_s, wl, polar_deg);
     let sol = solver::solve(
         &Problem {
             lattice,

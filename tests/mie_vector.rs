@@ -37,13 +37,13 @@
 //! not merely sparse.
 
 use inksim::config::{Linear, Method};
-use inksim::geometry::{Geometry, Particle, Sphere};
 use inksim::optics::baseline::mie;
-use inksim::raster::{rasterize, Grid};
 use inksim::solver::{self, Controls, Lattice, Problem, Solution, Wave};
-use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::f64::consts::PI;
+
+mod common;
+use common::layers::one_sphere_lattice;
 
 const WAVELENGTH: f64 = 500.0;
 const PERIOD: f64 = 1500.0;
@@ -102,29 +102,8 @@ fn project(f: [C64; 3], e: V3) -> C64 {
 /// cells, solved in Maxwell's equations for `polarisation` at `polar_deg`
 /// (azimuth 0); `eps_s = 1` is the empty lattice.
 fn solve(eps_s: C64, polarisation: Linear, polar_deg: f64, cells: usize) -> Solution {
-    let (l, h) = (PERIOD, HEIGHT);
-    let geom = Geometry {
-        size_nm: [l, l, h],
-        particles: vec![Particle {
-            species: 0,
-            spheres: vec![Sphere {
-                center: [0.37 * l, 0.61 * l, 0.5 * h],
-                radius: RADIUS,
-            }],
-        }],
-        stats: Default::default(),
-    };
-    let nz = (h / (l / cells as f64)).round() as usize;
-    let grid = Grid {
-        nx: cells,
-        ny: cells,
-        nz,
-        size_nm: [l, l, h],
-    };
-    let raster = rasterize(&geom, &grid, 4);
-    let mut eps = Array3::zeros((nz, cells, cells));
-    raster.epsilon_into(C64::new(1.0, 0.0), &[eps_s], &mut eps);
-    let lattice = Problem::lattice([cells, cells, nz], [l, l, h], WAVELENGTH, polar_deg, 0.0);
+    let (eps, lattice) =
+        one_sphere_lattice(PERIOD, HEIGHT, RADIUS, cells, eps_s, WAVELENGTH, polar_deg);
     solver::solve(
         &Problem {
             lattice,

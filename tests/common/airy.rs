@@ -87,3 +87,23 @@ pub fn tmm(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
     let r = (u - du / b) / 2.0;
     ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
 }
+
+/// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points (the
+/// diffuse terms of a closed-form slab, `R_dd` and `T_d`).
+pub fn hemispherical(f: impl Fn(f64) -> f64) -> f64 {
+    let n = 20_000;
+    let h = 1.0 / n as f64;
+    let mut s = 0.0;
+    for i in 0..=n {
+        let mu = i as f64 * h;
+        let w = if i == 0 || i == n {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        s += w * f(mu) * mu;
+    }
+    2.0 * s * h / 3.0
+}

@@ -2,7 +2,7 @@
 //! problem the solver takes, and a brute-force check of particle gaps.
 
 use inksim::config::{Background, Precision};
-use inksim::geometry::{pack_rsa, Geometry, PackParams, SpeciesParams, Sphere};
+use inksim::geometry::{pack_rsa, Geometry, PackParams, Particle, SpeciesParams, Sphere};
 use inksim::raster::{rasterize, Grid};
 use inksim::solver::{Controls, Lattice, Problem};
 use ndarray::Array3;
@@ -88,4 +88,42 @@ pub fn brute_min_gap(g: &Geometry) -> f64 {
         }
     }
     best
+}
+
+/// One sphere of radius `radius` and permittivity `eps_s` per period
+/// `l` × `l` × `h` in vacuum, at (0.37 l, 0.61 l, h/2), on `cells` lateral
+/// cells and cubic voxels: its ε grid and the lattice of the problem at
+/// wavelength `wl` lit at `polar_deg` (azimuth 0).
+pub fn one_sphere_lattice(
+    l: f64,
+    h: f64,
+    radius: f64,
+    cells: usize,
+    eps_s: C64,
+    wl: f64,
+    polar_deg: f64,
+) -> (Array3<C64>, Lattice) {
+    let geom = Geometry {
+        size_nm: [l, l, h],
+        particles: vec![Particle {
+            species: 0,
+            spheres: vec![Sphere {
+                center: [0.37 * l, 0.61 * l, 0.5 * h],
+                radius,
+            }],
+        }],
+        stats: Default::default(),
+    };
+    let nz = (h / (l / cells as f64)).round() as usize;
+    let grid = Grid {
+        nx: cells,
+        ny: cells,
+        nz,
+        size_nm: [l, l, h],
+    };
+    let raster = rasterize(&geom, &grid, 4);
+    let mut eps = Array3::zeros((nz, cells, cells));
+    raster.epsilon_into(C64::new(1.0, 0.0), &[eps_s], &mut eps);
+    let lattice = Problem::lattice([cells, cells, nz], [l, l, h], wl, polar_deg, 0.0);
+    (eps, lattice)
 }

@@ -405,6 +405,77 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     }
 }
 
+/// A high-contrast pigment (n 2.7 in binder of 1.558) is measured by a
+/// pilot solve before the study runs, not assumed from the stand-ins'
+/// rate: the pilot is the run's own first solve at the middle wavelength
+/// and normal incidence (same seed, grid and solver), so its applications
+/// are that solve's exactly; the low-contrast variant has no pilot; and the
+/// white variant's estimate carries the pilot's factor.
+#[test]
+fn a_high_contrast_layer_is_planned_from_a_pilot_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = SceneToml::grains()
+        .thickness_nm(400.0)
+        .fragment_nm(400.0)
+        .layer_pvc(0.2)
+        .pigment(PigmentToml::index("p", 1.4, 0.0).diameter_nm(150.0))
+        .cell_nm(25.0)
+        .z_cell_nm(25.0)
+        .wavelengths_nm(&[450.0, 550.0, 650.0])
+        .polar_deg(&[0.0, 30.0])
+        .tolerance(1e-5);
+    let study =
+        StudyToml::new("t", 5, "out", &base).axis("n", "pigment.0.material.index.0", "[1.4, 2.7]");
+    let p = write(dir.path(), "sweep.toml", &study.toml());
+    let ps = p.to_str().unwrap();
+    let (ok, plan, err) = inksim_in(dir.path(), &["plan", ps]);
+    assert!(ok, "{err}");
+    let pilots: Vec<&str> = plan
+        .lines()
+        .filter(|l| l.contains("high-contrast grains"))
+        .collect();
+    assert_eq!(pilots.len(), 1, "{plan}");
+    let line = pilots[0];
+    let parsed = Study::load(&p).unwrap().expand(None).unwrap();
+    let white = parsed
+        .variants
+        .iter()
+        .find(|v| inksim::pipeline::species_eps(&v.scene, 550.0).unwrap()[0].re > 7.0)
+        .unwrap();
+    assert!(
+        line.contains("1 variant(s)")
+            && line.contains(&format!("pilot solve of {} at 550 nm", white.name)),
+        "{line}"
+    );
+    let applications: f64 = line
+        .split(" applications per solve")
+        .next()
+        .and_then(|s| s.split_whitespace().last())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+
+    let (ok, out, err) = inksim_in(dir.path(), &["run", ps]);
+    assert!(ok, "{out}{err}");
+    let got = results(&dir.path().join("out/variants"));
+    let solve = got[&white.name]
+        .entries
+        .iter()
+        .find(|e| {
+            e.wavelength_nm == 550.0
+                && e.polar_deg == 0.0
+                && e.realisation == 0
+                && e.side == inksim::optics::farfield::Side::Above
+        })
+        .unwrap();
+    let run = (solve.iterations as f64 + 1.0) * solve.method.solver().applications_per_iteration();
+    assert_eq!(applications, run, "{line}");
+    let assumed = inksim::study::plan::default_applications(&white.scene);
+    assert!(
+        line.contains(&format!("{:.1}× the assumed {assumed:.0}", run / assumed)),
+        "{line}"
+    );
+}
+
 #[test]
 fn truncated_and_mismatched_results_are_redone() {
     let dir = tempfile::tempdir().unwrap();

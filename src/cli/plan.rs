@@ -55,6 +55,28 @@ pub fn plan(
         cal.ratio,
         cal.applications_source
     );
+    for (key, g) in &cal.groups {
+        let pilot = match &g.pilot {
+            Ok(p) => format!(
+                "pilot solve of {} at {} nm, 0°: {:.0} applications per solve, {:.1}× the assumed \
+                 {:.0} ({:.1} s CPU)",
+                p.variant,
+                p.wavelength_nm,
+                p.applications,
+                p.applications / g.assumed,
+                g.assumed,
+                p.cpu_s
+            ),
+            Err(e) => format!("pilot solve failed ({e}); the assumed rates"),
+        };
+        println!(
+            "  high-contrast grains (|n/n_b − 1| > {}), {} variant(s), {key}: {pilot}; × {:.2}: {}",
+            inksim::study::pilot::HIGH_CONTRAST,
+            g.members,
+            g.ratio,
+            g.source
+        );
+    }
     for ((g, equation), t) in &cal.grids {
         println!(
             "  grid {}×{}×{} ({}): setup {:.1} ms, one application {:.2} ms{}",

@@ -37,7 +37,7 @@ pub mod disk;
 mod eps;
 mod fine_bodies;
 mod grains;
-mod layer;
+pub mod layer;
 pub mod memory;
 pub mod model_error;
 mod plan;
@@ -61,9 +61,10 @@ use crate::solver;
 
 pub use appearance::{appearance_spec, PROXY_STEP_NM};
 pub use baseline::{add_baseline, baseline_input};
-pub use eps::fraction_eps;
+pub use eps::{fraction_eps, species_eps};
 pub use grains::{
-    build_geometry, build_geometry_seeded, grid_of, realisation_seed, Packer, RSA_MAX_PVC,
+    build_geometry, build_geometry_seeded, grid_of, largest_grain_nm, realisation_seed, Packer,
+    RSA_MAX_PVC,
 };
 pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;

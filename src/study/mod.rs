@@ -23,8 +23,10 @@
 //!
 //! The user documentation of the format and the commands is docs/STUDY.md.
 
+mod cpu;
 pub mod export;
 pub mod merge;
+pub mod pilot;
 pub mod plan;
 pub mod run;
 pub mod slurm;

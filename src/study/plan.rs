@@ -27,12 +27,17 @@
 //! spheres take a third of the applications of 450 nm ones); closed-form
 //! layers (no grid, [`ANALYTIC_SOLVE_S`] per solve) are left out of that
 //! ratio and out
-//! of the model. A Maxwell variant is timed on the vector operator and
+//! of the model. A high-contrast layer (white grains: real index more than
+//! [`pilot::HIGH_CONTRAST`] from the binder's) is not assumed at the
+//! stand-ins' rate: its group is measured by a pilot solve ([`pilot`]),
+//! whose factor replaces 1× as the group's prior. A Maxwell variant is timed on the vector operator and
 //! pays its setup and applications once per polarisation solved
 //! ([`wave_solves`]: natural light one random-phase solve for an ensemble, else two). Geometry packing and output
 //! are not modelled (seconds per variant). The estimate is a guide (±2×),
 //! not a promise.
 
+use super::cpu::process_cpu_s;
+use super::pilot;
 use super::run::{self, State};
 use super::sweep::Variant;
 use crate::config::{Background, Equation, Linear, Scene, Surface};
@@ -110,6 +115,25 @@ pub struct Calibration {
     pub ratio: f64,
     /// Where `ratio` came from.
     pub applications_source: String,
+    /// High-contrast groups ([`pilot::group`]) → their own factor, from a
+    /// pilot solve and their finished results, in place of `ratio`.
+    pub groups: BTreeMap<String, GroupRate>,
+}
+
+/// The measured factor of one high-contrast group.
+#[derive(Debug, Clone)]
+pub struct GroupRate {
+    /// Factor on the assumed applications of the group's variants.
+    pub ratio: f64,
+    /// Applications per solve the model assumes for the pilot's variant.
+    pub assumed: f64,
+    /// Its pilot, or why there is none.
+    pub pilot: Result<pilot::Pilot, String>,
+    /// Variants in the group, and how many of them are finished.
+    pub members: usize,
+    pub finished: usize,
+    /// Where `ratio` came from, in words.
+    pub source: String,
 }
 
 /// Estimated cost of one variant.
@@ -214,17 +238,6 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
     (setups[1], applies[1])
 }
 
-/// CPU seconds (user + system) of every thread of this process so far.
-fn process_cpu_s() -> f64 {
-    // SAFETY: getrusage writes the struct it is given and nothing else.
-    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut ru) } != 0 {
-        return f64::NAN;
-    }
-    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    tv(ru.ru_utime) + tv(ru.ru_stime)
-}
-
 /// Operator applications of the finished results among `variants` against
 /// what [`default_applications`] assumed for them, per solve: (measured /
 /// assumed, results counted), if any.
@@ -248,32 +261,82 @@ pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
     (assumed > 0.0).then(|| (measured / assumed, files))
 }
 
-/// Calibrate the time model for the grids of `variants`.
+/// Calibrate the time model for the grids of `variants`: time each grid's
+/// operator, measure every high-contrast group by a pilot solve
+/// ([`pilot`]), and scale the assumed rates by the finished results.
 pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
     let mut grids = BTreeMap::new();
     for v in variants {
         let key = (grid_of(&v.scene), v.scene.solver.equation);
         grids.entry(key).or_insert_with(|| time_grid(key.0, key.1));
     }
-    let (ratio, applications_source) = match measured_ratio(finished) {
-        Some((r, files)) => (
-            (PRIOR_RESULTS + files as f64 * r) / (PRIOR_RESULTS + files as f64),
-            format!(
-                "the {files} finished result(s) of this study needed {r:.2}× the assumed \
-                 rates, averaged with 1× counted as {PRIOR_RESULTS} results"
-            ),
-        ),
+    let mut members: BTreeMap<String, Vec<&Variant>> = BTreeMap::new();
+    for v in variants {
+        if let Some(key) = pilot::group(&v.scene) {
+            members.entry(key).or_default().push(v);
+        }
+    }
+    let in_group = |key: &str| -> Vec<Variant> {
+        finished
+            .iter()
+            .filter(|v| pilot::group(&v.scene).as_deref() == Some(key))
+            .cloned()
+            .collect()
+    };
+    let groups = members
+        .iter()
+        .map(|(key, m)| {
+            let rep = pilot::representative(m);
+            let assumed = default_applications(&rep.scene);
+            let p = pilot::measure(key, rep);
+            let prior = p.as_ref().map_or(1.0, |p| p.applications / assumed);
+            let done = measured_ratio(&in_group(key));
+            let (ratio, source) = blend(prior, done, "the pilot's factor", "group");
+            let rate = GroupRate {
+                ratio,
+                assumed,
+                pilot: p,
+                members: m.len(),
+                finished: done.map_or(0, |d| d.1),
+                source,
+            };
+            (key.clone(), rate)
+        })
+        .collect();
+    let ordinary_finished: Vec<Variant> = finished
+        .iter()
+        .filter(|v| pilot::group(&v.scene).is_none())
+        .cloned()
+        .collect();
+    let (ratio, applications_source) = match measured_ratio(&ordinary_finished) {
         None => (
             1.0,
             "no finished result yet: the measured rates as assumed (docs/PERFORMANCE.md, \
              \"The standard study\")"
                 .to_string(),
         ),
+        done => blend(1.0, done, "1×", "study"),
     };
     Calibration {
         grids,
         ratio,
         applications_source,
+        groups,
+    }
+}
+
+/// A prior factor averaged with the finished results' (`done`: factor and
+/// results counted), the prior counting as [`PRIOR_RESULTS`] results.
+fn blend(prior: f64, done: Option<(f64, usize)>, prior_name: &str, whose: &str) -> (f64, String) {
+    match done {
+        Some((r, files)) => (
+            (PRIOR_RESULTS * prior + files as f64 * r) / (PRIOR_RESULTS + files as f64),
+            format!(
+                "the {files} finished result(s) of this {whose} needed {r:.2}× the assumed \
+                 rates, averaged with {prior_name} counted as {PRIOR_RESULTS} results"
+            ),
+        ),
+        None => (prior, format!("{prior_name}, no finished result yet")),
     }
 }
 
@@ -290,7 +353,10 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
     } else {
         let key = (grid, scene.solver.equation);
         cal.grids.get(&key).map_or(f64::NAN, |t| {
-            let applications = default_applications(scene) * cal.ratio;
+            let ratio = pilot::group(scene)
+                .and_then(|k| cal.groups.get(&k))
+                .map_or(cal.ratio, |g| g.ratio);
+            let applications = default_applications(scene) * ratio;
             let waves = wave_solves(scene) as f64;
             solves as f64 * waves * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)
         })

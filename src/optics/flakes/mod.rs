@@ -12,11 +12,14 @@
 //!   adding–doubling directions (flakes and ordinary pigments);
 //! - [`paint`]: the fast model, layers added on a ground under the paint's
 //!   surface, and its BRDF;
+//! - [`montecarlo`]: the full model that checks it, ray tracing with
+//!   explicit disc flakes;
 //! - [`multiangle`]: the multi-angle geometries, their colours and the flop
 //!   index;
 //! - [`sparkle`]: Poisson glints per resolution cell and graininess.
 
 pub mod kernel;
+pub mod montecarlo;
 pub mod multiangle;
 pub mod normals;
 pub mod paint;

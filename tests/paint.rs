@@ -314,3 +314,16 @@ fn a_bad_paint_fails_in_one_line_and_leaves_nothing() {
     }
     assert!(!dir.path().join("runs").exists());
 }
+
+#[test]
+fn a_command_of_a_wave_scene_refuses_a_paint_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/metallic.toml");
+    let (ok, _, stderr) = inksim_in(dir.path(), &["geometry", cfg]);
+    assert!(!ok);
+    assert!(
+        stderr.contains("an effect paint ([paint] table)"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+}

@@ -51,3 +51,11 @@ def test_sparkle_and_brdf(metallic):
     assert np.all(np.isfinite(p["brdf"].values)) and np.all(p["brdf"].values >= 0)
     albedo = p["albedo"].values
     assert np.all((albedo > 0) & (albedo < 1))
+
+
+def test_views_in_the_plane(metallic):
+    v = metallic.paint["view_deg"].values
+    # Light's side negative, mirror side positive, the normal once and as +0.
+    assert np.all(np.diff(v) > 0)
+    assert np.count_nonzero(v == 0.0) == 1 and not np.signbit(v[v == 0.0][0])
+    assert v[0] == -v[-1]

@@ -148,6 +148,12 @@ impl ConfigFile {
 
     /// The scene it describes.
     pub fn scene(&self) -> Result<inksim::config::Scene> {
+        anyhow::ensure!(
+            !self.is_paint(),
+            "{}: an effect paint ([paint] table): `inksim run` and `inksim check` take it; this \
+             command takes a wave-optics scene",
+            self.display()
+        );
         Ok(inksim::config::parse_scene(&self.path, &self.text)?)
     }
 

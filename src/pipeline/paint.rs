@@ -291,7 +291,8 @@ struct InPlane {
 
 fn in_plane(reflections: &[PaintReflection]) -> Result<InPlane, PipelineError> {
     let (directions_deg, nodes) = air_nodes(&reflections[0]);
-    let mut view_deg: Vec<f64> = directions_deg.iter().rev().map(|d| -d).collect();
+    // `0 − d`, not `−d`: the normal reads 0, not −0.
+    let mut view_deg: Vec<f64> = directions_deg.iter().rev().map(|&d| 0.0 - d).collect();
     view_deg.extend(directions_deg.iter().filter(|&&d| d > 0.0));
     view_deg.dedup();
     let (nl, nd, nv) = (reflections.len(), directions_deg.len(), view_deg.len());

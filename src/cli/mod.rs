@@ -4,6 +4,7 @@
 //! prints what it did.
 //!
 //! - [`scene`]: `run`, `geometry` and `check` of one scene.
+//! - [`paint`]: `run` and `check` of an effect paint.
 //! - [`study`]: `run`, `check` and `merge` of a study.
 //! - [`plan`]: `plan`, the variants with their work and estimated time and
 //!   memory.
@@ -16,6 +17,7 @@
 
 pub mod export;
 pub mod materials;
+pub mod paint;
 pub mod plan;
 pub mod scene;
 pub mod slurm;
@@ -139,8 +141,19 @@ impl ConfigFile {
         inksim::study::is_study_text(&self.text)
     }
 
+    /// Whether it is an effect paint (has a [paint] table).
+    pub fn is_paint(&self) -> bool {
+        inksim::config::is_paint_text(&self.text)
+    }
+
     /// The scene it describes.
     pub fn scene(&self) -> Result<inksim::config::Scene> {
+        anyhow::ensure!(
+            !self.is_paint(),
+            "{}: an effect paint ([paint] table): `inksim run` and `inksim check` take it; this \
+             command takes a wave-optics scene",
+            self.display()
+        );
         Ok(inksim::config::parse_scene(&self.path, &self.text)?)
     }
 

@@ -13,6 +13,9 @@ pub fn run(
     output_dir: Option<PathBuf>,
     memory: Option<MemoryLimit>,
 ) -> Result<()> {
+    if config.is_paint() {
+        return super::paint::run(config, output_dir);
+    }
     let mut scene = config.scene()?;
     if let Some(d) = output_dir {
         scene.output.dir = d;
@@ -118,6 +121,9 @@ pub fn geometry(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> 
 
 /// `inksim check SCENE`: validate and print what a run would compute.
 pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
+    if config.is_paint() {
+        return super::paint::check(config);
+    }
     let scene = config.scene()?;
     let run_plan = inksim::pipeline::RunPlan::of(&scene);
     let disk_bytes = inksim::pipeline::disk::estimate_bytes(&scene, &run_plan);

@@ -13,13 +13,15 @@ pub mod colour;
 pub mod ground;
 pub mod materials;
 mod method;
+pub mod paint;
 mod raw;
+mod raw_paint;
 mod stack;
 mod wave;
 
 use std::path::{Path, PathBuf};
 
-pub use check::{load_scene, parse_scene};
+pub use check::{is_paint_text, load_scene, parse_paint, parse_scene};
 pub use colour::{Illuminant, Measurement, StandardObserver};
 pub use ground::{
     GroundReflectance, ReflectanceSpectrum, SpectrumError, Substrate, DEFAULT_PAPER_ALBEDO,

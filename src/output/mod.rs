@@ -8,14 +8,17 @@
 //!   `render`'s preview shades a sphere with);
 //! - [`progress`]: timestamped progress lines on long work;
 //! - [`space`]: the free space of an output's file system;
-//! - [`export`]: a result's numbers as CSV tables.
+//! - [`export`]: a result's numbers as CSV tables ([`csv`]: the table
+//!   writer; [`export_paint`]: an effect paint's tables).
 //!
 //! Imports from every earlier stage (`config` … `optics`), never from
 //! `pipeline` or `study`.
 
 pub mod atomic;
+pub mod csv;
 pub mod error;
 pub mod export;
+pub mod export_paint;
 pub mod h5;
 pub mod hiding;
 pub mod lock;

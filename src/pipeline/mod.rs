@@ -21,6 +21,7 @@
 //! - `appearance`: what the appearance stage is given;
 //! - `baseline`: the classical baselines' colours (Kubelka–Munk,
 //!   adding–doubling) beside the wave one, when the scene asks for them;
+//! - `paint`: an effect paint by the fast model, end to end ([`run_paint`]);
 //! - `result`: the result file assembled from a run's parts;
 //! - `run`: a run end to end ([`run`]), and the geometry-only run
 //!   ([`run_geometry`]);
@@ -40,6 +41,7 @@ mod grains;
 pub mod layer;
 pub mod memory;
 pub mod model_error;
+mod paint;
 mod plan;
 mod result;
 mod run;
@@ -66,6 +68,7 @@ pub use grains::{
     build_geometry, build_geometry_seeded, grid_of, largest_grain_nm, realisation_seed, Packer,
     RSA_MAX_PVC,
 };
+pub use paint::{paint_files, paint_plan, run_paint, PaintReport};
 pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};

@@ -155,6 +155,18 @@ class Result:
     - ``geometry``, ``statistics``, ``realisations`` (and ``seeds``);
     - ``tile_png``, ``picture_png``: the stored PNG bytes.
     - ``stack``: ``/stack`` of a stack combined layer by layer, else None.
+    - an effect paint's result (``kind`` ``"paint"`` in ``attrs``; no
+      solves, orders or appearance): ``paint``, ``/paint`` as a Dataset
+      (``brdf`` over ``wavelength_nm``, ``direction_deg``, ``view_deg``;
+      ``mirror_reflectance``, ``albedo``, ``fourier_terms``);
+      ``multiangle``, a Dataset over ``geometry`` (``illumination_deg``,
+      ``aspecular_deg`` as coordinates; ``lab``, ``lch``, ``xyz``,
+      ``reflectance_factor``, ``flop_index``; ``illuminant`` and
+      ``observer_deg`` in ``attrs``); ``sparkle``, over
+      ``sparkle_illumination_deg`` (``glints_per_mm2``,
+      ``glints_per_cell``, ``glint_reflectance`` and the scalars
+      ``viewing_distance_mm``, ``cell_area_mm2``, ``flakes_per_mm2``,
+      ``graininess``), None without flakes.
     - ``hiding``: over a hiding chart (``substrate.kind = "chart"``),
       ``/appearance/hiding`` as a Dataset over ``geometry`` (``45/0``,
       ``d/8 SCI``, ``d/8 SCE``): ``contrast_ratio``, ``y_black``,
@@ -183,6 +195,9 @@ class Result:
             )
             self.realisations = _read_realisations(f) if "realisations" in f else None
             self.stack = _read_stack(f) if "stack" in f else None
+            self.paint = _read_paint(f) if "paint" in f else None
+            self.multiangle = _read_group(f, "paint/multiangle") if "paint/multiangle" in f else None
+            self.sparkle = _read_group(f, "paint/sparkle") if "paint/sparkle" in f else None
             self.hiding = _read_hiding(f) if "appearance/hiding" in f else None
             self.picture_png: Optional[bytes] = (
                 f["picture_png"][()].tobytes() if "picture_png" in f else None
@@ -334,6 +349,10 @@ class Result:
             lines.append("  appearance: " + ", ".join(f"{k} {v}" for k, v in self.appearance.sizes.items()))
         if self.geometry is not None:
             lines.append("  geometry: " + ", ".join(f"{k} {v}" for k, v in self.geometry.sizes.items()))
+        if self.multiangle is not None:
+            fi = self.multiangle.get("flop_index")
+            lines.append(f"  paint: {self.multiangle.sizes.get('geometry', 0)} multi-angle geometries"
+                         + (f", flop index {float(fi):.2f}" if fi is not None else ""))
         if self.stack is not None:
             lines.append("  stack: " + ", ".join(f"{k} {v}" for k, v in self.stack.sizes.items()))
         return "\n".join(lines)
@@ -552,6 +571,30 @@ def _read_hiding(f: h5py.File) -> xr.Dataset:
         "wavelength_nm": _coord("appearance/wavelengths_nm", wl, ("wavelength_nm",)),
     }
     return xr.Dataset(data, coords=coords, attrs=_attrs(hg))
+
+
+def _read_group(f: h5py.File, name: str) -> xr.Dataset:
+    """The datasets of group ``name`` (not its subgroups or PNG bytes), on
+    the axes the file labels; 1-D datasets named after their own axis are
+    coordinates, and so are those along ``geometry``'s angles."""
+    g = f[name]
+    data: Dict[str, xr.Variable] = {}
+    coords: Dict[str, xr.Variable] = {}
+    for k, ds in g.items():
+        if not isinstance(ds, h5py.Dataset) or k.endswith("_png"):
+            continue
+        v = _var(f"{name}/{k}", ds)
+        own_axis = v.dims == (k,) or (k == "illumination_deg" and v.ndim == 1)
+        if own_axis or (v.dims == ("geometry",) and k == "aspecular_deg"):
+            coords[k if v.dims != (k,) else v.dims[0]] = v
+        else:
+            data[k] = v
+    return xr.Dataset(data, coords=coords, attrs=_attrs(g))
+
+
+def _read_paint(f: h5py.File) -> xr.Dataset:
+    """``/paint`` of an effect paint's result (docs/FORMAT.md)."""
+    return _read_group(f, "paint")
 
 
 def _read_stack(f: h5py.File) -> xr.Dataset:

@@ -63,27 +63,11 @@ impl Checker<'_> {
                 format!("must be in [2, 32], got {q}"),
             ));
         }
-        let illuminant = match raw.and_then(|a| a.illuminant.as_deref()) {
-            None => Illuminant::D50,
-            Some(name) => Illuminant::from_name(name).ok_or_else(|| {
-                self.invalid(
-                    "appearance.illuminant",
-                    format!("unknown illuminant \"{name}\"; allowed: \"D50\", \"D65\", \"A\""),
-                )
-            })?,
-        };
-        let observer = match raw.and_then(|a| a.observer_deg) {
-            None => StandardObserver::TwoDegree,
-            Some(d) => u32::try_from(d)
-                .ok()
-                .and_then(StandardObserver::from_degrees)
-                .ok_or_else(|| {
-                    self.invalid(
-                        "appearance.observer_deg",
-                        format!("must be 2 (CIE 1931) or 10 (CIE 1964), got {d}"),
-                    )
-                })?,
-        };
+        let (illuminant, observer) = self.colour_conditions(
+            "appearance",
+            raw.and_then(|a| a.illuminant.as_deref()),
+            raw.and_then(|a| a.observer_deg),
+        )?;
         let measurements = match raw.and_then(|a| a.measurements.as_ref()) {
             None => Measurement::ALL.to_vec(),
             Some(names) => {
@@ -119,6 +103,38 @@ impl Checker<'_> {
             measurements,
             baseline,
         })
+    }
+
+    /// `<table>.illuminant` (default D50) and `<table>.observer_deg`
+    /// (default 2).
+    pub(super) fn colour_conditions(
+        &self,
+        table: &str,
+        illuminant: Option<&str>,
+        observer_deg: Option<i64>,
+    ) -> Result<(Illuminant, StandardObserver), ConfigError> {
+        let illuminant = match illuminant {
+            None => Illuminant::D50,
+            Some(name) => Illuminant::from_name(name).ok_or_else(|| {
+                self.invalid(
+                    format!("{table}.illuminant"),
+                    format!("unknown illuminant \"{name}\"; allowed: \"D50\", \"D65\", \"A\""),
+                )
+            })?,
+        };
+        let observer = match observer_deg {
+            None => StandardObserver::TwoDegree,
+            Some(d) => u32::try_from(d)
+                .ok()
+                .and_then(StandardObserver::from_degrees)
+                .ok_or_else(|| {
+                    self.invalid(
+                        format!("{table}.observer_deg"),
+                        format!("must be 2 (CIE 1931) or 10 (CIE 1964), got {d}"),
+                    )
+                })?,
+        };
+        Ok((illuminant, observer))
     }
 
     /// `appearance.baseline`: one name or a list, each a known model, none
@@ -214,7 +230,7 @@ impl Checker<'_> {
 
     /// A ground's reflectance table `rel` (relative to the scene file),
     /// covering every wavelength of the scene.
-    fn ground_spectrum(
+    pub(super) fn ground_spectrum(
         &self,
         key: &str,
         rel: &str,

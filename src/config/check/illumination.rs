@@ -2,7 +2,7 @@
 //! angles of incidence with their azimuth.
 
 use super::{Checker, REL_EPS};
-use crate::config::raw::RawIllumination;
+use crate::config::raw::{RawIllumination, RawRange};
 use crate::config::{ConfigError, Incidence};
 
 const MAX_WAVELENGTHS: usize = 10_000;
@@ -13,17 +13,39 @@ impl Checker<'_> {
         &self,
         raw: &RawIllumination,
     ) -> Result<(Vec<f64>, &'static str), ConfigError> {
-        match (&raw.wavelengths_nm, &raw.wavelength_range_nm) {
+        self.wavelength_list(
+            "illumination",
+            raw.wavelengths_nm.as_ref(),
+            raw.wavelength_range_nm.as_ref(),
+        )
+    }
+
+    /// The wavelength list of table `table` (`illumination`, `paint`) from
+    /// its `wavelengths_nm` or `wavelength_range_nm`, and the key it came
+    /// from.
+    pub(super) fn wavelength_list(
+        &self,
+        table: &'static str,
+        list: Option<&Vec<f64>>,
+        range: Option<&RawRange>,
+    ) -> Result<(Vec<f64>, &'static str), ConfigError> {
+        let keys: (&'static str, &'static str) = match table {
+            "paint" => ("paint.wavelengths_nm", "paint.wavelength_range_nm"),
+            _ => (
+                "illumination.wavelengths_nm",
+                "illumination.wavelength_range_nm",
+            ),
+        };
+        match (list, range) {
             (Some(_), Some(_)) => Err(self.invalid(
-                "illumination",
+                table,
                 "give either wavelengths_nm or wavelength_range_nm, not both",
             )),
-            (None, None) => Err(self.invalid(
-                "illumination",
-                "give either wavelengths_nm or wavelength_range_nm",
-            )),
+            (None, None) => {
+                Err(self.invalid(table, "give either wavelengths_nm or wavelength_range_nm"))
+            }
             (Some(list), None) => {
-                let key = "illumination.wavelengths_nm";
+                let key = keys.0;
                 if list.is_empty() {
                     return Err(self.invalid(key, "must not be empty"));
                 }
@@ -37,7 +59,7 @@ impl Checker<'_> {
                 Ok((list.clone(), key))
             }
             (None, Some(r)) => {
-                let key = "illumination.wavelength_range_nm";
+                let key = keys.1;
                 self.range(
                     &format!("{key}.start"),
                     r.start,

@@ -44,13 +44,16 @@ mod appearance;
 mod illumination;
 mod layer;
 mod material;
+mod paint;
 mod pigments;
 mod scene;
 mod solver;
 mod stack;
 mod structure;
 
+use super::paint::PaintScene;
 use super::raw::RawConfig;
+use super::raw_paint::RawPaintConfig;
 use super::{ConfigError, Scene};
 use std::path::Path;
 
@@ -71,15 +74,39 @@ pub fn load_scene(path: &Path) -> Result<Scene, ConfigError> {
 /// Parses and validates scene TOML `text`; `path` is where it came from (used
 /// in messages, for resolving CSV paths and for default output names).
 pub fn parse_scene(path: &Path, text: &str) -> Result<Scene, ConfigError> {
-    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+    let raw: RawConfig = parse_raw(path, text)?;
+    checker(path).scene(path, text, raw)
+}
+
+/// The raw tables of TOML `text`; a parse error names `path`, the line and
+/// the column.
+fn parse_raw<T: serde::de::DeserializeOwned>(path: &Path, text: &str) -> Result<T, ConfigError> {
+    toml::from_str(text).map_err(|e| ConfigError::Parse {
         file: path.to_path_buf(),
         message: parse_message(text, &e),
-    })?;
+    })
+}
+
+/// The checker of the file at `path`.
+fn checker(path: &Path) -> Checker<'_> {
     Checker {
         file: path,
         prefix: String::new(),
     }
-    .scene(path, text, raw)
+}
+
+/// Parses and validates an effect paint's TOML `text` (a file with a
+/// `[paint]` table, [`is_paint_text`]).
+pub fn parse_paint(path: &Path, text: &str) -> Result<PaintScene, ConfigError> {
+    let raw: RawPaintConfig = parse_raw(path, text)?;
+    checker(path).paint(path, text, raw)
+}
+
+/// Whether TOML `text` describes an effect paint (has a top-level `[paint]`
+/// table); false for text that is not TOML.
+pub fn is_paint_text(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.get("paint").is_some_and(|v| v.is_table()))
 }
 
 /// The toml error on one line: `line L, column C: message; more`.

@@ -188,25 +188,7 @@ impl Checker<'_> {
                     "spheres and dissolved pigments have no axis to align",
                 ));
             }
-            let size = match &p.size {
-                None | Some(RawSize::Fixed) => GrainSize::Fixed,
-                Some(RawSize::Normal { sigma }) => GrainSize::Normal {
-                    sigma: self.range(
-                        &key("size.sigma"),
-                        *sigma,
-                        (0.0..=MAX_NORMAL_SIGMA).contains(sigma),
-                        &format!("[0, {MAX_NORMAL_SIGMA}] (relative to diameter_nm)"),
-                    )?,
-                },
-                Some(RawSize::LogNormal { sigma }) => GrainSize::LogNormal {
-                    sigma: self.range(
-                        &key("size.sigma"),
-                        *sigma,
-                        (0.0..=MAX_LOG_NORMAL_SIGMA).contains(sigma),
-                        &format!("[0, {MAX_LOG_NORMAL_SIGMA}] (standard deviation of ln d)"),
-                    )?,
-                },
-            };
+            let size = self.grain_size(p.size.as_ref(), &key("size"))?;
             if shape != GrainShape::Molecular {
                 let largest = size.max_diameter(diameter_nm);
                 if largest > max_d * (1.0 + REL_EPS) {
@@ -305,6 +287,34 @@ impl Checker<'_> {
                 let (aspect, spheres) = parts(*aspect, *spheres, 3.0, 7)?;
                 GrainShape::Rice { aspect, spheres }
             }
+        })
+    }
+
+    /// `size`: fixed, or normal / log-normal with `sigma` in range.
+    pub(super) fn grain_size(
+        &self,
+        raw: Option<&RawSize>,
+        key: &str,
+    ) -> Result<GrainSize, ConfigError> {
+        let sigma_key = format!("{key}.sigma");
+        Ok(match raw {
+            None | Some(RawSize::Fixed) => GrainSize::Fixed,
+            Some(RawSize::Normal { sigma }) => GrainSize::Normal {
+                sigma: self.range(
+                    &sigma_key,
+                    *sigma,
+                    (0.0..=MAX_NORMAL_SIGMA).contains(sigma),
+                    &format!("[0, {MAX_NORMAL_SIGMA}] (relative to diameter_nm)"),
+                )?,
+            },
+            Some(RawSize::LogNormal { sigma }) => GrainSize::LogNormal {
+                sigma: self.range(
+                    &sigma_key,
+                    *sigma,
+                    (0.0..=MAX_LOG_NORMAL_SIGMA).contains(sigma),
+                    &format!("[0, {MAX_LOG_NORMAL_SIGMA}] (standard deviation of ln d)"),
+                )?,
+            },
         })
     }
 }

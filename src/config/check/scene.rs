@@ -17,7 +17,7 @@ const DEFAULT_SEED: u64 = 1;
 /// `[output]` (where results go changes nothing in them), written back in
 /// one canonical form (sorted keys, no comments or layout), so that moving
 /// a study, `--output-dir`, comments and key order keep its results valid.
-fn result_defining_text(text: &str) -> String {
+pub(super) fn result_defining_text(text: &str) -> String {
     match text.parse::<toml::Table>() {
         Ok(mut t) => {
             t.remove("output");
@@ -27,6 +27,16 @@ fn result_defining_text(text: &str) -> String {
         Err(_) => text.to_string(),
     }
 }
+
+/// The hasher's digest as lowercase hex.
+pub(super) fn hex_digest(hasher: Sha256) -> String {
+    let mut out = String::with_capacity(64);
+    for b in hasher.finalize() {
+        let _ = write!(out, "{b:02x}");
+    }
+    out
+}
+
 const MAX_REALISATIONS: i64 = 10_000;
 
 impl Checker<'_> {
@@ -217,10 +227,7 @@ impl Checker<'_> {
         if let Some(g) = substrate.spectrum() {
             hasher.update(&g.bytes);
         }
-        let mut input_hash = String::with_capacity(64);
-        for b in hasher.finalize() {
-            let _ = write!(input_hash, "{b:02x}");
-        }
+        let input_hash = hex_digest(hasher);
 
         Ok(Scene {
             provenance: Provenance {
@@ -289,7 +296,7 @@ impl Checker<'_> {
     /// Every material has data at every wavelength: the first gap (in
     /// wavelength order, then in `materials` order) is an error on `key`
     /// naming the material and whose it is.
-    fn coverage(
+    pub(super) fn coverage(
         &self,
         key: &str,
         wavelengths_nm: &[f64],

@@ -148,24 +148,40 @@ pub fn pigment_kernels(ords: &Ordinates, medium: &Medium, modes: usize) -> Vec<F
     };
     let mut terms_same = vec![Matrix::zeros(n); modes];
     let mut terms_opp = vec![Matrix::zeros(n); modes];
-    let azimuths: Vec<(f64, Vec<f64>)> = (0..steps)
+    // The integrand is even in Δφ: the nodes q and steps − q coincide, so
+    // the half range [0, π] is summed with each inner node counted twice.
+    let half = steps / 2;
+    let azimuths: Vec<(f64, f64, Vec<f64>)> = (0..=half)
         .map(|q| {
             let dphi = 2.0 * PI * q as f64 / steps as f64;
+            let twice = q != 0 && 2 * q != steps;
+            let weight = if twice { 2.0 } else { 1.0 } / steps as f64;
             (
                 dphi.cos(),
+                weight,
                 (0..modes).map(|m| (m as f64 * dphi).cos()).collect(),
             )
         })
         .collect();
+    let (mut acc_same, mut acc_opp) = (vec![0.0; modes], vec![0.0; modes]);
+    // Symmetric in (i, j): the phase function's argument is.
     for i in 0..n {
-        for j in 0..n {
-            for (cos_dphi, cs) in &azimuths {
+        for j in i..n {
+            acc_same.iter_mut().for_each(|v| *v = 0.0);
+            acc_opp.iter_mut().for_each(|v| *v = 0.0);
+            for (cos_dphi, weight, cs) in &azimuths {
                 let ss = sin[i] * sin[j] * cos_dphi;
-                let ps = phase(ords.mu[i] * ords.mu[j] + ss);
-                let po = phase(-ords.mu[i] * ords.mu[j] + ss);
+                let ps = weight * phase(ords.mu[i] * ords.mu[j] + ss);
+                let po = weight * phase(-ords.mu[i] * ords.mu[j] + ss);
                 for m in 1..modes {
-                    terms_same[m][(i, j)] += ps * cs[m] / steps as f64;
-                    terms_opp[m][(i, j)] += po * cs[m] / steps as f64;
+                    acc_same[m] += ps * cs[m];
+                    acc_opp[m] += po * cs[m];
+                }
+            }
+            for m in 1..modes {
+                for (a, b) in [(i, j), (j, i)] {
+                    terms_same[m][(a, b)] = acc_same[m];
+                    terms_opp[m][(a, b)] = acc_opp[m];
                 }
             }
         }

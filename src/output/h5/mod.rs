@@ -15,6 +15,7 @@
 //!   readers;
 //! - `brdf_read`: what drawing the layer on an object needs (the RGB
 //!   BRDF's data, the measured spectra, the tile);
+//! - `paint`: an effect paint's result file, its writer and reader;
 //! - `attrs`: scalar and string attribute helpers shared by all of them;
 //! - `described`: every dataset's `units`, `description` and axis names,
 //!   written with it; `scales`: the HDF5 dimension scales behind the axes;
@@ -36,6 +37,7 @@ mod brdf_read;
 mod described;
 mod file;
 mod geometry;
+mod paint;
 mod result;
 mod scales;
 mod stack;
@@ -51,7 +53,11 @@ pub use brdf_read::{read_brdf_data, read_measured_spectra, read_tile_png, Measur
 pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};
 pub use geometry::GeometrySummary;
-pub use result::{write_result, RealisationStop, ResultSet};
+pub use paint::{
+    is_paint_result, read_paint, write_paint, AngleRecord, PaintRecord, PaintResultSet,
+    SparkleRecord, SparkleTable, PAINT_KIND,
+};
+pub use result::{write_result, Identity, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 

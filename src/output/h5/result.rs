@@ -70,15 +70,64 @@ pub struct RealisationStop {
 /// removed and an existing `path` is left untouched.
 pub fn write_result(path: &Path, set: &ResultSet) -> Result<(), IoError> {
     check_result_set(path, set)?;
+    write_hdf5(path, |file| write_contents(file, set))
+}
+
+/// Write an HDF5 file atomically by `contents` (`<path>.tmp`, closed,
+/// synced, renamed; removed on any error).
+pub(super) fn write_hdf5(
+    path: &Path,
+    contents: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
+) -> Result<(), IoError> {
     write_atomic_with(path, |tmp| {
         let hdf = |source| IoError::Hdf5 {
             path: tmp.to_path_buf(),
             source,
         };
         let file = super::create(tmp).map_err(hdf)?;
-        write_contents(&file, set).map_err(hdf)?;
+        contents(&file).map_err(hdf)?;
         file.close().map_err(hdf)
     })
+}
+
+/// The identity every result file carries as root attributes.
+#[derive(Debug, Clone, Copy)]
+pub struct Identity<'a> {
+    pub version: &'a str,
+    pub config_path: &'a str,
+    pub input_hash: &'a str,
+    pub created_unix_s: u64,
+}
+
+/// `format_version`, `inksim_version`, `config_path`, `input_hash` and
+/// `created_unix_s` on the root.
+pub(super) fn write_identity(file: &hdf5::File, id: &Identity) -> hdf5::Result<()> {
+    let root: &Location = file;
+    write_scalar_attr(root, "format_version", FORMAT_VERSION)?;
+    write_str_attr(root, "inksim_version", id.version)?;
+    write_str_attr(root, "config_path", id.config_path)?;
+    write_str_attr(root, "input_hash", id.input_hash)?;
+    write_scalar_attr(root, "created_unix_s", id.created_unix_s)
+}
+
+/// `/config` and `/plan`, scalar strings with their descriptions.
+pub(super) fn write_texts(
+    s: &Scales,
+    file: &hdf5::File,
+    config: &str,
+    config_description: &str,
+    plan: &str,
+    plan_description: &str,
+) -> hdf5::Result<()> {
+    for (name, text, description) in [
+        ("config", config, config_description),
+        ("plan", plan, plan_description),
+    ] {
+        let d = file.new_dataset::<VarLenUnicode>().shape(()).create(name)?;
+        d.write_scalar(&vlu(text)?)?;
+        s.describe(&d, about("", description, &[]))?;
+    }
+    Ok(())
 }
 
 /// One row of `/summary`.
@@ -198,12 +247,16 @@ fn check_result_set(path: &Path, set: &ResultSet) -> Result<(), IoError> {
 
 fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
     let root: &Location = file;
-    write_scalar_attr(root, "format_version", FORMAT_VERSION)?;
-    write_str_attr(root, "inksim_version", set.version)?;
-    write_str_attr(root, "config_path", set.config_path)?;
-    write_str_attr(root, "input_hash", set.input_hash)?;
+    write_identity(
+        file,
+        &Identity {
+            version: set.version,
+            config_path: set.config_path,
+            input_hash: set.input_hash,
+            created_unix_s: set.created_unix_s,
+        },
+    )?;
     write_scalar_attr(root, "seed", set.seed)?;
-    write_scalar_attr(root, "created_unix_s", set.created_unix_s)?;
     let grid = set.grid.map(|v| v as u64);
     root.new_attr_builder()
         .with_data(&grid[..])
@@ -214,22 +267,14 @@ fn write_contents(file: &hdf5::File, set: &ResultSet) -> hdf5::Result<()> {
 
     let mut scales = Scales::default();
     let s = &mut scales;
-    for (name, text, description) in [
-        (
-            "config",
-            set.config_text,
-            "the scene's exact TOML text (text, no units)",
-        ),
-        (
-            "plan",
-            set.plan,
-            "the run's plan, one line per decision (text, no units)",
-        ),
-    ] {
-        let d = file.new_dataset::<VarLenUnicode>().shape(()).create(name)?;
-        d.write_scalar(&vlu(text)?)?;
-        s.describe(&d, about("", description, &[]))?;
-    }
+    write_texts(
+        s,
+        file,
+        set.config_text,
+        "the scene's exact TOML text (text, no units)",
+        set.plan,
+        "the run's plan, one line per decision (text, no units)",
+    )?;
 
     write_geometry(s, file, &set.geometry)?;
     let real = file.create_group("realisations")?;

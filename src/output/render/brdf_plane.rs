@@ -107,11 +107,7 @@ pub fn brdf_plane_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError
             series,
         })
         .collect();
-    let legend: Vec<_> = panels[0]
-        .series
-        .iter()
-        .map(|s| (s.label.clone(), s.colour, s.dashed))
-        .collect();
+    let legend = panels[0].legend();
     let shown = if picked.len() < s.wavelengths_nm.len() {
         format!(
             "{} of the run's {} wavelengths shown. ",

@@ -51,6 +51,7 @@ mod brdf_polar;
 pub mod canvas;
 mod colour_bar;
 mod geometry;
+pub mod multiangle;
 pub mod plot;
 pub mod preview;
 mod spectra;

@@ -83,11 +83,7 @@ pub fn spectra_png(a: &Appearance, name: &str) -> Result<Vec<u8>, RenderError> {
             series,
         });
     }
-    let legend: Vec<_> = panels[0]
-        .series
-        .iter()
-        .map(|s| (s.label.clone(), s.colour, s.dashed))
-        .collect();
+    let legend = panels[0].legend();
     let notes = [
         "The layer alone (no paper), light from above: R and T sum every \
          propagating order, the specular one included; A = 1 − R − T per solve."

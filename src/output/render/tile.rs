@@ -246,16 +246,7 @@ pub fn tile_png(
             img.rect(x as i64, y as i64, PATCH_PX, PATCH_PX, rgb);
             let ink = ink_on(mapped.lab[0]);
             if mapped.moved {
-                for k in 0..MARK_PX {
-                    // Filled triangle in the top-right corner.
-                    img.rect(
-                        (x + PATCH_PX - MARK_PX + k) as i64,
-                        (y + k) as i64,
-                        MARK_PX - k,
-                        1,
-                        ink,
-                    );
-                }
+                mark_moved(&mut img, (x, y), ink);
             }
             patch_numbers(&mut img, (x, y), lab_rc, ink, s);
         }
@@ -281,8 +272,22 @@ fn fitting<'a>(long: &'a str, short: &'a str, room: f64, g: f64) -> &'a str {
     }
 }
 
+/// The out-of-gamut mark: a filled triangle in the top-right corner of the
+/// patch at `(x, y)`.
+pub(super) fn mark_moved(img: &mut Canvas, (x, y): (usize, usize), ink: [u8; 3]) {
+    for k in 0..MARK_PX {
+        img.rect(
+            (x + PATCH_PX - MARK_PX + k) as i64,
+            (y + k) as i64,
+            MARK_PX - k,
+            1,
+            ink,
+        );
+    }
+}
+
 /// Black on light patches, white on dark ones.
-fn ink_on(lightness: f64) -> [u8; 3] {
+pub(super) fn ink_on(lightness: f64) -> [u8; 3] {
     if lightness > 55.0 {
         [0, 0, 0]
     } else {
@@ -291,7 +296,13 @@ fn ink_on(lightness: f64) -> [u8; 3] {
 }
 
 /// L*, C*ab and h° of `lab` in three lines at the bottom left of a patch.
-fn patch_numbers(img: &mut Canvas, (x, y): (usize, usize), lab: [f64; 3], ink: [u8; 3], s: f64) {
+pub(super) fn patch_numbers(
+    img: &mut Canvas,
+    (x, y): (usize, usize),
+    lab: [f64; 3],
+    ink: [u8; 3],
+    s: f64,
+) {
     let [_, c, h] = lab_to_lch(lab);
     let lines = [
         format!("L* {:.1}", lab[0]),

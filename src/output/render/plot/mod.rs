@@ -79,6 +79,16 @@ pub struct Panel {
     pub series: Vec<Series>,
 }
 
+impl Panel {
+    /// The legend entries of its series: (label, colour, dashed).
+    pub fn legend(&self) -> Vec<(String, [u8; 3], bool)> {
+        self.series
+            .iter()
+            .map(|s| (s.label.clone(), s.colour, s.dashed))
+            .collect()
+    }
+}
+
 /// Size of every panel's frame (the data area), pixels.
 #[derive(Debug, Clone, Copy)]
 pub struct PanelSize {

@@ -1,0 +1,523 @@
+//! An effect paint end to end (`inksim run paint.toml`): the checked
+//! [`PaintScene`] turned into the fast model's layers per wavelength
+//! (lacquer absorption, the ordinary pigments' Mie medium, the flakes'
+//! reflectance table and orientation), solved by `optics::flakes::paint`
+//! (the wavelengths in parallel), then the in-plane BRDF, the multi-angle
+//! colours and flop index, the sparkle figures, the pictures and the result
+//! file.
+
+use std::path::PathBuf;
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+use ndarray::{Array2, Array3};
+use num_complex::Complex64 as C64;
+use rayon::prelude::*;
+
+use crate::config::paint::{FilmSpec, PaintGround, PaintScene, ReflectorSpec};
+use crate::config::{Equation, Material};
+use crate::optics::baseline::doubling::Medium;
+use crate::optics::baseline::ordinates::OrdinateParams;
+use crate::optics::baseline::{transfer, BaselineInput, BaselineSpecies};
+use crate::optics::colour::{self, Observer};
+use crate::optics::flakes::kernel::FlakeMedium;
+use crate::optics::flakes::multiangle;
+use crate::optics::flakes::normals::Orientation;
+use crate::optics::flakes::paint::{
+    self as model, Ground, ModelParams, PaintLayer, PaintReflection,
+};
+use crate::optics::flakes::reflector::{Layer as Film, Reflector};
+use crate::optics::flakes::sparkle;
+use crate::output::atomic;
+use crate::output::h5::{self, AngleRecord, Identity, PaintResultSet, SparkleRecord, SparkleTable};
+use crate::output::progress::Progress;
+use crate::output::render::multiangle::{flop_png, patches_png, PatchCaption};
+
+use super::{check_output_dir, PipelineError};
+
+/// What a paint run wrote and found.
+#[derive(Debug, Clone)]
+pub struct PaintReport {
+    pub result_path: PathBuf,
+    pub picture_path: PathBuf,
+    pub flop_path: PathBuf,
+    pub colours: Vec<AngleRecord>,
+    pub flop_index: Option<f64>,
+    pub sparkle: Option<SparkleTable>,
+    pub seconds: f64,
+}
+
+/// The files a paint run writes: the result, the patches and the flop
+/// plot.
+pub fn paint_files(scene: &PaintScene) -> [PathBuf; 3] {
+    let (d, n) = (&scene.output.dir, &scene.output.name);
+    [
+        d.join(format!("{n}.h5")),
+        d.join(format!("{n}.png")),
+        d.join(format!("{n}-flop.png")),
+    ]
+}
+
+/// The plan of a paint run, one line per part.
+pub fn paint_plan(scene: &PaintScene) -> Vec<String> {
+    let wl = &scene.wavelengths_nm;
+    let mut lines = vec![format!(
+        "fast model (METHOD §9): {} layer(s) on {}, {} wavelengths {}–{} nm, in parallel",
+        scene.layers.len(),
+        scene.ground.describe(),
+        wl.len(),
+        wl[0],
+        wl[wl.len() - 1]
+    )];
+    for l in &scene.layers {
+        let flakes = match &l.flakes {
+            Some(f) => format!(
+                ", {} flakes {} µm across at volume fraction {}, tilt spread {}°{}",
+                f.reflector.kind(),
+                f.diameter_um,
+                f.volume_fraction,
+                f.orientation_sd_deg,
+                if f.diffraction {
+                    " with the diffraction lobe"
+                } else {
+                    ""
+                }
+            ),
+            None => String::new(),
+        };
+        lines.push(format!(
+            "layer {}: {} µm of {}, {} pigment(s){flakes}",
+            l.name,
+            l.thickness_um,
+            l.lacquer,
+            l.pigments.len()
+        ));
+    }
+    lines.push(format!(
+        "multi-angle colour: {} geometries, {} {}°; sparkle at {} mm under {:?}°",
+        multiangle::geometries().len(),
+        scene.illuminant.name(),
+        scene.observer.degrees(),
+        scene.sparkle.viewing_distance_mm,
+        scene.sparkle.illumination_deg
+    ));
+    lines
+}
+
+/// The model's resolution from the scene's `[paint.model]`.
+fn model_params(scene: &PaintScene) -> ModelParams {
+    let d = ModelParams::default();
+    let m = scene.model;
+    ModelParams {
+        ordinates: OrdinateParams {
+            trapped_nodes: m.trapped_nodes.unwrap_or(d.ordinates.trapped_nodes),
+            escape_nodes: m.escape_nodes.unwrap_or(d.ordinates.escape_nodes),
+        },
+        max_terms: m.max_terms.unwrap_or(d.max_terms),
+        ..d
+    }
+}
+
+fn index(m: &Material, wavelength_nm: f64) -> Result<C64, PipelineError> {
+    m.index_at(wavelength_nm)
+        .ok_or_else(|| PipelineError::Material {
+            material: m.to_string(),
+            wavelength_nm,
+        })
+}
+
+/// The paint's lacquer index at a wavelength: the top layer's real part.
+fn lacquer_index(scene: &PaintScene, wavelength_nm: f64) -> Result<f64, PipelineError> {
+    Ok(index(&scene.layers[0].lacquer, wavelength_nm)?.re)
+}
+
+fn film(f: &FilmSpec, wavelength_nm: f64) -> Result<Film, PipelineError> {
+    Ok(Film {
+        index: index(&f.material, wavelength_nm)?,
+        thickness_nm: f.thickness_nm,
+        thickness_sd_nm: f.thickness_sd_nm,
+    })
+}
+
+/// A flake's optics at a wavelength.
+fn reflector(r: &ReflectorSpec, wavelength_nm: f64) -> Result<Reflector, PipelineError> {
+    Ok(match r {
+        ReflectorSpec::Metal { film: f } => Reflector::Metal(film(f, wavelength_nm)?),
+        ReflectorSpec::Spectrum { reflectance, .. } => {
+            Reflector::Spectrum(reflectance.at(wavelength_nm))
+        }
+        ReflectorSpec::Coated { substrate, coating } => Reflector::Coated {
+            coating: film(coating, wavelength_nm)?,
+            substrate: film(substrate, wavelength_nm)?,
+        },
+    })
+}
+
+/// The flakes' orientation at a wavelength (with the diffraction lobe of a
+/// disc of the mean diameter where asked).
+fn orientation(
+    f: &crate::config::paint::FlakeSpec,
+    wavelength_nm: f64,
+    lacquer: f64,
+) -> Orientation {
+    let sigma = f.orientation_sd_deg.to_radians();
+    if f.diffraction {
+        Orientation::with_diffraction(sigma, f.diameter_um * 1000.0, wavelength_nm, lacquer)
+    } else {
+        Orientation { sigma_rad: sigma }
+    }
+}
+
+/// The model's layers at one wavelength.
+fn layers_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Vec<PaintLayer>, PipelineError> {
+    let n = lacquer_index(scene, wavelength_nm)?;
+    let mut out = Vec::with_capacity(scene.layers.len());
+    for l in &scene.layers {
+        let thickness_nm = l.thickness_um * 1000.0;
+        let species = l
+            .pigments
+            .iter()
+            .map(|p| {
+                let m = index(&p.material, wavelength_nm)?;
+                Ok(BaselineSpecies {
+                    volume_fraction: p.volume_fraction,
+                    diameter_nm: p.diameter_nm,
+                    size: p.size,
+                    eps: vec![m * m],
+                })
+            })
+            .collect::<Result<Vec<_>, PipelineError>>()?;
+        let mut pigments = if species.is_empty() {
+            Medium {
+                mu_a: 0.0,
+                mu_s: 0.0,
+                moments: Vec::new(),
+            }
+        } else {
+            transfer::medium(
+                &BaselineInput {
+                    wavelengths_nm: vec![wavelength_nm],
+                    binder_index: n,
+                    thickness_nm,
+                    paper_albedo: 0.0,
+                    species,
+                    size_quadrature: Default::default(),
+                    equation: Equation::Maxwell,
+                },
+                0,
+            )
+        };
+        // The lacquer's own absorption, 4πk/λ, over the volume it fills.
+        let filled: f64 = l.pigments.iter().map(|p| p.volume_fraction).sum::<f64>()
+            + l.flakes.as_ref().map_or(0.0, |f| f.volume_fraction);
+        let k = index(&l.lacquer, wavelength_nm)?.im;
+        pigments.mu_a += (1.0 - filled) * 4.0 * std::f64::consts::PI * k / wavelength_nm;
+        let flakes = match &l.flakes {
+            None => None,
+            Some(f) => Some(FlakeMedium {
+                area_per_nm: f.area_per_nm(),
+                orientation: orientation(f, wavelength_nm, n),
+                table: reflector(&f.reflector, wavelength_nm)?.table(n, wavelength_nm),
+            }),
+        };
+        out.push(PaintLayer {
+            thickness_nm,
+            pigments,
+            flakes,
+        });
+    }
+    Ok(out)
+}
+
+fn ground_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Ground, PipelineError> {
+    Ok(match &scene.ground {
+        PaintGround::Black => Ground::Black,
+        PaintGround::Lambertian(g) => Ground::Lambertian {
+            albedo: g.at(wavelength_nm),
+        },
+        PaintGround::Metal(m) => Ground::Mirror {
+            index: index(m, wavelength_nm)?,
+        },
+    })
+}
+
+/// The paint's reflection at every wavelength, in parallel, with progress.
+fn solve(
+    scene: &PaintScene,
+    params: &ModelParams,
+    progress: &Progress,
+) -> Result<Vec<PaintReflection>, PipelineError> {
+    let air = multiangle::air_directions();
+    scene
+        .wavelengths_nm
+        .par_iter()
+        .map(|&wl| {
+            let r = model::reflect(
+                lacquer_index(scene, wl)?,
+                &layers_at(scene, wl)?,
+                ground_at(scene, wl)?,
+                wl,
+                &air,
+                params,
+            )?;
+            progress.inc(1, &format!("{wl} nm: {} Fourier terms", r.terms.len()));
+            Ok(r)
+        })
+        .collect()
+}
+
+/// The air polar angles of the escaping nodes, in node order, and the
+/// nodes.
+fn air_nodes(r: &PaintReflection) -> (Vec<f64>, Vec<usize>) {
+    let mut pairs: Vec<(f64, usize)> = r
+        .ords
+        .mu_air
+        .iter()
+        .enumerate()
+        .filter_map(|(i, m)| m.map(|m| (m.clamp(-1.0, 1.0).acos().to_degrees(), i)))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    pairs.into_iter().unzip()
+}
+
+/// The in-plane BRDF (1/sr), mirror reflectance and albedo on the air
+/// directions.
+struct InPlane {
+    directions_deg: Vec<f64>,
+    view_deg: Vec<f64>,
+    brdf: Array3<f64>,
+    mirror: Array2<f64>,
+    albedo: Array2<f64>,
+}
+
+fn in_plane(reflections: &[PaintReflection]) -> Result<InPlane, PipelineError> {
+    let (directions_deg, nodes) = air_nodes(&reflections[0]);
+    // `0 − d`, not `−d`: the normal reads 0, not −0.
+    let mut view_deg: Vec<f64> = directions_deg.iter().rev().map(|&d| 0.0 - d).collect();
+    view_deg.extend(directions_deg.iter().filter(|&&d| d > 0.0));
+    view_deg.dedup();
+    let (nl, nd, nv) = (reflections.len(), directions_deg.len(), view_deg.len());
+    let mut brdf = Array3::zeros((nl, nd, nv));
+    let mut mirror = Array2::zeros((nl, nd));
+    let mut albedo = Array2::zeros((nl, nd));
+    for (l, r) in reflections.iter().enumerate() {
+        for (j, (&inc, &node)) in directions_deg.iter().zip(&nodes).enumerate() {
+            mirror[[l, j]] = r.mirror[node];
+            albedo[[l, j]] = r.albedo(node);
+            for (v, &view) in view_deg.iter().enumerate() {
+                let az = if view < 0.0 { 180.0 } else { 0.0 };
+                brdf[[l, j, v]] = r.factor(inc, view.abs(), az)? / std::f64::consts::PI;
+            }
+        }
+    }
+    Ok(InPlane {
+        directions_deg,
+        view_deg,
+        brdf,
+        mirror,
+        albedo,
+    })
+}
+
+/// The sparkle figures: every flake layer's flakes (their glints add, as
+/// independent Poisson counts), the glint's luminous reflectance weighted
+/// by the glints of each layer.
+fn sparkle_table(
+    scene: &PaintScene,
+    obs: &Observer,
+) -> Result<Option<SparkleTable>, PipelineError> {
+    let wl = &scene.wavelengths_nm;
+    let mid = wl[wl.len() / 2];
+    let n = lacquer_index(scene, mid)?;
+    let sp = &scene.sparkle;
+    let cell = sparkle::cell_area_mm2(sp.viewing_distance_mm, sparkle::ARCMINUTE_RAD);
+    let acceptance = sp.acceptance_deg.to_radians();
+    let flaked: Vec<_> = scene
+        .layers
+        .iter()
+        .filter_map(|l| l.flakes.as_ref().map(|f| (l, f)))
+        .collect();
+    if flaked.is_empty() {
+        return Ok(None);
+    }
+    let mut flakes_per_mm2 = 0.0;
+    let mut rows: Vec<SparkleRecord> = sp
+        .illumination_deg
+        .iter()
+        .map(|&deg| SparkleRecord {
+            illumination_deg: deg,
+            glints_per_mm2: 0.0,
+            glints_per_cell: 0.0,
+            glint_reflectance: 0.0,
+        })
+        .collect();
+    for (l, f) in flaked {
+        let per_mm2 = sparkle::flakes_per_mm2(
+            f.volume_fraction,
+            l.thickness_um,
+            f.mean_square_diameter_um2().sqrt(),
+            f.thickness_nm() / 1000.0,
+        );
+        flakes_per_mm2 += per_mm2;
+        let o = Orientation {
+            sigma_rad: f.orientation_sd_deg.to_radians(),
+        };
+        for row in &mut rows {
+            let s = sparkle::sparkle(per_mm2, &o, n, cell, acceptance, Some(row.illumination_deg));
+            let cos_local = sparkle::half_vector_tilt(row.illumination_deg, n).cos();
+            let spectrum = wl
+                .iter()
+                .map(|&w| {
+                    let ni = lacquer_index(scene, w)?;
+                    Ok(reflector(&f.reflector, w)?.powers(ni, w, cos_local).r)
+                })
+                .collect::<Result<Vec<f64>, PipelineError>>()?;
+            let y = colour::xyz_from_reflectance(obs, wl, &spectrum)
+                .map_err(crate::optics::baseline::BaselineError::from)?[1]
+                / 100.0;
+            row.glint_reflectance += s.glints_per_mm2 * y;
+            row.glints_per_mm2 += s.glints_per_mm2;
+            row.glints_per_cell += s.glints_per_cell;
+        }
+    }
+    for row in &mut rows {
+        if row.glints_per_mm2 > 0.0 {
+            row.glint_reflectance /= row.glints_per_mm2;
+        }
+    }
+    let per_cell = flakes_per_mm2 * cell;
+    Ok(Some(SparkleTable {
+        viewing_distance_mm: sp.viewing_distance_mm,
+        acceptance_deg: sp.acceptance_deg,
+        cell_area_mm2: cell,
+        flakes_per_mm2,
+        graininess: if per_cell > 0.0 {
+            1.0 / per_cell.sqrt()
+        } else {
+            0.0
+        },
+        rows,
+    }))
+}
+
+/// Run an effect paint and write its files; progress lines unless `quiet`.
+pub fn run_paint(scene: &PaintScene, quiet: bool) -> Result<PaintReport, PipelineError> {
+    let start = Instant::now();
+    check_output_dir(&scene.output.dir)?;
+    let [result_path, picture_path, flop_path] = paint_files(scene);
+    let plan = paint_plan(scene);
+    let total = scene.wavelengths_nm.len() as u64;
+    let progress = if quiet {
+        Progress::hidden(total, &scene.output.name)
+    } else {
+        Progress::new(total, &scene.output.name)
+    };
+    for l in &plan {
+        progress.log(l);
+    }
+    let params = model_params(scene);
+    let reflections = solve(scene, &params, &progress)?;
+    progress.finish("every wavelength solved");
+
+    let obs = Observer::standard(scene.illuminant, scene.observer);
+    let geometries = multiangle::geometries();
+    let wl = &scene.wavelengths_nm;
+    let mut factors = Array2::zeros((geometries.len(), wl.len()));
+    for (g, geo) in geometries.iter().enumerate() {
+        let (view, az) = geo.view();
+        for (l, r) in reflections.iter().enumerate() {
+            factors[[g, l]] = r.factor(geo.illumination_deg, view, az)?;
+        }
+    }
+    let rows: Vec<Vec<f64>> = factors.outer_iter().map(|r| r.to_vec()).collect();
+    let angle_colours = multiangle::colours(&obs, wl, &rows)
+        .map_err(crate::optics::baseline::BaselineError::from)?;
+    let flop_index = multiangle::flop_index_of(&angle_colours);
+    let colours: Vec<AngleRecord> = angle_colours
+        .iter()
+        .map(|c| AngleRecord {
+            illumination_deg: c.geometry.illumination_deg,
+            aspecular_deg: c.geometry.aspecular_deg,
+            xyz: c.xyz,
+            lab: c.lab,
+            lch: c.lch,
+        })
+        .collect();
+    let sparkle = sparkle_table(scene, &obs)?;
+    let plane = in_plane(&reflections)?;
+    let terms: Vec<u64> = reflections.iter().map(|r| r.terms.len() as u64).collect();
+
+    let conditions = format!("{}, {}°", scene.illuminant.name(), scene.observer.degrees());
+    let name = &scene.output.name;
+    let flop = flop_png(&colours, name, &conditions, flop_index)?;
+    let paint = format!(
+        "{} layer(s) ({}) on {}",
+        scene.layers.len(),
+        scene
+            .layers
+            .iter()
+            .map(|l| l.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" / "),
+        scene.ground.describe()
+    );
+    let tile = patches_png(
+        &colours,
+        &PatchCaption {
+            name,
+            observer: &obs,
+            conditions: &conditions,
+            paint: &paint,
+            flop_index,
+            sparkle: sparkle.as_ref(),
+        },
+    )?;
+    atomic::write_atomic(&picture_path, &tile)?;
+    atomic::write_atomic(&flop_path, &flop)?;
+    let mut plan_lines = plan;
+    plan_lines.push(format!(
+        "Fourier terms kept per wavelength: {}–{}",
+        terms.iter().min().copied().unwrap_or(0),
+        terms.iter().max().copied().unwrap_or(0)
+    ));
+    let created_unix_s = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let config_path = scene.provenance.path.display().to_string();
+    h5::write_paint(
+        &result_path,
+        &PaintResultSet {
+            identity: Identity {
+                version: crate::VERSION,
+                config_path: &config_path,
+                input_hash: &scene.provenance.input_hash,
+                created_unix_s,
+            },
+            config_text: &scene.provenance.text,
+            plan: &plan_lines.join("\n"),
+            wavelengths_nm: wl,
+            directions_deg: &plane.directions_deg,
+            brdf: &plane.brdf,
+            view_deg: &plane.view_deg,
+            mirror: &plane.mirror,
+            albedo: &plane.albedo,
+            terms: &terms,
+            factors: &factors,
+            colours: &colours,
+            illuminant: scene.illuminant.name(),
+            observer_deg: scene.observer.degrees(),
+            flop_index,
+            sparkle: sparkle.as_ref(),
+            tile_png: &tile,
+            flop_png: &flop,
+        },
+    )?;
+    Ok(PaintReport {
+        result_path,
+        picture_path,
+        flop_path,
+        colours,
+        flop_index,
+        sparkle,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}

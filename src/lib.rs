@@ -6,7 +6,8 @@
 //! [`config`] → [`geometry`] → [`raster`] → [`solver`] → [`optics`] (far
 //! field, substrate, colour, appearance) → [`output`] (atomic writes, HDF5,
 //! pictures, MERL, progress) → [`pipeline`] (one scene) → [`study`] (a sweep
-//! of scenes) → [`view`] (the interactive page of `inksim view`). `tests/layering.rs` checks the rule on the source: no import
+//! of scenes) → [`match`](crate::r#match) (formulation: from a target colour to a
+//! recipe) → [`view`] (the interactive page of `inksim view`). `tests/layering.rs` checks the rule on the source: no import
 //! from a later stage and no import cycle anywhere.
 //!
 //! The physics and numerics are explained in `docs/METHOD.md` (the module
@@ -15,6 +16,7 @@
 
 pub mod config;
 pub mod geometry;
+pub mod r#match;
 pub mod optics;
 pub mod output;
 pub mod pipeline;

@@ -194,11 +194,29 @@ enum Command {
         #[arg(long)]
         mitsuba: bool,
     },
-    /// Validate a scene (or every variant of a study) and print what a run
-    /// would compute, without running it.
+    /// Validate a scene (or every variant of a study, or a match file) and
+    /// print what a run would compute, without running it.
     Check {
-        /// Scene or study file (TOML).
+        /// Scene, study or match file (TOML).
         config: PathBuf,
+    },
+    /// Find recipes for a target colour: the fewest pigments of a palette,
+    /// and their volume fractions, whose colour on the fast forward model
+    /// (the base scene's Kubelka–Munk baseline) matches a CIELAB target or
+    /// a measured reflectance spectrum. See docs/MATCH.md.
+    ///
+    /// Writes <output_dir>/<name>.h5 and <name>-recipes.csv: per recipe the
+    /// composition with standard errors from the target's measurement noise
+    /// (and the ingredients it cannot tell apart), ΔE00 per geometry, and
+    /// for a spectrum target the metamerism index under CIE A, FL11 and
+    /// LED-B3; for an unreachable target the closest reachable colour.
+    Match {
+        /// Match file (TOML with [match], [target], base and [[palette]]),
+        /// e.g. configs/match-red-tint.toml.
+        config: PathBuf,
+        /// Write results here instead of match.output_dir.
+        #[arg(long)]
+        output_dir: Option<PathBuf>,
     },
     /// List the materials a scene may name: the built-in stand-ins and the
     /// library of published optical constants.
@@ -350,9 +368,14 @@ fn real_main() -> Result<ExitCode> {
             host,
             allow_remote,
         } => cli::view::view(&inputs, host, port, allow_remote)?,
+        Command::Match { config, output_dir } => {
+            cli::r#match::run(&cli::ConfigFile::read(&config)?, output_dir)?
+        }
         Command::Check { config } => {
             let config = cli::ConfigFile::read(&config)?;
-            if config.is_study() {
+            if config.is_match() {
+                cli::r#match::check(&config)?;
+            } else if config.is_study() {
                 cli::study::check(&config, memory)?;
             } else {
                 cli::scene::check(&config, memory)?;

@@ -11,11 +11,13 @@
 //! - [`slurm`]: `slurm`, the sbatch job-array script.
 //! - [`materials`]: `materials`, the stand-ins and the material library.
 //! - [`view`]: `view`, the interactive page.
+//! - [`match`](r#match): `match`, from a target colour to a recipe.
 //!
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
 
 pub mod export;
+pub mod r#match;
 pub mod materials;
 pub mod paint;
 pub mod plan;
@@ -134,6 +136,11 @@ impl ConfigFile {
 
     pub fn display(&self) -> std::path::Display<'_> {
         self.path.display()
+    }
+
+    /// Whether it is a match file (has a [match] table).
+    pub fn is_match(&self) -> bool {
+        inksim::r#match::config::is_match_text(&self.text)
     }
 
     /// Whether it is a study (has a [study] table).

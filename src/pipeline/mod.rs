@@ -61,7 +61,7 @@ use crate::output::render;
 use crate::raster::structure;
 use crate::solver;
 
-pub use appearance::{appearance_spec, PROXY_STEP_NM};
+pub use appearance::{appearance_spec, fine_grid, PROXY_STEP_NM};
 pub use baseline::{add_baseline, baseline_input};
 pub use eps::{fraction_eps, species_eps};
 pub use grains::{

@@ -133,17 +133,15 @@ impl LiveModel for RadiativeTransfer {
     }
 
     fn compute(&self, values: &[f64]) -> Result<PageResult, ViewError> {
-        let mut input = self.input.clone();
-        let ns = input.species.len();
-        for (s, v) in input.species.iter_mut().zip(values) {
-            s.volume_fraction = *v;
-        }
-        if let Some(&t) = values.get(ns) {
-            input.thickness_nm = t;
-        }
-        if let Some(&a) = values.get(ns + 1) {
-            input.paper_albedo = a;
-        }
+        let ns = self.input.species.len();
+        let input = self.input.with_recipe(
+            &values[..ns.min(values.len())],
+            values.get(ns).copied().unwrap_or(self.input.thickness_nm),
+            values
+                .get(ns + 1)
+                .copied()
+                .unwrap_or(self.input.paper_albedo),
+        );
         let geometries = Measurement::ALL;
         let colours =
             baseline::baseline_colours(self.model, &input, &geometries, &|_| None, &self.observer)

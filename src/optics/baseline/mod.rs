@@ -144,6 +144,21 @@ pub struct BaselineInput {
     pub equation: Equation,
 }
 
+impl BaselineInput {
+    /// The same layer with other pigment volume fractions (`fractions[s]`
+    /// for species `s`; species beyond `fractions` keep theirs), thickness
+    /// and paper albedo: what a formulation changes.
+    pub fn with_recipe(&self, fractions: &[f64], thickness_nm: f64, paper_albedo: f64) -> Self {
+        let mut input = self.clone();
+        for (s, f) in input.species.iter_mut().zip(fractions) {
+            s.volume_fraction = *f;
+        }
+        input.thickness_nm = thickness_nm;
+        input.paper_albedo = paper_albedo;
+        input
+    }
+}
+
 /// The KM coefficients at one wavelength (1/nm).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KmCoefficients {
@@ -238,12 +253,44 @@ pub fn body_reflectance(input: &BaselineInput) -> Vec<f64> {
 /// reflectance `r` under a binder surface of index `binder_index` that
 /// reflects by `fresnel`: Saunderson's correction with its `r_e` and `r_i`.
 pub fn measured_factor_of(fresnel: Fresnel, m: Measurement, r: f64, binder_index: f64) -> f64 {
-    let r_i = fresnel.internal(binder_index);
-    let r_e = |deg| fresnel.external(binder_index, deg);
-    match m {
-        Measurement::FortyFiveZero => km::saunderson_excluded(r, r_e(45.0), r_i),
-        Measurement::DiffuseEightSce => km::saunderson_excluded(r, r_e(8.0), r_i),
-        Measurement::DiffuseEightSci => km::saunderson(r, r_e(8.0), r_i),
+    Saunderson::of(fresnel, m, binder_index).factor(r)
+}
+
+/// Saunderson's correction of one geometry with its surface reflectances
+/// computed once (`r_i` is a hemisphere integral): for evaluating many body
+/// reflectances, as [`measured_factor_of`] does one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Saunderson {
+    /// `r_e` at the geometry's directed angle (45° for 45°/0°, 8° for d/8°).
+    pub r_e: f64,
+    /// `r_i`, diffuse from inside.
+    pub r_i: f64,
+    /// Whether the geometry sees the specular reflection (d/8° SCI).
+    pub specular: bool,
+}
+
+impl Saunderson {
+    /// The correction of geometry `m` under a binder surface of index
+    /// `binder_index` that reflects by `fresnel`.
+    pub fn of(fresnel: Fresnel, m: Measurement, binder_index: f64) -> Saunderson {
+        let deg = match m {
+            Measurement::FortyFiveZero => 45.0,
+            Measurement::DiffuseEightSce | Measurement::DiffuseEightSci => 8.0,
+        };
+        Saunderson {
+            r_e: fresnel.external(binder_index, deg),
+            r_i: fresnel.internal(binder_index),
+            specular: m == Measurement::DiffuseEightSci,
+        }
+    }
+
+    /// The reflectance factor read from body reflectance `r`.
+    pub fn factor(&self, r: f64) -> f64 {
+        if self.specular {
+            km::saunderson(r, self.r_e, self.r_i)
+        } else {
+            km::saunderson_excluded(r, self.r_e, self.r_i)
+        }
     }
 }
 

@@ -39,10 +39,14 @@ use std::f64::consts::PI;
 
 pub mod conditions;
 pub mod gamut;
+pub mod metamerism;
+pub mod sources;
 mod uncertainty;
 
 pub use conditions::{bradford, illuminant_a, Illuminant, StandardObserver, SRGB_WHITE};
 use conditions::{interpolate, mat_vec, D50_CSV, D65_CSV};
+pub use metamerism::{special_metamerism_index, Metamerism};
+pub use sources::TestSource;
 pub use uncertainty::{delta_e2000_se, lch_se};
 
 /// Wavelength range (nm) a spectrum's samples must lie in.
@@ -179,11 +183,7 @@ impl Observer {
                     .into_iter()
                     .map(|(w, v)| (w, v[0]))
                     .collect();
-                let ill: Vec<(f64, Vec<f64>)> = cmf
-                    .iter()
-                    .map(|(w, _)| (*w, vec![interpolate(&tab, *w)]))
-                    .collect();
-                Observer::from_rows(&cmf, &ill)
+                Observer::under_table(&cmf, &tab)
             }
             Illuminant::A => {
                 let ill: Vec<(f64, Vec<f64>)> = cmf
@@ -208,6 +208,17 @@ impl Observer {
         let cmf = parse_table(cmf_csv, "colour-matching functions", 3)?;
         let ill = parse_table(illuminant_csv, "illuminant", 1)?;
         Observer::from_rows(&cmf, &ill)
+    }
+
+    /// The observer of `cmf` under the illuminant tabulated in `table`
+    /// (`(λ, S)`, increasing λ), put on the CMF grid by linear interpolation
+    /// and held at its end values beyond it.
+    fn under_table(cmf: &[(f64, Vec<f64>)], table: &[(f64, f64)]) -> Result<Observer, ColourError> {
+        let ill: Vec<(f64, Vec<f64>)> = cmf
+            .iter()
+            .map(|(w, _)| (*w, vec![interpolate(table, *w)]))
+            .collect();
+        Observer::from_rows(cmf, &ill)
     }
 
     fn from_rows(

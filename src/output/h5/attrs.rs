@@ -6,18 +6,18 @@ use std::str::FromStr;
 use hdf5::types::VarLenUnicode;
 use hdf5::{H5Type, Location};
 
-pub(super) fn vlu(s: &str) -> hdf5::Result<VarLenUnicode> {
+pub(crate) fn vlu(s: &str) -> hdf5::Result<VarLenUnicode> {
     VarLenUnicode::from_str(s).map_err(|e| hdf5::Error::from(e.to_string()))
 }
 
-pub(super) fn write_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+pub(crate) fn write_str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
     loc.new_attr::<VarLenUnicode>()
         .shape(())
         .create(name)?
         .write_scalar(&vlu(value)?)
 }
 
-pub(super) fn write_scalar_attr<T: H5Type>(
+pub(crate) fn write_scalar_attr<T: H5Type>(
     loc: &Location,
     name: &str,
     value: T,

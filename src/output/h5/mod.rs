@@ -49,6 +49,7 @@ pub use appearance_read::{
     read_appearance, read_baseline, read_measured, read_measured_black, read_optional,
     AppearanceArrays, BaselineRecord, MeasuredRecord,
 };
+pub(crate) use attrs::{vlu, write_scalar_attr, write_str_attr};
 pub use brdf_read::{read_brdf_data, read_measured_spectra, read_tile_png, MeasuredSpectrum};
 pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};

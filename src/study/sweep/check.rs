@@ -147,36 +147,7 @@ impl Checker<'_> {
     /// The base scene as a table, and the path its variants are checked
     /// against.
     fn base(&self, base: Option<Value>) -> Result<(Table, PathBuf), StudyError> {
-        let sweep_dir = self.path.parent().unwrap_or(Path::new("")).to_path_buf();
-        match base {
-            None => Err(self.err(
-                "missing `base`: give `base = \"scene.toml\"` (relative to this file) or an \
-                 inline [base] table holding a complete scene"
-                    .into(),
-            )),
-            Some(Value::String(f)) => {
-                let p = sweep_dir.join(&f);
-                let t = std::fs::read_to_string(&p).map_err(|e| {
-                    self.err(format!(
-                        "key `base`: cannot read scene `{}`: {e}",
-                        p.display()
-                    ))
-                })?;
-                let table: Table = t.parse().map_err(|e: toml::de::Error| {
-                    self.err(format!(
-                        "key `base`: {}: {}",
-                        p.display(),
-                        e.message().trim()
-                    ))
-                })?;
-                Ok((table, p))
-            }
-            Some(Value::Table(t)) => Ok((t, self.path.to_path_buf())),
-            Some(other) => Err(self.err(format!(
-                "key `base`: must be a file name or a table, got a {}",
-                other.type_str()
-            ))),
-        }
+        base_table(self.path, base).map_err(|m| self.err(m))
     }
 
     /// The overrides of a `set`-like table, each key path checked; `what`
@@ -500,4 +471,33 @@ fn axis_index(axes: &[Axis], name: &str) -> Option<usize> {
 
 fn axis_names(axes: &[Axis]) -> String {
     list_or_none(axes.iter().map(|a| &a.name))
+}
+
+/// The base scene of the file `path` as a TOML table (`base = "scene.toml"`,
+/// relative to `path`, or an inline `[base]` table), and the path the scene
+/// is checked against (its own file, or `path` for an inline one). The
+/// message names the key and what is allowed.
+pub fn base_table(path: &Path, base: Option<Value>) -> Result<(Table, PathBuf), String> {
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    match base {
+        None => Err(
+            "missing `base`: give `base = \"scene.toml\"` (relative to this file) or an \
+                     inline [base] table holding a complete scene"
+                .into(),
+        ),
+        Some(Value::String(f)) => {
+            let p = dir.join(&f);
+            let t = std::fs::read_to_string(&p)
+                .map_err(|e| format!("key `base`: cannot read scene `{}`: {e}", p.display()))?;
+            let table: Table = t.parse().map_err(|e: toml::de::Error| {
+                format!("key `base`: {}: {}", p.display(), e.message().trim())
+            })?;
+            Ok((table, p))
+        }
+        Some(Value::Table(t)) => Ok((t, path.to_path_buf())),
+        Some(other) => Err(format!(
+            "key `base`: must be a file name or a table, got a {}",
+            other.type_str()
+        )),
+    }
 }

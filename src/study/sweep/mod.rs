@@ -68,6 +68,7 @@ mod keypath;
 mod raw;
 mod select;
 
+pub use check::base_table;
 pub use keypath::apply_override;
 pub use select::Selection;
 

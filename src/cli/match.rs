@@ -1,0 +1,148 @@
+//! `inksim match`: a match file → ranked recipes (HDF5 + CSV), with
+//! timestamped progress lines; `inksim check` of a match file.
+
+use anyhow::Result;
+use inksim::output::progress::utc_stamp;
+use inksim::r#match::{report, write, MatchReport, MatchSpec};
+use std::path::PathBuf;
+use std::time::SystemTime;
+
+use super::ConfigFile;
+
+/// A progress line with its UTC time.
+fn say(line: &str) {
+    eprintln!("{} [inksim] match: {line}", utc_stamp(SystemTime::now()));
+}
+
+/// The checked match file.
+fn spec(config: &ConfigFile) -> Result<MatchSpec> {
+    Ok(MatchSpec::parse(&config.path, &config.text)?)
+}
+
+/// `inksim check` of a match file: the file, its base scene and palette,
+/// and the fast model built, without searching.
+pub fn check(config: &ConfigFile) -> Result<()> {
+    let spec = spec(config)?;
+    let problem = report::problem(&spec)?;
+    println!(
+        "{}: match file OK: target in {} ({}, {}), {} palette pigment(s), up to {} colourant(s), \
+         {} start(s) per subset, objective {}, tolerance {} ΔE00; fast model {} on {} \
+         wavelengths; results in {}",
+        config.display(),
+        spec.target
+            .geometries()
+            .iter()
+            .map(|m| m.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        spec.target.illuminant.name(),
+        spec.target.observer.name(),
+        spec.palette.len(),
+        spec.search.max_colourants,
+        spec.search.starts,
+        spec.search.objective.name(),
+        spec.search.tolerance_de00,
+        spec.model.name(),
+        problem.model.wavelengths_nm().len(),
+        spec.output_dir.display()
+    );
+    Ok(())
+}
+
+/// `inksim match FILE`.
+pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
+    let mut spec = spec(config)?;
+    if let Some(d) = output_dir {
+        spec.output_dir = d;
+    }
+    say(&format!(
+        "{} ({} palette pigment(s))",
+        config.display(),
+        spec.palette.len()
+    ));
+    let report = inksim::r#match::run(&spec, &say)?;
+    let written = write::write_outputs(&spec, &report, &spec.output_dir)?;
+    print_report(&spec, &report);
+    say(&format!(
+        "{} subset(s) in {:.2} s ({} model evaluations); wrote {} and {}",
+        report.subsets,
+        report.seconds,
+        report.evaluations,
+        written.h5.display(),
+        written.csv.display()
+    ));
+    Ok(())
+}
+
+/// A number with four significant digits or so: fixed between 0.01 and
+/// 10⁵, scientific otherwise.
+fn num(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else if (0.01..1e5).contains(&v.abs()) {
+        format!("{v:.4}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+fn print_report(spec: &MatchSpec, r: &MatchReport) {
+    let conditions = format!(
+        "{}, {}",
+        spec.target.illuminant.name(),
+        spec.target.observer.name()
+    );
+    if r.reached() {
+        println!("within {} ΔE00 ({conditions}):", spec.search.tolerance_de00);
+    } else {
+        println!(
+            "no recipe within {} ΔE00; the closest reachable colour is recipe 1 ({conditions}):",
+            spec.search.tolerance_de00
+        );
+    }
+    for x in &r.recipes {
+        let parts: Vec<String> = x
+            .unknowns
+            .iter()
+            .enumerate()
+            .map(|(k, n)| {
+                let v = x.candidate.x[k];
+                match x.uncertainty.se.as_ref() {
+                    Some(se) => format!("{n} {} ± {}", num(v), num(se[k])),
+                    None => format!("{n} {}", num(v)),
+                }
+            })
+            .collect();
+        let de: Vec<String> = r
+            .target_lab
+            .iter()
+            .zip(&x.candidate.fit.de00)
+            .map(|((m, _), d)| format!("{d:.3} ΔE00 at {}", m.name()))
+            .collect();
+        let mi: Vec<String> = x
+            .metamerism
+            .iter()
+            .map(|(s, m)| format!("{} {:.2}", s.name(), m.index))
+            .collect();
+        println!(
+            "  {}. {}{}: {}{}{}",
+            x.rank,
+            parts.join(", "),
+            if spec.search.thickness_range_nm.is_some() {
+                " (thickness nm)"
+            } else {
+                ""
+            },
+            de.join(", "),
+            if mi.is_empty() {
+                String::new()
+            } else {
+                format!("; metamerism index {}", mi.join(", "))
+            },
+            match x.not_determined() {
+                f if f.is_empty() => String::new(),
+                f => format!("\n     not determined: {}", f.join("; ")),
+            }
+        );
+    }
+}

@@ -1,0 +1,615 @@
+//! The match file: `[match]` (search settings and output), `[target]` (the
+//! colour to match), `base` (the scene whose layer, ground and colour band
+//! the recipe is for) and `[[palette]]` (the pigments it may use, each a
+//! scene pigment table plus its `pvc_range`). Read into raw serde structs
+//! (`deny_unknown_fields`, tagged target, units in key names) and checked
+//! into a [`MatchSpec`]; every error names the file, the key and what is
+//! allowed. The palette is checked as the base scene's pigments, by the
+//! scene checker itself (materials, sizes, shapes), so a palette pigment is
+//! valid exactly when it would be valid in a scene.
+
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use toml::{Table, Value};
+
+use crate::config::{
+    parse_scene, Baseline, ConfigError, Illuminant, Measurement, ReflectanceSpectrum, Scene,
+    StandardObserver, MAX_PVC,
+};
+use crate::study::sweep::base_table;
+
+use super::MatchError;
+
+/// Most pigments a palette may hold.
+pub const MAX_PALETTE: usize = 24;
+/// Most colourants in one recipe.
+pub const MAX_COLOURANTS: usize = 4;
+/// Most starting points per subset.
+pub const MAX_STARTS: usize = 64;
+/// The volume fraction each palette pigment is given while the base scene
+/// is checked (the search sets the real ones).
+const CHECK_PVC: f64 = 0.01;
+/// Default measurement noise of each of L*, a*, b* (1σ), a good
+/// spectrophotometer's repeatability.
+pub const DEFAULT_NOISE_LAB: f64 = 0.05;
+/// The colour grid must reach at least this far into the blue and red, nm.
+const BAND_NM: (f64, f64) = (430.0, 680.0);
+
+/// What the search minimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Objective {
+    /// Root-mean-square difference of the reflectance factors on the grid
+    /// (a spectrum target).
+    SpectralRms,
+    /// CIEDE2000 (root-mean-square over the target's geometries).
+    De00,
+}
+
+impl Objective {
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::SpectralRms => "spectral-rms",
+            Objective::De00 => "de00",
+        }
+    }
+}
+
+/// The colour to match.
+#[derive(Debug, Clone)]
+pub enum TargetColour {
+    /// CIELAB in one or more geometries.
+    Lab(Vec<(Measurement, [f64; 3])>),
+    /// A reflectance-factor spectrum measured in one geometry.
+    Spectrum {
+        geometry: Measurement,
+        spectrum: ReflectanceSpectrum,
+    },
+}
+
+/// The target and the conditions it is stated in.
+#[derive(Debug, Clone)]
+pub struct Target {
+    pub colour: TargetColour,
+    pub illuminant: Illuminant,
+    pub observer: StandardObserver,
+    /// Measurement noise (1σ) of L*, a*, b*.
+    pub noise_lab: [f64; 3],
+}
+
+impl Target {
+    /// The geometries the target is stated in.
+    pub fn geometries(&self) -> Vec<Measurement> {
+        match &self.colour {
+            TargetColour::Lab(c) => c.iter().map(|(m, _)| *m).collect(),
+            TargetColour::Spectrum { geometry, .. } => vec![*geometry],
+        }
+    }
+}
+
+/// One palette pigment: its name and the bounds on its volume fraction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaletteEntry {
+    pub name: String,
+    /// Least and most volume fraction of the layer.
+    pub pvc_range: [f64; 2],
+}
+
+/// The search settings.
+#[derive(Debug, Clone)]
+pub struct Search {
+    pub tolerance_de00: f64,
+    pub max_colourants: usize,
+    pub starts: usize,
+    pub objective: Objective,
+    /// Most total volume fraction of a recipe.
+    pub max_total_pvc: f64,
+    /// Bounds on the thickness when the search may change it.
+    pub thickness_range_nm: Option<[f64; 2]>,
+    /// How many recipes are reported.
+    pub recipes: usize,
+}
+
+/// A checked match file.
+#[derive(Debug, Clone)]
+pub struct MatchSpec {
+    pub path: PathBuf,
+    pub name: String,
+    pub output_dir: PathBuf,
+    pub target: Target,
+    /// The base scene with the palette as its pigments, in palette order.
+    pub scene: Scene,
+    /// The fast model (the base scene's first baseline, default
+    /// `kubelka-munk`).
+    pub model: Baseline,
+    pub palette: Vec<PaletteEntry>,
+    pub search: Search,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMatchFile {
+    #[serde(rename = "match")]
+    settings: RawSettings,
+    target: RawTarget,
+    base: Option<Value>,
+    #[serde(default)]
+    palette: Vec<Table>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSettings {
+    name: Option<String>,
+    output_dir: Option<PathBuf>,
+    tolerance_de00: f64,
+    max_colourants: Option<usize>,
+    starts: Option<usize>,
+    objective: Option<String>,
+    max_total_pvc: Option<f64>,
+    thickness_range_nm: Option<Vec<f64>>,
+    recipes: Option<usize>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+enum RawTarget {
+    Lab {
+        illuminant: String,
+        observer_deg: u32,
+        noise_lab: Option<Vec<f64>>,
+        colour: Vec<RawColour>,
+    },
+    Spectrum {
+        illuminant: String,
+        observer_deg: u32,
+        noise_lab: Option<Vec<f64>>,
+        csv: String,
+        geometry: String,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawColour {
+    geometry: String,
+    lab: Vec<f64>,
+}
+
+/// Whether TOML `text` is a match file (has a `[match]` table).
+pub fn is_match_text(text: &str) -> bool {
+    text.parse::<Table>()
+        .map(|t| t.contains_key("match"))
+        .unwrap_or(false)
+}
+
+/// A [`MatchError::Config`] of `file`, key `key`.
+fn invalid(file: &Path, key: &str, message: impl Into<String>) -> MatchError {
+    MatchError::Config {
+        file: file.to_path_buf(),
+        message: format!("key `{key}`: {}", message.into()),
+    }
+}
+
+impl MatchSpec {
+    /// Read and check the match file `path`.
+    pub fn load(path: &Path) -> Result<MatchSpec, MatchError> {
+        let text = std::fs::read_to_string(path).map_err(|e| MatchError::Config {
+            file: path.to_path_buf(),
+            message: format!("cannot read: {e}"),
+        })?;
+        MatchSpec::parse(path, &text)
+    }
+
+    /// Parse and check match-file `text` read from `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<MatchSpec, MatchError> {
+        let raw: RawMatchFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            MatchError::Config {
+                file: path.to_path_buf(),
+                message: format!(
+                    "{}{} (a match file has [match], [target], base and [[palette]])",
+                    line.map_or(String::new(), |l| format!("line {l}: ")),
+                    e.message().trim()
+                ),
+            }
+        })?;
+        let target = check_target(path, raw.target)?;
+        let (palette, scene) = check_palette(path, raw.base, raw.palette)?;
+        let model = scene
+            .appearance
+            .baseline
+            .first()
+            .copied()
+            .unwrap_or(Baseline::KubelkaMunk);
+        if !matches!(model, Baseline::KubelkaMunk | Baseline::KubelkaMunkScene) {
+            return Err(invalid(
+                path,
+                "base.appearance.baseline",
+                format!(
+                    "the fast model is `kubelka-munk` or `kubelka-munk-scene`, got `{}`",
+                    model.name()
+                ),
+            ));
+        }
+        let search = check_search(path, &raw.settings, &target, &scene, palette.len())?;
+        let name = match raw.settings.name {
+            Some(n) if n.is_empty() || crate::study::sweep::sanitise(&n) != n => {
+                return Err(invalid(
+                    path,
+                    "match.name",
+                    format!("`{n}` must be non-empty and use only A-Z a-z 0-9 _ . -"),
+                ))
+            }
+            Some(n) => n,
+            None => path.file_stem().map_or("match".into(), |s| {
+                crate::study::sweep::sanitise(&s.to_string_lossy())
+            }),
+        };
+        let output_dir = raw
+            .settings
+            .output_dir
+            .unwrap_or_else(|| PathBuf::from("runs").join(&name));
+        Ok(MatchSpec {
+            path: path.to_path_buf(),
+            name,
+            output_dir,
+            target,
+            scene,
+            model,
+            palette,
+            search,
+        })
+    }
+}
+
+/// The 3 numbers of `key`, each checked by `ok` (`what` says the range).
+fn three(
+    file: &Path,
+    key: &str,
+    v: &[f64],
+    ok: impl Fn(usize, f64) -> bool,
+    what: &str,
+) -> Result<[f64; 3], MatchError> {
+    if v.len() != 3 {
+        return Err(invalid(
+            file,
+            key,
+            format!("must be 3 numbers, got {}", v.len()),
+        ));
+    }
+    for (i, &x) in v.iter().enumerate() {
+        if !x.is_finite() || !ok(i, x) {
+            return Err(invalid(file, key, format!("{x} is outside {what}")));
+        }
+    }
+    Ok([v[0], v[1], v[2]])
+}
+
+fn check_target(file: &Path, raw: RawTarget) -> Result<Target, MatchError> {
+    let (illuminant, observer_deg, noise) = match &raw {
+        RawTarget::Lab {
+            illuminant,
+            observer_deg,
+            noise_lab,
+            ..
+        }
+        | RawTarget::Spectrum {
+            illuminant,
+            observer_deg,
+            noise_lab,
+            ..
+        } => (illuminant, *observer_deg, noise_lab),
+    };
+    let illuminant = Illuminant::from_name(illuminant).ok_or_else(|| {
+        invalid(
+            file,
+            "target.illuminant",
+            format!("`{illuminant}` is not one of D50, D65, A"),
+        )
+    })?;
+    let observer = StandardObserver::from_degrees(observer_deg).ok_or_else(|| {
+        invalid(
+            file,
+            "target.observer_deg",
+            format!("{observer_deg} is not 2 or 10"),
+        )
+    })?;
+    let noise_lab = match noise {
+        Some(v) => three(
+            file,
+            "target.noise_lab",
+            v,
+            |_, x| x > 0.0 && x <= 5.0,
+            "(0, 5] (1σ of L*, a*, b*)",
+        )?,
+        None => [DEFAULT_NOISE_LAB; 3],
+    };
+    let geometry = |key: &str, name: &str| {
+        Measurement::from_name(name).ok_or_else(|| {
+            invalid(
+                file,
+                key,
+                format!("`{name}` is not one of 45/0, d/8 SCI, d/8 SCE"),
+            )
+        })
+    };
+    let colour = match raw {
+        RawTarget::Lab { colour, .. } => {
+            if colour.is_empty() {
+                return Err(invalid(
+                    file,
+                    "target.colour",
+                    "give at least one { geometry, lab }",
+                ));
+            }
+            let mut out: Vec<(Measurement, [f64; 3])> = Vec::new();
+            for (i, c) in colour.iter().enumerate() {
+                let m = geometry(&format!("target.colour[{i}].geometry"), &c.geometry)?;
+                if out.iter().any(|(g, _)| *g == m) {
+                    return Err(invalid(
+                        file,
+                        &format!("target.colour[{i}].geometry"),
+                        format!("`{}` is given twice", m.name()),
+                    ));
+                }
+                let lab = three(
+                    file,
+                    &format!("target.colour[{i}].lab"),
+                    &c.lab,
+                    |k, x| {
+                        if k == 0 {
+                            (0.0..=100.0).contains(&x)
+                        } else {
+                            x.abs() <= 200.0
+                        }
+                    },
+                    "L* in [0, 100], a*, b* in [-200, 200]",
+                )?;
+                out.push((m, lab));
+            }
+            TargetColour::Lab(out)
+        }
+        RawTarget::Spectrum {
+            csv, geometry: g, ..
+        } => {
+            let p = file.parent().unwrap_or(Path::new("")).join(&csv);
+            let spectrum = ReflectanceSpectrum::from_csv(&p)
+                .map_err(|e| invalid(file, "target.csv", e.to_string()))?;
+            TargetColour::Spectrum {
+                geometry: geometry("target.geometry", &g)?,
+                spectrum,
+            }
+        }
+    };
+    Ok(Target {
+        colour,
+        illuminant,
+        observer,
+        noise_lab,
+    })
+}
+
+/// The palette's entries, and the base scene with the palette as its
+/// pigments (checked by the scene checker).
+fn check_palette(
+    file: &Path,
+    base: Option<Value>,
+    palette: Vec<Table>,
+) -> Result<(Vec<PaletteEntry>, Scene), MatchError> {
+    let (mut table, scene_path) = base_table(file, base).map_err(|m| MatchError::Config {
+        file: file.to_path_buf(),
+        message: m,
+    })?;
+    if palette.is_empty() || palette.len() > MAX_PALETTE {
+        return Err(invalid(
+            file,
+            "palette",
+            format!(
+                "give 1 to {MAX_PALETTE} [[palette]] pigments, got {}",
+                palette.len()
+            ),
+        ));
+    }
+    if table.contains_key("pigment") || table.contains_key("stack") {
+        return Err(invalid(
+            file,
+            "base",
+            "the base scene must have no [[pigment]] or [[stack]]: the palette gives the pigments",
+        ));
+    }
+    if let Some(Value::Table(layer)) = table.get("layer") {
+        if layer.contains_key("pvc") {
+            return Err(invalid(
+                file,
+                "base.layer.pvc",
+                "remove it: the palette's pvc_range bounds give the PVC",
+            ));
+        }
+    }
+    let mut entries = Vec::with_capacity(palette.len());
+    let mut pigments = Vec::with_capacity(palette.len());
+    for (i, mut p) in palette.into_iter().enumerate() {
+        let key = |k: &str| format!("palette[{i}].{k}");
+        for k in ["pvc", "share"] {
+            if p.contains_key(k) {
+                return Err(invalid(
+                    file,
+                    &key(k),
+                    "not allowed: give pvc_range = [min, max]",
+                ));
+            }
+        }
+        let range = match p.remove("pvc_range") {
+            Some(Value::Array(a)) => a
+                .iter()
+                .map(|v| v.as_float().or(v.as_integer().map(|i| i as f64)))
+                .collect::<Option<Vec<f64>>>(),
+            _ => None,
+        };
+        let range = match range.as_deref() {
+            Some(&[lo, hi]) if (0.0..=hi).contains(&lo) && hi > 0.0 && hi <= MAX_PVC => [lo, hi],
+            _ => {
+                return Err(invalid(
+                    file,
+                    &key("pvc_range"),
+                    format!(
+                    "give [min, max] volume fractions with 0 <= min <= max, 0 < max <= {MAX_PVC}"
+                ),
+                ))
+            }
+        };
+        let name = match p.get("name") {
+            Some(Value::String(s)) => s.clone(),
+            _ => {
+                return Err(invalid(
+                    file,
+                    &key("name"),
+                    "give the pigment's name (a string)",
+                ))
+            }
+        };
+        p.insert("pvc".into(), Value::Float(CHECK_PVC));
+        pigments.push(Value::Table(p));
+        entries.push(PaletteEntry {
+            name,
+            pvc_range: range,
+        });
+    }
+    table.insert("pigment".into(), Value::Array(pigments));
+    let text = toml::to_string(&table).map_err(|e| MatchError::Config {
+        file: file.to_path_buf(),
+        message: format!("base: {e}"),
+    })?;
+    let scene = parse_scene(&scene_path, &text).map_err(|e| MatchError::Config {
+        file: file.to_path_buf(),
+        message: format!(
+            "base scene with the palette as its pigments: {}",
+            scene_message(&e).replace("pigment[", "palette[")
+        ),
+    })?;
+    Ok((entries, scene))
+}
+
+/// What the scene checker says, without its file (the match file is named
+/// already) and without the position in the combined scene text, which is
+/// not the user's file.
+fn scene_message(e: &ConfigError) -> String {
+    match e {
+        ConfigError::Parse { message, .. } => match message.split_once(", column ") {
+            Some((line, rest)) if line.starts_with("line ") => {
+                rest.split_once(": ").map_or(rest, |(_, m)| m).to_string()
+            }
+            _ => message.clone(),
+        },
+        ConfigError::Invalid { key, message, .. } => format!("key `{key}`: {message}"),
+        other => other.to_string(),
+    }
+}
+
+fn check_search(
+    file: &Path,
+    raw: &RawSettings,
+    target: &Target,
+    scene: &Scene,
+    palette: usize,
+) -> Result<Search, MatchError> {
+    let tol = raw.tolerance_de00;
+    if !(tol.is_finite() && tol > 0.0 && tol <= 20.0) {
+        return Err(invalid(
+            file,
+            "match.tolerance_de00",
+            format!("{tol} is outside (0, 20]"),
+        ));
+    }
+    let max_colourants = raw.max_colourants.unwrap_or(3);
+    if !(1..=MAX_COLOURANTS).contains(&max_colourants) {
+        return Err(invalid(
+            file,
+            "match.max_colourants",
+            format!("{max_colourants} is outside [1, {MAX_COLOURANTS}]"),
+        ));
+    }
+    // No subset is larger than the palette.
+    let max_colourants = max_colourants.min(palette);
+    let starts = raw.starts.unwrap_or(4);
+    if !(1..=MAX_STARTS).contains(&starts) {
+        return Err(invalid(
+            file,
+            "match.starts",
+            format!("{starts} is outside [1, {MAX_STARTS}]"),
+        ));
+    }
+    let spectral = matches!(target.colour, TargetColour::Spectrum { .. });
+    let objective = match raw.objective.as_deref() {
+        None if spectral => Objective::SpectralRms,
+        None | Some("de00") => Objective::De00,
+        Some("spectral-rms") if spectral => Objective::SpectralRms,
+        Some("spectral-rms") => {
+            return Err(invalid(
+                file,
+                "match.objective",
+                "`spectral-rms` needs a spectrum target (target.kind = \"spectrum\")",
+            ))
+        }
+        Some(o) => {
+            return Err(invalid(
+                file,
+                "match.objective",
+                format!("`{o}` is not one of spectral-rms, de00"),
+            ))
+        }
+    };
+    let max_total_pvc = raw.max_total_pvc.unwrap_or(MAX_PVC);
+    if !(max_total_pvc > 0.0 && max_total_pvc <= MAX_PVC) {
+        return Err(invalid(
+            file,
+            "match.max_total_pvc",
+            format!("{max_total_pvc} is outside (0, {MAX_PVC}]"),
+        ));
+    }
+    let thickness_range_nm = match raw.thickness_range_nm.as_deref() {
+        None => None,
+        Some(&[lo, hi]) if lo > 0.0 && lo <= hi && hi <= 20000.0 => Some([lo, hi]),
+        Some(_) => {
+            return Err(invalid(
+                file,
+                "match.thickness_range_nm",
+                "give [min, max] in nm with 0 < min <= max <= 20000",
+            ))
+        }
+    };
+    let recipes = raw.recipes.unwrap_or(5);
+    if !(1..=100).contains(&recipes) {
+        return Err(invalid(
+            file,
+            "match.recipes",
+            format!("{recipes} is outside [1, 100]"),
+        ));
+    }
+    let band = (
+        scene.wavelengths_nm.first().copied().unwrap_or(f64::NAN),
+        scene.wavelengths_nm.last().copied().unwrap_or(f64::NAN),
+    );
+    if !(band.0 <= BAND_NM.0 && band.1 >= BAND_NM.1) {
+        return Err(invalid(
+            file,
+            "base.illumination.wavelengths_nm",
+            format!(
+                "the colour grid is the band of these wavelengths, {}–{} nm; it must reach {} nm \
+                 or below and {} nm or above",
+                band.0, band.1, BAND_NM.0, BAND_NM.1
+            ),
+        ));
+    }
+    Ok(Search {
+        tolerance_de00: tol,
+        max_colourants,
+        starts,
+        objective,
+        max_total_pvc,
+        thickness_range_nm,
+        recipes,
+    })
+}

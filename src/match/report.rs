@@ -1,0 +1,184 @@
+//! A match from file to report: the fast model of the base scene with the
+//! palette, the search, and per reported recipe its composition, colour
+//! against the target per geometry, metamerism indices and uncertainty.
+//!
+//! The metamerism indices ([`crate::optics::colour::metamerism`]) compare the
+//! recipe's reflectance factor with the target's spectrum in the target's
+//! geometry, from the target's illuminant to CIE A, FL11 and LED-B3; a
+//! CIELAB target has no spectrum, so they are reported for a spectrum
+//! target only.
+
+use std::time::Instant;
+
+use crate::optics::colour::{special_metamerism_index, Metamerism, TestSource};
+
+/// The test sources of the metamerism indices, in report order.
+pub const TEST_SOURCES: [TestSource; 3] = TestSource::ALL;
+use crate::pipeline::baseline::baseline_input;
+use crate::pipeline::fine_grid;
+
+use super::config::MatchSpec;
+use super::forward::{FastModel, Recipe};
+use super::problem::Problem;
+use super::search::{search, Candidate};
+use super::uncertainty::{uncertainty, Uncertainty};
+use super::MatchError;
+
+/// One reported recipe.
+#[derive(Debug, Clone)]
+pub struct RecipeReport {
+    /// 1 for the best.
+    pub rank: usize,
+    pub candidate: Candidate,
+    pub recipe: Recipe,
+    /// Names of the unknowns: the pigments, then `thickness` when free.
+    pub unknowns: Vec<String>,
+    /// Whether every geometry is within the tolerance.
+    pub reached: bool,
+    pub uncertainty: Uncertainty,
+    /// Per test source (a spectrum target only).
+    pub metamerism: Vec<(TestSource, Metamerism)>,
+    /// Reflectance factor in the target's first geometry, on the grid.
+    pub factor: Vec<f64>,
+}
+
+impl RecipeReport {
+    /// `name: why` for every unknown the target does not determine.
+    pub fn not_determined(&self) -> Vec<String> {
+        self.unknowns
+            .iter()
+            .zip(&self.uncertainty.flags)
+            .filter(|(_, f)| !f.is_empty())
+            .map(|(n, f)| format!("{n}: {f}"))
+            .collect()
+    }
+}
+
+/// The outcome of a match.
+#[derive(Debug, Clone)]
+pub struct MatchReport {
+    pub recipes: Vec<RecipeReport>,
+    /// The model's grid, nm.
+    pub wavelengths_nm: Vec<f64>,
+    /// The target's geometries and CIELAB.
+    pub target_lab: Vec<(crate::config::Measurement, [f64; 3])>,
+    /// A spectrum target on the grid.
+    pub target_factor: Option<Vec<f64>>,
+    /// Palette subsets tried, largest subset size, model evaluations.
+    pub subsets: usize,
+    pub largest: usize,
+    pub evaluations: usize,
+    /// Wall time of the search and the report, s.
+    pub seconds: f64,
+}
+
+impl MatchReport {
+    /// Whether the best recipe reaches the tolerance (else it is the
+    /// closest reachable colour).
+    pub fn reached(&self) -> bool {
+        self.recipes.first().is_some_and(|r| r.reached)
+    }
+}
+
+/// The fast model and the problem of a checked match file.
+pub fn problem(spec: &MatchSpec) -> Result<Problem, MatchError> {
+    let input = baseline_input(&spec.scene)?.ok_or_else(|| MatchError::Config {
+        file: spec.path.clone(),
+        message: "key `base.substrate`: the fast model needs a ground of one albedo (paper, \
+                  white or black)"
+            .into(),
+    })?;
+    if input.wavelengths_nm.len() < fine_grid(&spec.scene.wavelengths_nm).len() {
+        return Err(MatchError::Config {
+            file: spec.path.clone(),
+            message: format!(
+                "key `base.illumination.wavelengths_nm`: a palette material has no data over the \
+                 whole band {}–{} nm; narrow the band to every material's range (`inksim \
+                 materials` lists them)",
+                spec.scene.wavelengths_nm[0],
+                spec.scene.wavelengths_nm[spec.scene.wavelengths_nm.len() - 1]
+            ),
+        });
+    }
+    Problem::new(spec, FastModel::new(spec.model, &input)?)
+}
+
+/// Match the target of `spec`; `progress` hears what is done.
+pub fn run(spec: &MatchSpec, progress: &dyn Fn(&str)) -> Result<MatchReport, MatchError> {
+    let start = Instant::now();
+    let problem = problem(spec)?;
+    progress(&format!(
+        "fast model {} on {} wavelengths, {} palette pigment(s), objective {}",
+        spec.model.name(),
+        problem.model.wavelengths_nm().len(),
+        spec.palette.len(),
+        spec.search.objective.name()
+    ));
+    let s = &spec.search;
+    let outcome = search(
+        &problem,
+        s.max_colourants,
+        s.starts,
+        s.tolerance_de00,
+        progress,
+    );
+    let mut recipes = Vec::new();
+    for (i, c) in outcome.ranked.iter().take(s.recipes).enumerate() {
+        recipes.push(recipe_report(spec, &problem, i + 1, c)?);
+    }
+    Ok(MatchReport {
+        recipes,
+        wavelengths_nm: problem.model.wavelengths_nm().to_vec(),
+        target_lab: problem.target_lab.clone(),
+        target_factor: problem.target_factor.clone(),
+        subsets: outcome.subsets,
+        largest: outcome.largest,
+        evaluations: outcome.evaluations,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The report of one candidate.
+fn recipe_report(
+    spec: &MatchSpec,
+    problem: &Problem,
+    rank: usize,
+    c: &Candidate,
+) -> Result<RecipeReport, MatchError> {
+    let recipe = problem.recipe(&c.subset, &c.x);
+    let mut unknowns: Vec<String> = c
+        .subset
+        .iter()
+        .map(|&s| spec.palette[s].name.clone())
+        .collect();
+    if problem.thickness_range_nm.is_some() {
+        unknowns.push("thickness".into());
+    }
+    let geometry = problem.target_lab[0].0;
+    let factor = problem.model.factor(&recipe, geometry);
+    let metamerism = match &problem.target_factor {
+        Some(t) => {
+            let grid = problem.model.wavelengths_nm();
+            let mut out = Vec::new();
+            for source in TEST_SOURCES {
+                let test = source.observer(spec.target.observer);
+                out.push((
+                    source,
+                    special_metamerism_index(&problem.observer, &test, grid, t, &factor)?,
+                ));
+            }
+            out
+        }
+        None => Vec::new(),
+    };
+    Ok(RecipeReport {
+        rank,
+        uncertainty: uncertainty(problem, &c.subset, &c.x, &unknowns),
+        reached: c.reaches(spec.search.tolerance_de00),
+        candidate: c.clone(),
+        recipe,
+        unknowns,
+        metamerism,
+        factor,
+    })
+}

@@ -1,0 +1,120 @@
+//! A recipe's uncertainty from the target's measurement noise: the target's
+//! L*, a*, b* in each geometry carry independent noise of standard
+//! deviation σ (`target.noise_lab`), and the recipe's unknowns move with
+//! them. To first order the fitted unknowns `x` satisfy
+//! `J δx ≈ δLab` with `J = ∂Lab/∂x` at the recipe (the fast model's
+//! Jacobian, central differences), so their covariance is the Gauss–Markov
+//! `C = (Jᵀ W J)⁻¹`, `W = diag(1/σ²)` — the standard error of each unknown
+//! is `√C_jj`, and the correlation `C_ij/√(C_ii C_jj)`.
+//!
+//! Ingredients the target cannot tell apart are flagged: two unknowns whose
+//! correlation exceeds [`MAX_CORRELATION`] in magnitude (the target fixes
+//! only a combination of them), one whose standard error exceeds
+//! [`MAX_RELATIVE_SE`] of its value, and every unknown when `JᵀWJ` is
+//! singular (more unknowns than the target has numbers, or a pigment that
+//! does not change the colour). The condition number is that of the
+//! correlation matrix (1-norm), free of the unknowns' units. The first-order
+//! propagation ignores the bounds: an unknown at a bound is reported as
+//! such.
+
+use super::problem::Problem;
+use super::solve::{inverse, jacobian, normal_matrix, Bounds};
+
+/// Correlation beyond which two unknowns are not told apart.
+pub const MAX_CORRELATION: f64 = 0.95;
+/// Relative standard error beyond which an unknown is not pinned down.
+pub const MAX_RELATIVE_SE: f64 = 0.5;
+
+/// The uncertainty of one recipe's unknowns.
+#[derive(Debug, Clone)]
+pub struct Uncertainty {
+    /// Standard error of each unknown (volume fractions, then the
+    /// thickness when free, nm); None when `JᵀWJ` is singular.
+    pub se: Option<Vec<f64>>,
+    /// Correlation matrix of the unknowns (row-major), when not singular.
+    pub correlation: Option<Vec<Vec<f64>>>,
+    /// Condition number of the correlation matrix, when not singular.
+    pub condition: Option<f64>,
+    /// Per unknown: why it is not determined (empty when it is).
+    pub flags: Vec<String>,
+}
+
+/// The uncertainty of `subset`'s unknowns `x`; `names` names them.
+pub fn uncertainty(
+    problem: &Problem,
+    subset: &[usize],
+    x: &[f64],
+    names: &[String],
+) -> Uncertainty {
+    let (lo, hi) = problem.bounds(subset);
+    let identity = |_: &mut [f64]| {};
+    let bounds = Bounds {
+        lo: &lo,
+        hi: &hi,
+        project: &identity,
+    };
+    let lab = |y: &[f64]| problem.lab_stack(&problem.recipe(subset, y));
+    let j = jacobian(&lab, x, &bounds);
+    let w: Vec<f64> = (0..j.len())
+        .map(|i| 1.0 / problem.noise_lab[i % 3].powi(2))
+        .collect();
+    let n = x.len();
+    let mut flags = vec![String::new(); n];
+    let at_bound = |k: usize| x[k] <= lo[k] || x[k] >= hi[k];
+    let Some(cov) = inverse(&normal_matrix(&j, &w)) else {
+        let why = if n > j.len() {
+            format!("undetermined: {n} unknowns from {} target numbers", j.len())
+        } else {
+            "undetermined: the colour does not fix the unknowns apart".to_string()
+        };
+        return Uncertainty {
+            se: None,
+            correlation: None,
+            condition: None,
+            flags: vec![why; n],
+        };
+    };
+    let se: Vec<f64> = (0..n).map(|k| cov[(k, k)].max(0.0).sqrt()).collect();
+    let corr: Vec<Vec<f64>> = (0..n)
+        .map(|a| {
+            (0..n)
+                .map(|b| cov[(a, b)] / (se[a] * se[b]).max(f64::MIN_POSITIVE))
+                .collect()
+        })
+        .collect();
+    for a in 0..n {
+        let mut why: Vec<String> = Vec::new();
+        for b in 0..n {
+            if a != b && corr[a][b].abs() > MAX_CORRELATION {
+                why.push(format!(
+                    "not told apart from {} (correlation {:+.3})",
+                    names[b], corr[a][b]
+                ));
+            }
+        }
+        if se[a] > MAX_RELATIVE_SE * x[a].abs() {
+            why.push(format!(
+                "standard error {:.3e} exceeds half its value",
+                se[a]
+            ));
+        }
+        if at_bound(a) {
+            why.push("at a bound (the propagation ignores bounds)".into());
+        }
+        flags[a] = why.join("; ");
+    }
+    let cm = crate::optics::baseline::matrix::Matrix::from_fn(n, |a, b| corr[a][b]);
+    let condition = inverse(&cm).map(|ci| one_norm(&cm, n) * one_norm(&ci, n));
+    Uncertainty {
+        se: Some(se),
+        correlation: Some(corr),
+        condition,
+        flags,
+    }
+}
+
+fn one_norm(m: &crate::optics::baseline::matrix::Matrix, n: usize) -> f64 {
+    (0..n)
+        .map(|c| (0..n).map(|r| m[(r, c)].abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}

@@ -3,8 +3,9 @@
 //! metallic and a pearl paint at three flake loadings; the table of
 //! docs/VALIDATION.md, "Effect paints: fast against full model".
 //!
-//! `cargo run --release --example flake_models [rays]` (default 2 000 000
-//! rays per paint).
+//! `cargo run --release --example flake_models [rays] [diameter_nm]`
+//! (default 2 000 000 rays per paint, flakes 15 µm across; small discs,
+//! e.g. 300 nm, are the fast model's independent scatterers).
 //!
 //! The paints, at 550 nm in a lacquer of index 1.5 under a 30 µm clear
 //! coat, flakes 15 µm across:
@@ -29,7 +30,6 @@ use num_complex::Complex64 as C64;
 
 const LACQUER: f64 = 1.5;
 const WL: f64 = 550.0;
-const DIAMETER: f64 = 15_000.0;
 
 fn clear(h: f64) -> PaintLayer {
     PaintLayer {
@@ -101,6 +101,10 @@ fn main() {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(2_000_000);
+    let diameter: f64 = std::env::args()
+        .nth(2)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(15_000.0);
     let geometries: Vec<Geometry> = ASPECULAR_45_DEG
         .iter()
         .map(|&a| Geometry {
@@ -142,7 +146,7 @@ fn main() {
             let mc = montecarlo::trace(
                 LACQUER,
                 &layers,
-                &[DIAMETER, DIAMETER],
+                &[diameter, diameter],
                 ground,
                 WL,
                 45.0,

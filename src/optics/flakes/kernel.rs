@@ -337,10 +337,21 @@ fn integrate_lobes(
             (0..modes).map(move |m| (m as f64 * phi).cos())
         })
         .collect();
-    // Intervals of μ_o: [0, μ_0] (all to node 0), then between nodes.
-    let mut intervals: Vec<(f64, f64, usize, usize)> = vec![(0.0, ords.mu[0], 0, 0)];
-    for k in 0..n - 1 {
-        intervals.push((ords.mu[k], ords.mu[k + 1], k, k + 1));
+    // Each node's cell of μ_o: consecutive intervals as wide as the nodes'
+    // quadrature weights (from 0 to 1), all of a cell's flux to its node.
+    // The flux a node receives is then its radiance times its own weight,
+    // as the doubling reads it, so that the kernel is reciprocal before it
+    // is symmetrised (hat functions between nodes give each node the
+    // spacing of its neighbours instead, which differs from its weight
+    // where the nodes crowd at the critical angle, and symmetrising that
+    // added spurious flux).
+    let total: f64 = ords.weight.iter().sum();
+    let mut intervals: Vec<(f64, f64, usize, usize)> = Vec::with_capacity(n);
+    let mut lo = 0.0;
+    for k in 0..n {
+        let hi = (lo + ords.weight[k] / total).min(1.0);
+        intervals.push((lo, hi, k, k));
+        lo = hi;
     }
     let mut profile = vec![0.0; azimuths];
     let mut coefficients = vec![0.0; modes];

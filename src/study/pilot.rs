@@ -43,8 +43,6 @@ pub struct Pilot {
     pub applications: f64,
     /// CPU seconds of the pilot (geometry, raster and the solve).
     pub cpu_s: f64,
-    /// The layer's relative real-index contrast.
-    pub contrast: f64,
 }
 
 /// The largest `|Re n_p / n_b − 1|` of the scene's pigments over its
@@ -155,6 +153,5 @@ fn solve_one(v: &Variant) -> Result<Pilot, String> {
         wavelength_nm: scene.wavelengths_nm[0],
         applications: measured / (entries.len() as f64 * waves),
         cpu_s,
-        contrast: contrast(&v.scene),
     })
 }

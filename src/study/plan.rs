@@ -129,9 +129,8 @@ pub struct GroupRate {
     pub assumed: f64,
     /// Its pilot, or why there is none.
     pub pilot: Result<pilot::Pilot, String>,
-    /// Variants in the group, and how many of them are finished.
+    /// Variants in the group.
     pub members: usize,
-    pub finished: usize,
     /// Where `ratio` came from, in words.
     pub source: String,
 }
@@ -270,19 +269,20 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
         let key = (grid_of(&v.scene), v.scene.solver.equation);
         grids.entry(key).or_insert_with(|| time_grid(key.0, key.1));
     }
+    // Each variant's group, found once: None for the ordinary layers.
     let mut members: BTreeMap<String, Vec<&Variant>> = BTreeMap::new();
     for v in variants {
         if let Some(key) = pilot::group(&v.scene) {
             members.entry(key).or_default().push(v);
         }
     }
-    let in_group = |key: &str| -> Vec<Variant> {
-        finished
-            .iter()
-            .filter(|v| pilot::group(&v.scene).as_deref() == Some(key))
-            .cloned()
-            .collect()
-    };
+    let mut done: BTreeMap<Option<String>, Vec<Variant>> = BTreeMap::new();
+    for v in finished {
+        done.entry(pilot::group(&v.scene))
+            .or_default()
+            .push(v.clone());
+    }
+    let measured = |key: Option<String>| done.get(&key).and_then(|f| measured_ratio(f));
     let groups = members
         .iter()
         .map(|(key, m)| {
@@ -290,25 +290,23 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
             let assumed = default_applications(&rep.scene);
             let p = pilot::measure(key, rep);
             let prior = p.as_ref().map_or(1.0, |p| p.applications / assumed);
-            let done = measured_ratio(&in_group(key));
-            let (ratio, source) = blend(prior, done, "the pilot's factor", "group");
+            let (ratio, source) = blend(
+                prior,
+                measured(Some(key.clone())),
+                "the pilot's factor",
+                "group",
+            );
             let rate = GroupRate {
                 ratio,
                 assumed,
                 pilot: p,
                 members: m.len(),
-                finished: done.map_or(0, |d| d.1),
                 source,
             };
             (key.clone(), rate)
         })
         .collect();
-    let ordinary_finished: Vec<Variant> = finished
-        .iter()
-        .filter(|v| pilot::group(&v.scene).is_none())
-        .cloned()
-        .collect();
-    let (ratio, applications_source) = match measured_ratio(&ordinary_finished) {
+    let (ratio, applications_source) = match measured(None) {
         None => (
             1.0,
             "no finished result yet: the measured rates as assumed (docs/PERFORMANCE.md, \

@@ -78,6 +78,21 @@ impl Medium {
     }
 }
 
+/// The phase function of normalised Legendre moments `χ` at `cos Θ = x`:
+/// `p(x) = Σ_l (2l + 1) χ_l P_l(x)`, whose mean over all directions is
+/// `χ_0` (1 for a normalised one).
+pub fn phase_series(chi: &[f64], x: f64) -> f64 {
+    let (mut p0, mut p1) = (1.0, x);
+    let mut s = chi.first().copied().unwrap_or(0.0);
+    for (l, c) in chi.iter().enumerate().skip(1) {
+        s += (2 * l + 1) as f64 * c * p1;
+        let p2 = ((2 * l + 1) as f64 * x * p1 - l as f64 * p0) / (l + 1) as f64;
+        p0 = p1;
+        p1 = p2;
+    }
+    s
+}
+
 /// The phase matrices `(p(μ_i, μ_j), p(μ_i, −μ_j))` on the nodes, with the
 /// diagonal energy correction.
 pub fn phase_matrices(ords: &Ordinates, chi: &[f64]) -> (Matrix, Matrix) {

@@ -22,9 +22,10 @@
 //! (`dω_o = 4 |ω·h| dω_h`, `h` the half vector), the flux scattered per unit
 //! path into `dω_o` is `(a/4) D(h) R_f(|ω·h|) dω_o`, smooth in `ω_o` for a
 //! spread σ > 0. For the incident direction of node `j` (azimuth 0) it is
-//! integrated against each node's hat function in `μ_o` (linear between
-//! neighbouring nodes, so power is kept however narrow the lobe;
-//! Gauss–Legendre on each interval, finer than σ) and against `cos mφ_o`
+//! integrated over each node's cell in `μ_o` (consecutive intervals as wide
+//! as the nodes' quadrature weights, so power is kept however narrow the
+//! lobe and each node receives its radiance times its own weight;
+//! Gauss–Legendre on each cell, finer than σ) and against `cos mφ_o`
 //! (midpoint rule in azimuth, finer than σ). Aligned flakes (σ = 0) reflect
 //! each direction into its mirror image exactly: one node each.
 //! The discrete kernel is then made reciprocal exactly,
@@ -44,7 +45,7 @@
 
 use super::normals::Orientation;
 use super::reflector::LocalTable;
-use crate::optics::baseline::doubling::{phase_matrices, FluxKernel, Medium};
+use crate::optics::baseline::doubling::{phase_matrices, phase_series, FluxKernel, Medium};
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::{gauss_legendre, Ordinates};
 use std::f64::consts::PI;
@@ -135,17 +136,7 @@ pub fn pigment_kernels(ords: &Ordinates, medium: &Medium, modes: usize) -> Vec<F
         .iter()
         .map(|mu| (1.0 - mu * mu).max(0.0).sqrt())
         .collect();
-    let phase = |x: f64| {
-        let (mut p0, mut p1) = (1.0, x);
-        let mut s = chi[0];
-        for (l, c) in chi.iter().enumerate().skip(1) {
-            s += (2 * l + 1) as f64 * c * p1;
-            let p2 = ((2 * l + 1) as f64 * x * p1 - l as f64 * p0) / (l + 1) as f64;
-            p0 = p1;
-            p1 = p2;
-        }
-        s
-    };
+    let phase = |x: f64| phase_series(&chi, x);
     let mut terms_same = vec![Matrix::zeros(n); modes];
     let mut terms_opp = vec![Matrix::zeros(n); modes];
     // The integrand is even in Δφ: the nodes q and steps − q coincide, so
@@ -309,9 +300,9 @@ pub fn flake_kernels(
 /// The spread flakes' kernels by integrating the reflected radiance over
 /// the view directions: per unit path the flux scattered into `dω_o` is
 /// `(a/4) D(h) R_f(|ω·h|) dω_o` (`h` the half vector, `dω_o = 4 |ω·h| dω_h`),
-/// integrated against each node's hat function in `μ_o` (Gauss–Legendre on
-/// every interval between nodes, finer than σ) and against `cos mφ` in
-/// azimuth (midpoint rule on `[0, π]`, finer than σ).
+/// integrated over each node's cell in `μ_o` (Gauss–Legendre on every
+/// cell, finer than σ) and against `cos mφ` in azimuth (midpoint rule on
+/// `[0, π]`, finer than σ).
 fn integrate_lobes(
     ords: &Ordinates,
     flakes: &FlakeMedium,
@@ -341,16 +332,16 @@ fn integrate_lobes(
     // quadrature weights (from 0 to 1), all of a cell's flux to its node.
     // The flux a node receives is then its radiance times its own weight,
     // as the doubling reads it, so that the kernel is reciprocal before it
-    // is symmetrised (hat functions between nodes give each node the
+    // is symmetrised (hat functions between nodes would give each node the
     // spacing of its neighbours instead, which differs from its weight
-    // where the nodes crowd at the critical angle, and symmetrising that
-    // added spurious flux).
+    // where the nodes crowd at the critical angle; symmetrising such a
+    // kernel adds flux).
     let total: f64 = ords.weight.iter().sum();
-    let mut intervals: Vec<(f64, f64, usize, usize)> = Vec::with_capacity(n);
+    let mut cells: Vec<(f64, f64)> = Vec::with_capacity(n);
     let mut lo = 0.0;
-    for k in 0..n {
-        let hi = (lo + ords.weight[k] / total).min(1.0);
-        intervals.push((lo, hi, k, k));
+    for w in &ords.weight {
+        let hi = (lo + w / total).min(1.0);
+        cells.push((lo, hi));
         lo = hi;
     }
     let mut profile = vec![0.0; azimuths];
@@ -358,18 +349,13 @@ fn integrate_lobes(
     for j in 0..n {
         let mu_j = ords.mu[j];
         let wj = [(1.0 - mu_j * mu_j).max(0.0).sqrt(), 0.0, mu_j];
-        for &(lo, hi, k0, k1) in &intervals {
+        for (k, &(lo, hi)) in cells.iter().enumerate() {
             let span = (lo.clamp(0.0, 1.0).acos() - hi.clamp(0.0, 1.0).acos()).abs();
             let points = ((2.0 * span / sigma).ceil() as usize).clamp(3, 24);
             let (x, w) = gauss_legendre(points);
             for (x, w) in x.iter().zip(&w) {
                 let mu_o = lo + 0.5 * (hi - lo) * (x + 1.0);
                 let weight = 0.5 * (hi - lo) * w;
-                let share1 = if k1 == k0 {
-                    0.0
-                } else {
-                    (mu_o - lo) / (hi - lo)
-                };
                 let sin_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
                 for (sign, target) in [(1.0, &mut *same), (-1.0, &mut *opp)] {
                     let mut any = false;
@@ -403,8 +389,7 @@ fn integrate_lobes(
                         }
                     }
                     for (m, c) in coefficients.iter().enumerate() {
-                        target[m][(k0, j)] += weight * (1.0 - share1) * c;
-                        target[m][(k1, j)] += weight * share1 * c;
+                        target[m][(k, j)] += weight * c;
                     }
                 }
             }

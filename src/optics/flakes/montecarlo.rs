@@ -49,6 +49,7 @@
 use super::normals::Orientation;
 use super::paint::{Ground, PaintLayer};
 use super::thin_film;
+use crate::optics::baseline::doubling;
 use crate::optics::baseline::fresnel::fresnel_unpolarised;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -116,6 +117,14 @@ struct Disc {
 /// A disc's name: layer, cell and place in the cell.
 type DiscId = (usize, i64, i64, usize);
 
+/// A batch's scratch, so that the walk along a ray does not allocate: one
+/// cell's discs, and the cells already tested on the current path.
+#[derive(Default)]
+struct Scratch {
+    discs: Vec<Disc>,
+    tested: Vec<(i64, i64)>,
+}
+
 /// The paint as the tracer sees it.
 struct Paint<'a> {
     lacquer: f64,
@@ -140,30 +149,21 @@ struct PhaseTable {
 const PHASE_NODES: usize = 2001;
 
 impl PhaseTable {
-    /// From normalised Legendre moments `χ_l`: `p(x) = Σ (2l+1)/2 χ_l P_l(x)`.
+    /// From normalised Legendre moments `χ_l` (isotropic when there are
+    /// none): the density `p(x)/2` in `x = cos Θ` of
+    /// [`doubling::phase_series`].
     fn new(moments: &[f64]) -> PhaseTable {
+        let chi = if moments.is_empty() {
+            &[1.0][..]
+        } else {
+            moments
+        };
         let x: Vec<f64> = (0..PHASE_NODES)
             .map(|i| -1.0 + 2.0 * i as f64 / (PHASE_NODES - 1) as f64)
             .collect();
         let p: Vec<f64> = x
             .iter()
-            .map(|&x| {
-                let (mut p0, mut p1) = (1.0, x);
-                let mut s = 0.5 * moments.first().copied().unwrap_or(1.0);
-                for (l, c) in moments.iter().enumerate().skip(1) {
-                    let pl = if l == 1 {
-                        p1
-                    } else {
-                        let lf = l as f64;
-                        let next = ((2.0 * lf - 1.0) * x * p1 - (lf - 1.0) * p0) / lf;
-                        p0 = p1;
-                        p1 = next;
-                        next
-                    };
-                    s += 0.5 * (2 * l + 1) as f64 * c * pl;
-                }
-                s.max(0.0)
-            })
+            .map(|&x| (0.5 * doubling::phase_series(chi, x)).max(0.0))
             .collect();
         let mut cdf = vec![0.0; PHASE_NODES];
         for i in 1..PHASE_NODES {
@@ -293,7 +293,7 @@ impl Paint<'_> {
         d: [f64; 3],
         s_max: f64,
         skip: Option<DiscId>,
-        scratch: &mut Vec<Disc>,
+        scratch: &mut Scratch,
     ) -> Option<(f64, DiscId, [f64; 3])> {
         self.layers[k].flakes.as_ref()?;
         let (c, r2) = (self.cell[k], self.radius[k] * self.radius[k]);
@@ -312,7 +312,8 @@ impl Paint<'_> {
         let mut t_next = [next_wall(0, cell[0]), next_wall(1, cell[1])];
         let t_step = [c / d[0].abs(), c / d[1].abs()];
         let mut best: Option<(f64, DiscId, [f64; 3])> = None;
-        let mut tested: Vec<(i64, i64)> = Vec::with_capacity(16);
+        let Scratch { discs, tested } = scratch;
+        tested.clear();
         loop {
             for ox in -1..=1 {
                 for oy in -1..=1 {
@@ -321,8 +322,8 @@ impl Paint<'_> {
                         continue;
                     }
                     tested.push((ix, iy));
-                    self.cell_discs(seed, k, ix, iy, scratch);
-                    for (j, disc) in scratch.iter().enumerate() {
+                    self.cell_discs(seed, k, ix, iy, discs);
+                    for (j, disc) in discs.iter().enumerate() {
                         let id = (k, ix, iy, j);
                         if skip == Some(id) {
                             continue;
@@ -454,7 +455,7 @@ pub fn trace(
                 views: vec![0.0; dirs.len()],
                 ..Tally::default()
             };
-            let mut scratch = Vec::new();
+            let mut scratch = Scratch::default();
             for _ in 0..per_batch {
                 paint.ray(
                     field,
@@ -505,7 +506,7 @@ impl Paint<'_> {
         views: &[[f64; 3]],
         cos_cone: f64,
         rng: &mut impl Rng,
-        scratch: &mut Vec<Disc>,
+        scratch: &mut Scratch,
         t: &mut Tally,
     ) {
         let n = self.lacquer;

@@ -188,7 +188,9 @@ pub fn heartbeat_interval() -> std::time::Duration {
 /// residual: while `|ΣR + ΣT + A − 1|` exceeds [`ENERGY_BALANCE_LIMIT`] it is
 /// solved again to a tenth of the tolerance (down to 1e-10, or 1e-6 with
 /// f32 storage), saying so in the log (`label` names the solve) and in the
-/// record, whose cost includes the attempts it replaced.
+/// record, whose cost includes the attempts it replaced. Where the tighter
+/// solve fails, the answer at the looser tolerance is kept and the log and
+/// the note say so.
 fn solve_balanced(
     p: &Problem,
     method: Method,
@@ -198,11 +200,36 @@ fn solve_balanced(
     label: &str,
 ) -> Result<(Efficiencies, SolveRecord), solver::SolveError> {
     // Attempts a tighter solve replaced, and why.
-    let (mut replaced, mut again) = (Vec::new(), String::new());
+    let (mut replaced, mut again) = (Vec::<(Efficiencies, SolveRecord)>::new(), String::new());
     let (efficiencies, mut record) = loop {
-        let sol = heartbeat::scope(heartbeat_interval(), beat, || {
+        let solved = heartbeat::scope(heartbeat_interval(), beat, || {
             solver::solve(p, method, &ctl)
-        })?;
+        });
+        let sol = match (solved, replaced.pop()) {
+            (Ok(sol), previous) => {
+                replaced.extend(previous);
+                sol
+            }
+            (Err(e), None) => return Err(e),
+            // A tighter solve that fails keeps the answer at the looser
+            // tolerance, which met its own residual: said in the log and
+            // the note, its energy balance recorded as it is.
+            (Err(e), Some((eff, mut previous))) => {
+                progress.log(&format!(
+                    "[inksim] {label}: the solve to {:.0e} failed ({e}); keeping the answer at \
+                     {:.0e} (energy balance {:.1e})",
+                    ctl.tolerance,
+                    ctl.tolerance * 10.0,
+                    eff.energy_balance
+                ));
+                again.push_str(&format!(
+                    "; the solve to {:.0e} failed ({e}), this answer kept",
+                    ctl.tolerance
+                ));
+                previous.operator_applications += e.applications();
+                break (eff, previous);
+            }
+        };
         let eff = farfield::efficiencies(&sol);
         let tighter = ctl.tolerance / 10.0;
         if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
@@ -220,9 +247,9 @@ fn solve_balanced(
             eff.energy_balance, ctl.tolerance
         ));
         ctl.tolerance = tighter;
-        replaced.push(sol.record);
+        replaced.push((eff, sol.record));
     };
-    for r in &replaced {
+    for (_, r) in &replaced {
         record.add(r);
     }
     record.note.push_str(&again);

@@ -116,8 +116,36 @@ pub enum SolveError {
         residual: f64,
         tolerance: f64,
     },
+    #[error("{method} stalled: residual {residual:.3e} not halved in {window} iterations (after {iterations})")]
+    Stalled {
+        method: Method,
+        iterations: usize,
+        residual: f64,
+        window: usize,
+    },
     #[error("invalid problem: {0}")]
     Invalid(String),
+}
+
+impl SolveError {
+    /// Operator applications a failed solve spent (its iterations × its
+    /// method's applications per iteration); none for an invalid problem.
+    pub fn applications(&self) -> usize {
+        match *self {
+            SolveError::Diverged {
+                method, iterations, ..
+            }
+            | SolveError::NotConverged {
+                method, iterations, ..
+            }
+            | SolveError::Stalled {
+                method, iterations, ..
+            } => {
+                (iterations as f64 * method.solver().applications_per_iteration()).round() as usize
+            }
+            SolveError::Invalid(_) => 0,
+        }
+    }
 }
 
 /// One diffraction problem: a permittivity grid, a wavelength, an incidence.

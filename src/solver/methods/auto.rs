@@ -1,7 +1,10 @@
 //! `auto`: Born where its contraction estimate says it converges, then
 //! BiCGStab, then time-marching (always convergent) as the last resort, on
-//! one system and one field. Each choice and failure is written into the
-//! note, and the record names the method that produced the answer.
+//! one system and one field. On the mean background BiCGStab runs without a
+//! preconditioner; where it stalls (high-contrast grains) it runs again on
+//! the binder background with the CBS preconditioner before the march.
+//! Each choice and failure is written into the note, and the record names
+//! the method that produced the answer.
 
 use super::{born, Outcome, Solver, Validity};
 use crate::config::{Background, Method, Precision};
@@ -35,7 +38,11 @@ impl Solver for Auto {
         ctl: &Controls,
     ) -> Result<Outcome, SolveError> {
         let born = Method::Born.solver();
-        let mut chain = vec![Method::BiCgStab.solver(), Method::TimeMarching.solver()];
+        // Each method with the background it switches to first (None: as built).
+        let mut chain = vec![
+            (Method::BiCgStab.solver(), None),
+            (Method::TimeMarching.solver(), None),
+        ];
         let mut notes = vec![];
         let mut spent = born::ESTIMATE_STEPS;
         if sys.background() == Background::Mean {
@@ -44,6 +51,7 @@ impl Solver for Auto {
             notes.push("skipped Born: Krylov on the mean background".to_string());
             sys.release_binder();
             spent = 0;
+            chain.insert(1, (Method::BiCgStab.solver(), Some(Background::Binder)));
         } else {
             match born.validity(sys, scr, u.precision()) {
                 Validity::Unlikely(why) => {
@@ -52,15 +60,23 @@ impl Solver for Auto {
                 }
                 Validity::Likely(why) => {
                     notes.push(format!("chose Born: {why}"));
-                    chain.insert(0, born);
+                    chain.insert(0, (born, None));
                 }
                 Validity::Always => {
-                    chain.insert(0, born);
+                    chain.insert(0, (born, None));
                 }
             }
         }
         let mut last_err = None;
-        for m in chain {
+        for (m, background) in chain {
+            if let Some(bg) = background {
+                sys.use_background(bg);
+                notes.push(format!(
+                    "{} again, {}",
+                    m.method(),
+                    sys.describe_background()
+                ));
+            }
             sys.set_start_field(u);
             match m.run(sys, scr, u, ctl) {
                 Ok(mut o) => {
@@ -70,6 +86,7 @@ impl Solver for Auto {
                     return Ok(o);
                 }
                 Err(e) => {
+                    spent += e.applications();
                     notes.push(format!("{e}; falling back"));
                     last_err = Some(e);
                 }

@@ -77,7 +77,7 @@ impl BiCgStab {
         let (mut r, mut rh, mut p, mut v, mut s, mut t) = (z(), z(), z(), z(), z(), z());
         let mut iterations = 0;
         let mut applications = 0;
-        let mut monitor = Monitor::new(Method::BiCgStab);
+        let mut monitor = Monitor::krylov(Method::BiCgStab);
         let one = C64::new(1.0, 0.0);
         loop {
             applications += 1;
@@ -141,7 +141,7 @@ impl BiCgStab {
                 let rn = norm_sqr(&r).sqrt();
                 // The true residual scales with the preconditioned one
                 // from the restart, where `target` is half of tolerance's.
-                monitor.tick(iterations, 0.5 * ctl.tolerance * rn / target);
+                monitor.tick(iterations, 0.5 * ctl.tolerance * rn / target)?;
                 if !rn.is_finite() || rn <= target || omega.norm() == 0.0 {
                     break;
                 }

@@ -62,7 +62,7 @@ impl Gmres {
         let mut g = vec![C64::new(0.0, 0.0); m + 1];
         let mut inner = 0;
         let mut applications = 0;
-        let mut monitor = Monitor::new(Method::Gmres);
+        let mut monitor = Monitor::krylov(Method::Gmres);
         loop {
             applications += 1;
             let (beta, target) = match restart(sys, scr, u, &mut r, &mut monitor, inner, ctl)? {
@@ -124,7 +124,7 @@ impl Gmres {
                 k_used = k + 1;
                 // The true residual estimated as in the restart (`target`
                 // is half of the tolerance's preconditioned norm).
-                monitor.tick(inner, 0.5 * ctl.tolerance * g[k + 1].norm() / target);
+                monitor.tick(inner, 0.5 * ctl.tolerance * g[k + 1].norm() / target)?;
                 if g[k + 1].norm() <= target || hn == 0.0 || inner >= ctl.max_iterations {
                     break;
                 }

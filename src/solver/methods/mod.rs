@@ -19,7 +19,7 @@ pub mod gmres;
 pub mod marching;
 mod monitor;
 
-pub use monitor::{restart, Monitor, Restart};
+pub use monitor::{restart, Monitor, Restart, STALL_ITERATIONS};
 
 /// [`Solver::run`] for a method whose inherent `iterate::<S>` does the
 /// work on fields stored as `S`: unwraps the [`Field`] into its storage.

@@ -114,6 +114,7 @@ fn main() {
             Ok(o) => {
                 let record = solver::SolveRecord {
                     method: o.method,
+                    background: sys.background(),
                     iterations: o.iterations,
                     operator_applications: o.applications,
                     residual: o.residual,

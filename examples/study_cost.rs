@@ -242,6 +242,7 @@ fn child(layer: &str, name: &str) {
                 .unwrap_or_else(|e| panic!("{layer} {name} {lambda} nm {polar}°: {e}"));
             let record = SolveRecord {
                 method: o.method,
+                background: sys.background(),
                 iterations: o.iterations,
                 operator_applications: o.applications,
                 residual: o.residual,

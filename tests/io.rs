@@ -54,6 +54,7 @@ fn entries() -> Vec<SolveEntry> {
             },
             record: SolveRecord {
                 method: Method::Born,
+                background: inksim::config::Background::Binder,
                 iterations: 17,
                 operator_applications: 18,
                 residual: 3.2e-9,
@@ -84,6 +85,7 @@ fn entries() -> Vec<SolveEntry> {
             },
             record: SolveRecord {
                 method: Method::TimeMarching,
+                background: inksim::config::Background::Binder,
                 iterations: 1234,
                 operator_applications: 2469,
                 residual: 9.9e-7,
@@ -114,6 +116,7 @@ fn entries() -> Vec<SolveEntry> {
             },
             record: SolveRecord {
                 method: Method::TimeMarching,
+                background: inksim::config::Background::Binder,
                 iterations: 0,
                 operator_applications: 0,
                 residual: f64::MIN_POSITIVE,

@@ -82,6 +82,7 @@ fn entry(wl: f64, polar: f64, orders: Vec<Order>) -> SolveEntry {
         },
         record: SolveRecord {
             method: Method::Born,
+            background: inksim::config::Background::Binder,
             iterations: 3,
             operator_applications: 4,
             residual: 1e-8,

@@ -190,7 +190,8 @@ pub fn heartbeat_interval() -> std::time::Duration {
 /// f32 storage), saying so in the log (`label` names the solve) and in the
 /// record, whose cost includes the attempts it replaced. Where the tighter
 /// solve fails, the answer at the looser tolerance is kept and the log and
-/// the note say so.
+/// the note say so. A solve `auto` finished on another background than the
+/// one asked for is solved again on the background that answered.
 fn solve_balanced(
     p: &Problem,
     method: Method,
@@ -247,6 +248,12 @@ fn solve_balanced(
             eff.energy_balance, ctl.tolerance
         ));
         ctl.tolerance = tighter;
+        if method == Method::Auto && sol.record.background != ctl.background {
+            // Where `auto` had to leave the mean background (a stall), the
+            // tighter solve starts on the background that answered: the
+            // same problem would stall the same way again.
+            ctl.background = sol.record.background;
+        }
         replaced.push((eff, sol.record));
     };
     for (_, r) in &replaced {

@@ -80,6 +80,9 @@ pub use system::{Scratch, ShiftParams, System, MEAN_LOSS_FLOOR, SHIFT_MARGIN};
 #[derive(Debug, Clone)]
 pub struct SolveRecord {
     pub method: Method,
+    /// The background the answering method ran on (`auto` may have moved
+    /// from the mean to the CBS-preconditioned binder background).
+    pub background: Background,
     pub iterations: usize,
     /// Number of applications of a background Green's operator.
     pub operator_applications: usize,

@@ -6,7 +6,7 @@
 //! effective-medium shortcut; scenes cannot ask for it.
 
 use super::{Solver, Validity};
-use crate::config::{Method, Precision};
+use crate::config::{Background, Method, Precision};
 use crate::solver::airy::{self, SlabField};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
@@ -137,6 +137,7 @@ impl Solver for Airy {
             absorption,
             record: SolveRecord {
                 method: Method::Airy,
+                background: Background::DEFAULT,
                 iterations: 0,
                 operator_applications: 0,
                 residual: 0.0,

@@ -135,6 +135,7 @@ pub trait Solver: Sync {
         }
         let record = SolveRecord {
             method: out.method,
+            background: sys.background(),
             iterations: out.iterations,
             operator_applications: out.applications,
             residual: out.residual,

@@ -11,7 +11,7 @@ use ndarray::Array3;
 /// Iterations a Krylov method may run without halving its best residual
 /// before it is declared stalled. Unpreconditioned on the mean background,
 /// BiCGStab and GMRES plateau for good on high-contrast layers (rutile in
-/// binder: BiCGStab at 0.11 from iteration ~100 to the 5000th), while the
+/// binder: BiCGStab at 0.11 from iteration ~170 to the 5000th), while the
 /// same methods with the CBS preconditioner halve theirs every ~120
 /// iterations on the same layer (docs/PERFORMANCE.md, "High contrast").
 pub const STALL_ITERATIONS: usize = 500;

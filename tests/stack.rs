@@ -61,6 +61,23 @@ fn on(a: (f64, f64, f64), b: (f64, f64, f64)) -> (f64, f64, f64) {
 
 #[test]
 fn two_dissolved_layers_equal_the_incoherent_closed_form() {
+    dissolved_layers_against_the_closed_form("helmholtz");
+}
+
+/// Beside Maxwell every flux of the chain is natural light's: the mean of
+/// the s and p powers of each surface and each slab. The surfaces' p
+/// reflectance is lower, so more light reaches the paper than in s.
+#[test]
+fn two_dissolved_layers_in_maxwell_equal_natural_lights_closed_form() {
+    let vector = dissolved_layers_against_the_closed_form("maxwell");
+    let scalar = dissolved_layers_against_the_closed_form("helmholtz");
+    for (v, s) in vector.iter().zip(&scalar) {
+        assert!(v > &(s * 1.005), "45°/0°: Maxwell {v} vs Helmholtz {s}");
+    }
+}
+
+/// Returns the 45°/0° reflectance factor at each wavelength.
+fn dissolved_layers_against_the_closed_form(equation: &str) -> Vec<f64> {
     // Each layer is a homogeneous slab (Airy inside the binder); between
     // them and at the binder's two flat surfaces only fluxes pass, so every
     // direction is a one-dimensional incoherent chain, and the paper in air
@@ -72,7 +89,8 @@ fn two_dissolved_layers_equal_the_incoherent_closed_form() {
         layer(PigmentToml::builtin("yellow").pvc(0.2).molecular(), h1),
         layer(PigmentToml::builtin("blue").pvc(0.1).molecular(), h2),
     ];
-    let scene = stack(dir.path(), &layers, "incoherent", "dissolved");
+    let scene = stack(dir.path(), &layers, "incoherent", "dissolved").equation(equation);
+    let maxwell = equation == "maxwell";
     let report = scene.run(dir.path());
     let path = &report.result_path;
 
@@ -89,15 +107,29 @@ fn two_dissolved_layers_equal_the_incoherent_closed_form() {
         (m * m * pvc + (1.0 - pvc) * n * n) / (n * n)
     };
     let albedo = 0.9;
+    let mut forty_five = Vec::new();
     for (l, &w) in wl.iter().enumerate() {
         // (R↓, R↑, T) of every escaping direction, in air.
         let chain = |k: usize| {
             let (tb, ta) = (binder_deg[k].to_radians(), air_deg[k].to_radians());
             let rs = ((n * tb.cos() - ta.cos()) / (n * tb.cos() + ta.cos())).powi(2);
-            let surface = (rs, rs, 1.0 - rs);
+            let rp = ((tb.cos() - n * ta.cos()) / (tb.cos() + n * ta.cos())).powi(2);
+            let rf = if maxwell { (rs + rp) / 2.0 } else { rs };
+            let surface = (rf, rf, 1.0 - rf);
             let slab = |e, h| {
-                let s = airy::slab(e, h, w / n, binder_deg[k]);
-                (s.r.norm_sqr(), s.r.norm_sqr(), s.t.norm_sqr())
+                let k0 = 2.0 * std::f64::consts::PI * n / w;
+                let kx = k0 * binder_deg[k].to_radians().sin();
+                let pol = |p| airy::SlabField::polarised(e, h, k0, kx, p).response;
+                let (s, p) = (pol(false), pol(true));
+                let (r, t) = if maxwell {
+                    (
+                        (s.r.norm_sqr() + p.r.norm_sqr()) / 2.0,
+                        (s.t.norm_sqr() + p.t.norm_sqr()) / 2.0,
+                    )
+                } else {
+                    (s.r.norm_sqr(), s.t.norm_sqr())
+                };
+                (r, r, t)
             };
             let l1 = slab(eps("yellow", 0.2, w), h1);
             let l2 = slab(eps("blue", 0.1, w), h2);
@@ -131,6 +163,9 @@ fn two_dissolved_layers_equal_the_incoherent_closed_form() {
                 (got - e).abs() < 1e-12 * e.max(1e-3),
                 "{slug} at {w} nm: {got} vs closed form {e}"
             );
+            if slug == "45_0" {
+                forty_five.push(got);
+            }
         }
         // The tile's diffuse BRDF: the mirror reflection left out, only the
         // paper's light, π f = ρ T(θi) T(θo) / (1 − ρ R_d), in every cell.
@@ -150,10 +185,21 @@ fn two_dissolved_layers_equal_the_incoherent_closed_form() {
             }
         }
     }
+    forty_five
 }
 
 #[test]
 fn a_stack_that_absorbs_nothing_conserves_energy() {
+    lossless_stack_conserves_energy("helmholtz");
+}
+
+/// The same in Maxwell: natural light's layer fluxes and surfaces.
+#[test]
+fn a_stack_in_maxwell_that_absorbs_nothing_conserves_energy() {
+    lossless_stack_conserves_energy("maxwell");
+}
+
+fn lossless_stack_conserves_energy(equation: &str) {
     // Grains of a real index in a real binder: every solve conserves power,
     // and so must the flux matrices and their adding, in every direction.
     let dir = tempfile::tempdir().unwrap();
@@ -171,7 +217,9 @@ fn a_stack_that_absorbs_nothing_conserves_energy() {
             200.0,
         ),
     ];
-    let scene = stack(dir.path(), &layers, "incoherent", "lossless").no_substrate();
+    let scene = stack(dir.path(), &layers, "incoherent", "lossless")
+        .no_substrate()
+        .equation(equation);
     let report = scene.run(dir.path());
     let r = read(&report.result_path, "stack/reflectance");
     let t = read(&report.result_path, "stack/transmittance");
@@ -264,6 +312,13 @@ fn bad_stacks_are_refused_naming_the_key() {
             stack(dir.path(), &[red(300.0)], "incoherent", "d").outputs(&["tile", "brdf"]),
             "appearance.outputs",
             "not the BRDF at every azimuth",
+        ),
+        (
+            stack(dir.path(), &[red(300.0)], "incoherent", "m")
+                .equation("maxwell")
+                .set("illumination.polarisation", "s"),
+            "illumination.polarisation",
+            "natural light's fluxes",
         ),
         (
             stack(dir.path(), &[red(300.0).coverage(0.0)], "incoherent", "f"),

@@ -577,7 +577,7 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
         "stack: {} layer{} from the top ({}), coupled incoherently: each solved on its own \
          inside the binder (n = {}: at λ/n with ε/n²), from above and from below at {} \
          directions ({} trapped by the surface, {} escaping; binder polar angles {}), combined \
-         by adding under the flat binder surface on {}",
+         by adding under the flat binder surface ({}) on {}",
         st.layers.len(),
         if st.layers.len() == 1 { "" } else { "s" },
         st.layers
@@ -607,6 +607,12 @@ pub fn stack_plan(scene: &Scene) -> RunPlan {
             .map(|d| format!("{d:.1}"))
             .collect::<Vec<_>>()
             .join(", "),
+        match scene.solver.equation {
+            crate::config::Equation::Helmholtz => "s-like Fresnel reflectance, as Helmholtz's",
+            crate::config::Equation::Maxwell =>
+                "natural light's Fresnel reflectance; Maxwell's layers combined as natural \
+                 light's fluxes",
+        },
         match scene.substrate.ground().and_then(|g| g.constant()) {
             Some(albedo) => format!("a ground of albedo {albedo} in air"),
             None => "air".to_string(),

@@ -12,6 +12,7 @@ use ndarray::{Array1, Array2, Array3};
 
 use crate::config::Scene;
 use crate::optics::appearance::{self, MeasuredColour, TileSpectra};
+use crate::optics::baseline::fresnel::Fresnel;
 use crate::optics::colour::Observer;
 use crate::optics::farfield::Side;
 use crate::optics::stack::{self, Below, BinQuadrature, Views};
@@ -173,6 +174,7 @@ fn combine(
         viewing_deg: viewing,
         illumination_deg: tile.then_some(&illumination[..]),
         above_deg: &above,
+        surfaces: Fresnel::of(scene.solver.equation),
     };
     let (coverage, yn) = halftone_of(scene);
     let rr = plan.realisations;

@@ -2,13 +2,15 @@
 //! homogeneous slab (the volume-averaged ε, in closed form inside the
 //! binder), stacked and printed the same way, on the fine colour grid. It
 //! carries the pigments' absorption bands between the solved wavelengths
-//! (`optics::appearance::SpectralProxy` for one layer).
+//! (`optics::appearance::SpectralProxy` for one layer). Beside Maxwell the
+//! slabs and surfaces are natural light's (the mean of s and p powers).
 
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
 use crate::config::Scene;
 use crate::optics::baseline::adding::Slab;
+use crate::optics::baseline::fresnel::Fresnel;
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::stack::{self, Below, LayerSlab, Views};
@@ -74,9 +76,20 @@ pub(super) fn proxy_factors(
             let eps_rel: C64 = eps / (nb * nb);
             let (mut r, mut t) = (vec![0.0; nodes.len()], vec![0.0; nodes.len()]);
             for (j, &deg) in nodes.iter().enumerate() {
-                let s = airy::slab(eps_rel, ls.layer.thickness_nm, w / nb, deg);
-                r[j] = s.r.norm_sqr();
-                t[j] = s.t.norm_sqr();
+                // Natural light's powers beside Maxwell: the mean of s and p.
+                let k0 = 2.0 * std::f64::consts::PI * nb / w;
+                let kx = k0 * deg.to_radians().sin();
+                let powers = |p: bool| {
+                    let s = airy::SlabField::polarised(eps_rel, ls.layer.thickness_nm, k0, kx, p);
+                    [s.response.r.norm_sqr(), s.response.t.norm_sqr()]
+                };
+                [r[j], t[j]] = match views.surfaces {
+                    Fresnel::Scalar => powers(false),
+                    Fresnel::Unpolarised => {
+                        let ([rs, ts], [rp, tp]) = (powers(false), powers(true));
+                        [(rs + rp) / 2.0, (ts + tp) / 2.0]
+                    }
+                };
             }
             let slab = Slab::symmetric(Matrix::diagonal(&r), Matrix::diagonal(&t));
             slabs.push(LayerSlab {

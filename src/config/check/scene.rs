@@ -139,11 +139,16 @@ impl Checker<'_> {
         if solver.equation == crate::config::Equation::Maxwell {
             // What does not honour both polarisations yet is refused rather
             // than mixed silently into a Maxwell result.
-            if stack.is_some() {
+            // Layers solved one by one couple by natural light's fluxes.
+            let incoherent = stack
+                .as_ref()
+                .is_some_and(|s| s.coupling == crate::config::StackCoupling::Incoherent);
+            if incoherent && solver.polarisation != crate::config::Polarisation::Unpolarised {
                 return Err(self.invalid(
-                    "solver.equation",
-                    "\"maxwell\" is not available for [[stack]] scenes yet: their flat \
-                     surfaces and coupling are scalar (s-like); use \"helmholtz\"",
+                    "illumination.polarisation",
+                    "a [[stack]] solved layer by layer combines natural light's fluxes \
+                     between its layers: \"unpolarised\" only (or stacking.coupling = \
+                     \"coherent\")",
                 ));
             }
             // The baselines are computed for natural light (Mie grains,

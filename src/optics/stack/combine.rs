@@ -2,8 +2,11 @@
 //! top surface, each layer's [`LayerSlab`] from the top down (incoherently:
 //! one layer's fragment is uncorrelated with the next's, so fluxes add),
 //! the binder's flat lower surface, and under it the paper in air (the wave
-//! scene's boundary) or nothing. The flat surfaces are the scalar (s-like)
-//! ones: a stack is solved with the Helmholtz equation.
+//! scene's boundary) or nothing. The flat surfaces reflect by the law of
+//! the equation the layers were solved in ([`Fresnel::of`]): s-like beside
+//! Helmholtz, natural light's beside Maxwell (whose layers' fluxes are then
+//! natural light's too, combined without tracking the polarisation between
+//! layers).
 //!
 //! The mirror reflection (what a gloss trap removes, d/8° SCE) is the light
 //! that met only specular orders on its way: the same adding over each
@@ -36,22 +39,28 @@ pub enum Below {
 
 /// The stack of `layers` (top first) between the binder's two flat
 /// surfaces, in air on both sides: reflection and transmission of the whole.
-pub fn free_stack(ords: &Ordinates, layers: &[&Slab]) -> Result<Slab, BaselineError> {
-    let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
+/// The surfaces reflect by `fresnel`.
+pub fn free_stack(
+    ords: &Ordinates,
+    layers: &[&Slab],
+    fresnel: Fresnel,
+) -> Result<Slab, BaselineError> {
+    let mut s = adding::surface_air_over_binder(ords, fresnel);
     for l in layers {
         s = adding::add(&s, l)?;
     }
-    adding::add(&s, &adding::surface_binder_over_air(ords, Fresnel::Scalar))
+    adding::add(&s, &adding::surface_binder_over_air(ords, fresnel))
 }
 
 /// The reflection of the stack of `layers` (top first) on `below`, and its
-/// mirror part per bin.
+/// mirror part per bin; the surfaces reflect by `fresnel`.
 pub fn stack_reflection(
     ords: &Ordinates,
     layers: &[&LayerSlab],
     below: Below,
+    fresnel: Fresnel,
 ) -> Result<StackReflection, BaselineError> {
-    let lower = adding::surface_binder_over_air(ords, Fresnel::Scalar);
+    let lower = adding::surface_binder_over_air(ords, fresnel);
     let backing = match below {
         Below::Paper { albedo } => {
             adding::on_backing(&lower, &adding::lambertian_in_air(ords, albedo))?
@@ -59,7 +68,7 @@ pub fn stack_reflection(
         Below::Air => lower.r_down.clone(),
     };
     let reflect = |slabs: Vec<&Slab>, backing: &Matrix| -> Result<Matrix, BaselineError> {
-        let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
+        let mut s = adding::surface_air_over_binder(ords, fresnel);
         for l in slabs {
             s = adding::add(&s, l)?;
         }
@@ -93,20 +102,22 @@ pub fn white_sky(s: &StackReflection, polar_deg: f64) -> Result<f64, BaselineErr
 /// `sr` of the same stack on `below`,
 /// `π f = [R⁰ + 2 Σ_{m≥1} Rᵐ − mirror]_{vc} / w_v`, `w_v` the viewing bin's
 /// flux weight in air. The sum runs over the layers' terms (`azimuthal`,
-/// the same number in every layer).
+/// the same number in every layer). The surfaces reflect by `fresnel`, as
+/// in `sr`.
 pub fn plane_factors(
     ords: &Ordinates,
     layers: &[&LayerSlab],
     sr: &StackReflection,
     illumination_deg: &[f64],
     viewing_deg: &[f64],
+    fresnel: Fresnel,
 ) -> Result<Array2<f64>, BaselineError> {
     let node = |deg: f64| ords.air_node(deg).ok_or(BaselineError::NoDirection(deg));
     let terms = layers.first().map_or(0, |l| l.azimuthal.len());
-    let lower = adding::surface_binder_over_air(ords, Fresnel::Scalar);
+    let lower = adding::surface_binder_over_air(ords, fresnel);
     let mut sum = sr.r.clone();
     for m in 0..terms {
-        let mut s = adding::surface_air_over_binder(ords, Fresnel::Scalar);
+        let mut s = adding::surface_air_over_binder(ords, fresnel);
         for l in layers {
             s = adding::add(&s, &l.azimuthal[m])?;
         }

@@ -10,6 +10,7 @@ use ndarray::Array2;
 use super::combine::{free_stack, plane_factors, stack_reflection, white_sky, Below};
 use super::flux::LayerSlab;
 use crate::optics::appearance::Measurement;
+use crate::optics::baseline::fresnel::Fresnel;
 use crate::optics::baseline::halftone::{primaries, yule_nielsen};
 use crate::optics::baseline::ordinates::Ordinates;
 use crate::optics::baseline::BaselineError;
@@ -25,6 +26,9 @@ pub struct Views<'a> {
     pub illumination_deg: Option<&'a [f64]>,
     /// Air angles of the totals in air.
     pub above_deg: &'a [f64],
+    /// How the binder's flat surfaces reflect: by the law of the equation
+    /// the layers were solved in (`Fresnel::of`).
+    pub surfaces: Fresnel,
 }
 
 /// What a stack (or a halftone of stacks) shows at one wavelength.
@@ -66,7 +70,7 @@ pub fn look(
             totals: vec![[0.0, 1.0, 0.0]; v.above_deg.len()],
         });
     }
-    let sr = stack_reflection(ords, layers, below)?;
+    let sr = stack_reflection(ords, layers, below, v.surfaces)?;
     let factors = v
         .measurements
         .iter()
@@ -78,14 +82,25 @@ pub fn look(
         .map(|&deg| white_sky(&sr, deg))
         .collect::<Result<_, _>>()?;
     let plane = match v.illumination_deg {
-        Some(ill) => Some(plane_factors(ords, layers, &sr, ill, v.viewing_deg)?),
+        Some(ill) => Some(plane_factors(
+            ords,
+            layers,
+            &sr,
+            ill,
+            v.viewing_deg,
+            v.surfaces,
+        )?),
         None => None,
     };
     // The stack in air, only when its totals are asked for.
     let totals = if v.above_deg.is_empty() {
         Vec::new()
     } else {
-        let free = free_stack(ords, &layers.iter().map(|l| &l.total).collect::<Vec<_>>())?;
+        let free = free_stack(
+            ords,
+            &layers.iter().map(|l| &l.total).collect::<Vec<_>>(),
+            v.surfaces,
+        )?;
         v.above_deg
             .iter()
             .map(|&deg| {

@@ -14,8 +14,17 @@
 //!   `K = S (a − 1)`, and `K/S = a − 1 = (1 − R∞)²/(2 R∞)`. The formula for
 //!   `a` follows from `R_w = R_b + T² R_g/(1 − R_b R_g)` and Kubelka's
 //!   `T² = (a − R_b)² − b²`. Where the reflectances admit no Kubelka layer
-//!   (`R_w ≤ R_b` with `a < 1`, `R_b ≤ 0`, `R_g ≤ 0`) the coefficients are
-//!   NaN; a layer that hides completely (`R_b = R_w`) has `S = ∞`.
+//!   (`R_w < R_b`, `R_b ≤ 0`, `R_g ≤ 0`) the coefficients are NaN; a layer
+//!   that hides completely (`R_b = R_w`) has `S = ∞`.
+//! - **A layer that absorbs nothing measurable.** `a = 1 + K/S` cannot be
+//!   below 1 for a Kubelka layer, but readings that include the surface
+//!   reflection raise `R_b` more than `R_w` asks for, which lowers `a`: a
+//!   nearly lossless white (rutile at 550–650 nm) reads `a < 1` with
+//!   `R_w > R_b`. Such readings are taken as the non-absorbing layer,
+//!   `K = 0`, `R∞ = 1` and `S X = R_b/(1 − R_b)` (Kubelka's limit `b → 0`,
+//!   from the reading over black alone), rather than left undefined: the
+//!   bound `K ≥ 0` of the model applied to the readings. S then carries
+//!   the surface reflection in `R_b`, as every value here does.
 //!
 //! S and K are computed from the reflectance factors as measured, surface
 //! reflection included (as a lab applies Kubelka's formulas to its
@@ -65,9 +74,11 @@ pub fn kubelka(r_black: f64, r_white: f64, r_ground: f64, x: f64) -> Kubelka {
         return NAN;
     }
     let a = 0.5 * (r_white + (r_black - r_white + r_ground) / (r_black * r_ground));
-    if a.is_nan() || a < 1.0 {
+    if a.is_nan() || r_white < r_black {
         return NAN;
     }
+    // K ≥ 0: readings of a < 1 are the non-absorbing layer's (module doc).
+    let a = a.max(1.0);
     let b = (a * a - 1.0).sqrt();
     if r_black == r_white && b > 0.0 {
         // Complete hiding: the layer is its own R∞, S X = ∞ (the general
@@ -319,5 +330,14 @@ mod tests {
         assert!((h.r_inf - r).abs() < 1e-12 && h.s == f64::INFINITY);
         // No Kubelka layer: darker over white than over black.
         assert!(kubelka(0.5, 0.4, rg, x).s.is_nan());
+        // A non-absorbing layer read with a surface reflection of 0.05 on
+        // both halves: a < 1 without the bound; K = 0 and S from R_b.
+        let (rb_s, rw_s) = (rb + 0.05, rw + 0.05);
+        let a = 0.5 * (rw_s + (rb_s - rw_s + rg) / (rb_s * rg));
+        assert!(a < 1.0, "{a}");
+        let got = kubelka(rb_s, rw_s, rg, x);
+        assert_eq!(got.k, 0.0);
+        assert_eq!(got.r_inf, 1.0);
+        assert!((got.s - rb_s / ((1.0 - rb_s) * x)).abs() < 1e-12, "{got:?}");
     }
 }

@@ -111,7 +111,9 @@ fn write_one(s: &mut Scales, parent: &hdf5::Group, h: &Hiding) -> hdf5::Result<(
             "k_per_um",
             &h.k_per_um,
             "um-1",
-            "Kubelka's absorption coefficient K at the solved wavelengths; wavelength",
+            "Kubelka's absorption coefficient K at the solved wavelengths (0 where the readings \
+             admit no absorbing layer, a < 1 with R_w ≥ R_b: S is then the non-absorbing \
+             layer's, from R_b); wavelength",
         ),
         (
             "k_over_s",

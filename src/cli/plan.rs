@@ -172,6 +172,9 @@ pub fn plan(
         );
     }
     println!("expected ΔE00 (column ΔE00): {}", de_summary(&chosen));
+    if let Some(line) = unbounded_scalar(&chosen) {
+        println!("{line}");
+    }
     for target in [1.0, 0.5] {
         if let Some(line) = statistics_cost(&chosen, &cal, target, t_sum) {
             println!("{line}");
@@ -257,6 +260,31 @@ fn de_summary(exp: &Expansion) -> String {
         de.len(),
         above(3.0)
     )
+}
+
+/// "WARNING: the scalar approximation is not bounded for N variant(s) …":
+/// the variants whose grains scatter beyond the stand-ins' range in the
+/// scalar equation (`model_error::grain_ratio`), or `None`.
+fn unbounded_scalar(exp: &Expansion) -> Option<String> {
+    use inksim::pipeline::model_error::{grain_ratio, GRAIN_RATIO_LIMIT};
+    let beyond: Vec<(String, f64)> = exp
+        .variants
+        .iter()
+        .filter_map(|v| grain_ratio(&v.scene).map(|g| (v.name.clone(), g.ratio)))
+        .filter(|(_, r)| r.ln().abs() > GRAIN_RATIO_LIMIT.ln())
+        .collect();
+    let (name, ratio) = beyond
+        .iter()
+        .max_by(|a, b| a.1.ln().abs().total_cmp(&b.1.ln().abs()))?;
+    Some(format!(
+        "WARNING: the scalar approximation is not bounded for {} of {} variants: their grains \
+         scatter beyond {GRAIN_RATIO_LIMIT}× what they scatter in Maxwell's equations (up to \
+         {ratio:.1}× in transport, {name}); their ΔE00 column holds the stand-ins' term, a \
+         lower bound (docs/ACCURACY.md, \"High-index grains\"); solver.equation = \
+         \"maxwell\" removes it",
+        beyond.len(),
+        exp.variants.len()
+    ))
 }
 
 /// What a realisation target of `target` would cost: "fragment s.e. ≤ 0.5

@@ -283,12 +283,21 @@ pub fn expected_rows(scene: &Scene) -> Vec<(String, f64)> {
         ),
     ));
     if let Some(m) = super::model_error::scalar_de00(scene) {
-        rows.push((
-            "scalar approximation (the Helmholtz equation against Maxwell's; \
-             solver.equation = \"maxwell\" removes it)"
+        use super::model_error::{grain_ratio, GRAIN_RATIO_LIMIT};
+        let label = match grain_ratio(scene) {
+            Some(g) if g.ratio.ln().abs() > GRAIN_RATIO_LIMIT.ln() => format!(
+                "scalar approximation, not bounded for this layer: one {} grain scatters {:.1}× \
+                 (transport) in the Helmholtz equation what it scatters in Maxwell's at {} nm, \
+                 beyond the stand-ins' ≤ {GRAIN_RATIO_LIMIT}× where this term was measured; \
+                 the value is theirs, a lower bound here (solver.equation = \"maxwell\" \
+                 removes it)",
+                g.species, g.ratio, g.wavelength_nm
+            ),
+            _ => "scalar approximation (the Helmholtz equation against Maxwell's; \
+                  solver.equation = \"maxwell\" removes it)"
                 .to_string(),
-            m,
-        ));
+        };
+        rows.push((label, m));
     }
     rows
 }

@@ -194,10 +194,11 @@ enum Command {
         #[arg(long)]
         mitsuba: bool,
     },
-    /// Validate a scene (or every variant of a study, or a match file) and
+    /// Validate a scene (or every variant of a study, a match file or a fit
+    /// file) and
     /// print what a run would compute, without running it.
     Check {
-        /// Scene, study or match file (TOML).
+        /// Scene, study, match or fit file (TOML).
         config: PathBuf,
     },
     /// Find recipes for a target colour: the fewest pigments of a palette,
@@ -215,6 +216,27 @@ enum Command {
         /// e.g. configs/match-red-tint.toml.
         config: PathBuf,
         /// Write results here instead of match.output_dir.
+        #[arg(long)]
+        output_dir: Option<PathBuf>,
+    },
+    /// Fit a pigment's optical constants to measured drawdowns: k(λ) with
+    /// n known, or n(λ) and k(λ), and if asked its grain diameter, so that
+    /// the fast forward model (the base scene's Kubelka–Munk baseline)
+    /// reproduces the reflectance spectra of masstones and tints with a
+    /// known white, over black and white. See docs/MATCH.md, "Colourants
+    /// from drawdowns".
+    ///
+    /// Writes <output_dir>/<name>.csv, the fitted material as a table any
+    /// scene reads (`material = { csv = "<name>.csv" }`, with the fitted
+    /// diameter), its header stating the drawdowns, the residuals, the
+    /// standard errors, what is not determined and the provenance; and
+    /// <name>.h5 with the same, the residual of every reading and the exact
+    /// fit file.
+    FitMaterial {
+        /// Fit file (TOML with [fit], [pigment], [white], base and
+        /// [[drawdown]]), e.g. configs/fit-red.toml.
+        config: PathBuf,
+        /// Write results here instead of fit.output_dir.
         #[arg(long)]
         output_dir: Option<PathBuf>,
     },
@@ -371,9 +393,14 @@ fn real_main() -> Result<ExitCode> {
         Command::Match { config, output_dir } => {
             cli::r#match::run(&cli::ConfigFile::read(&config)?, output_dir)?
         }
+        Command::FitMaterial { config, output_dir } => {
+            cli::fit_material::run(&cli::ConfigFile::read(&config)?, output_dir)?
+        }
         Command::Check { config } => {
             let config = cli::ConfigFile::read(&config)?;
-            if config.is_match() {
+            if config.is_fit() {
+                cli::fit_material::check(&config)?;
+            } else if config.is_match() {
                 cli::r#match::check(&config)?;
             } else if config.is_study() {
                 cli::study::check(&config, memory)?;

@@ -12,11 +12,13 @@
 //! - [`materials`]: `materials`, the stand-ins and the material library.
 //! - [`view`]: `view`, the interactive page.
 //! - [`match`](r#match): `match`, from a target colour to a recipe.
+//! - [`fit_material`]: `fit-material`, a pigment's constants from drawdowns.
 //!
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
 
 pub mod export;
+pub mod fit_material;
 pub mod r#match;
 pub mod materials;
 pub mod paint;
@@ -141,6 +143,11 @@ impl ConfigFile {
     /// Whether it is a match file (has a [match] table).
     pub fn is_match(&self) -> bool {
         inksim::r#match::config::is_match_text(&self.text)
+    }
+
+    /// Whether it is a fit file (has a [fit] table).
+    pub fn is_fit(&self) -> bool {
+        inksim::r#match::fit::config::is_fit_text(&self.text)
     }
 
     /// Whether it is a study (has a [study] table).

@@ -183,74 +183,84 @@ pub fn is_match_text(text: &str) -> bool {
 }
 
 /// A [`MatchError::Config`] of `file`, key `key`.
-fn invalid(file: &Path, key: &str, message: impl Into<String>) -> MatchError {
+pub(crate) fn invalid(file: &Path, key: &str, message: impl Into<String>) -> MatchError {
     MatchError::Config {
         file: file.to_path_buf(),
         message: format!("key `{key}`: {}", message.into()),
     }
 }
 
+/// The fast model: the base scene's first baseline (default
+/// `kubelka-munk`), a Kubelka–Munk one.
+pub(crate) fn fast_model(path: &Path, scene: &Scene) -> Result<Baseline, MatchError> {
+    let model = scene
+        .appearance
+        .baseline
+        .first()
+        .copied()
+        .unwrap_or(Baseline::KubelkaMunk);
+    if !matches!(model, Baseline::KubelkaMunk | Baseline::KubelkaMunkScene) {
+        return Err(invalid(
+            path,
+            "base.appearance.baseline",
+            format!(
+                "the fast model is `kubelka-munk` or `kubelka-munk-scene`, got `{}`",
+                model.name()
+            ),
+        ));
+    }
+    Ok(model)
+}
+
+/// The text of the file `path`, or one error naming it.
+pub(crate) fn read_text(path: &Path) -> Result<String, MatchError> {
+    std::fs::read_to_string(path).map_err(|e| MatchError::Config {
+        file: path.to_path_buf(),
+        message: format!("cannot read: {e}"),
+    })
+}
+
+/// `text` (read from `path`) as the raw serde type `T`; an error is one
+/// line with the parser's line number and `what` the file holds.
+pub(crate) fn from_toml<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    text: &str,
+    what: &str,
+) -> Result<T, MatchError> {
+    toml::from_str(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        MatchError::Config {
+            file: path.to_path_buf(),
+            message: format!(
+                "{}{} ({what})",
+                line.map_or(String::new(), |l| format!("line {l}: ")),
+                e.message().trim()
+            ),
+        }
+    })
+}
+
 impl MatchSpec {
     /// Read and check the match file `path`.
     pub fn load(path: &Path) -> Result<MatchSpec, MatchError> {
-        let text = std::fs::read_to_string(path).map_err(|e| MatchError::Config {
-            file: path.to_path_buf(),
-            message: format!("cannot read: {e}"),
-        })?;
-        MatchSpec::parse(path, &text)
+        MatchSpec::parse(path, &read_text(path)?)
     }
 
     /// Parse and check match-file `text` read from `path`.
     pub fn parse(path: &Path, text: &str) -> Result<MatchSpec, MatchError> {
-        let raw: RawMatchFile = toml::from_str(text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-            MatchError::Config {
-                file: path.to_path_buf(),
-                message: format!(
-                    "{}{} (a match file has [match], [target], base and [[palette]])",
-                    line.map_or(String::new(), |l| format!("line {l}: ")),
-                    e.message().trim()
-                ),
-            }
-        })?;
+        let raw: RawMatchFile = from_toml(
+            path,
+            text,
+            "a match file has [match], [target], base and [[palette]]",
+        )?;
         let target = check_target(path, raw.target)?;
         let (palette, scene) = check_palette(path, raw.base, raw.palette)?;
-        let model = scene
-            .appearance
-            .baseline
-            .first()
-            .copied()
-            .unwrap_or(Baseline::KubelkaMunk);
-        if !matches!(model, Baseline::KubelkaMunk | Baseline::KubelkaMunkScene) {
-            return Err(invalid(
-                path,
-                "base.appearance.baseline",
-                format!(
-                    "the fast model is `kubelka-munk` or `kubelka-munk-scene`, got `{}`",
-                    model.name()
-                ),
-            ));
-        }
+        let model = fast_model(path, &scene)?;
         let search = check_search(path, &raw.settings, &target, &scene, palette.len())?;
-        let name = match raw.settings.name {
-            Some(n) if n.is_empty() || crate::study::sweep::sanitise(&n) != n => {
-                return Err(invalid(
-                    path,
-                    "match.name",
-                    format!("`{n}` must be non-empty and use only A-Z a-z 0-9 _ . -"),
-                ))
-            }
-            Some(n) => n,
-            None => path.file_stem().map_or("match".into(), |s| {
-                crate::study::sweep::sanitise(&s.to_string_lossy())
-            }),
-        };
-        let output_dir = raw
-            .settings
-            .output_dir
-            .unwrap_or_else(|| PathBuf::from("runs").join(&name));
+        let (name, output_dir) =
+            output_names(path, "match", raw.settings.name, raw.settings.output_dir)?;
         Ok(MatchSpec {
             path: path.to_path_buf(),
             name,
@@ -262,6 +272,31 @@ impl MatchSpec {
             search,
         })
     }
+}
+
+/// The checked `<table>.name` (default: the file's stem) and
+/// `<table>.output_dir` (default `runs/<name>`) of the file `path`.
+pub(crate) fn output_names(
+    path: &Path,
+    table: &str,
+    name: Option<String>,
+    output_dir: Option<PathBuf>,
+) -> Result<(String, PathBuf), MatchError> {
+    let name = match name {
+        Some(n) if n.is_empty() || crate::study::sweep::sanitise(&n) != n => {
+            return Err(invalid(
+                path,
+                &format!("{table}.name"),
+                format!("`{n}` must be non-empty and use only A-Z a-z 0-9 _ . -"),
+            ))
+        }
+        Some(n) => n,
+        None => path.file_stem().map_or(table.into(), |s| {
+            crate::study::sweep::sanitise(&s.to_string_lossy())
+        }),
+    };
+    let output_dir = output_dir.unwrap_or_else(|| PathBuf::from("runs").join(&name));
+    Ok((name, output_dir))
 }
 
 /// The 3 numbers of `key`, each checked by `ok` (`what` says the range).
@@ -398,10 +433,11 @@ fn check_palette(
     base: Option<Value>,
     palette: Vec<Table>,
 ) -> Result<(Vec<PaletteEntry>, Scene), MatchError> {
-    let (mut table, scene_path) = base_table(file, base).map_err(|m| MatchError::Config {
-        file: file.to_path_buf(),
-        message: m,
-    })?;
+    let (mut table, scene_path) = base_without_pigments(
+        file,
+        base,
+        "remove it: the palette's pvc_range bounds give the PVC",
+    )?;
     if palette.is_empty() || palette.len() > MAX_PALETTE {
         return Err(invalid(
             file,
@@ -411,22 +447,6 @@ fn check_palette(
                 palette.len()
             ),
         ));
-    }
-    if table.contains_key("pigment") || table.contains_key("stack") {
-        return Err(invalid(
-            file,
-            "base",
-            "the base scene must have no [[pigment]] or [[stack]]: the palette gives the pigments",
-        ));
-    }
-    if let Some(Value::Table(layer)) = table.get("layer") {
-        if layer.contains_key("pvc") {
-            return Err(invalid(
-                file,
-                "base.layer.pvc",
-                "remove it: the palette's pvc_range bounds give the PVC",
-            ));
-        }
     }
     let mut entries = Vec::with_capacity(palette.len());
     let mut pigments = Vec::with_capacity(palette.len());
@@ -478,18 +498,61 @@ fn check_palette(
         });
     }
     table.insert("pigment".into(), Value::Array(pigments));
-    let text = toml::to_string(&table).map_err(|e| MatchError::Config {
+    let scene = checked_scene(
+        file,
+        &table,
+        &scene_path,
+        "base scene with the palette as its pigments",
+        &|m| m.replace("pigment[", "palette["),
+    )?;
+    Ok((entries, scene))
+}
+
+/// The base scene's table of the file `file` (inline or its own file, and
+/// that file's path), refused when it has pigments, a stack or a
+/// `layer.pvc` (`pvc_why` says where the volume fractions come from).
+pub(crate) fn base_without_pigments(
+    file: &Path,
+    base: Option<Value>,
+    pvc_why: &str,
+) -> Result<(Table, PathBuf), MatchError> {
+    let (table, scene_path) = base_table(file, base).map_err(|m| MatchError::Config {
+        file: file.to_path_buf(),
+        message: m,
+    })?;
+    if table.contains_key("pigment") || table.contains_key("stack") {
+        return Err(invalid(
+            file,
+            "base",
+            "the base scene must have no [[pigment]] or [[stack]]: this file gives the pigments",
+        ));
+    }
+    if let Some(Value::Table(layer)) = table.get("layer") {
+        if layer.contains_key("pvc") {
+            return Err(invalid(file, "base.layer.pvc", pvc_why));
+        }
+    }
+    Ok((table, scene_path))
+}
+
+/// The scene `table` checked by the scene checker as if read from
+/// `scene_path`; an error is one line of `file` saying `what` was checked,
+/// its key renamed by `rename` into the user's file.
+pub(crate) fn checked_scene(
+    file: &Path,
+    table: &Table,
+    scene_path: &Path,
+    what: &str,
+    rename: &dyn Fn(String) -> String,
+) -> Result<Scene, MatchError> {
+    let text = toml::to_string(table).map_err(|e| MatchError::Config {
         file: file.to_path_buf(),
         message: format!("base: {e}"),
     })?;
-    let scene = parse_scene(&scene_path, &text).map_err(|e| MatchError::Config {
+    parse_scene(scene_path, &text).map_err(|e| MatchError::Config {
         file: file.to_path_buf(),
-        message: format!(
-            "base scene with the palette as its pigments: {}",
-            scene_message(&e).replace("pigment[", "palette[")
-        ),
-    })?;
-    Ok((entries, scene))
+        message: format!("{what}: {}", rename(scene_message(&e))),
+    })
 }
 
 /// What the scene checker says, without its file (the match file is named

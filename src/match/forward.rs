@@ -98,24 +98,49 @@ impl FastModel {
     /// The reflectance factor geometry `m` reads from the recipe's layer, on
     /// the grid.
     pub fn factor(&self, recipe: &Recipe, m: Measurement) -> Vec<f64> {
-        let rg = match self.model {
-            Baseline::KubelkaMunkScene => {
-                km::scene_backing(recipe.paper_albedo, self.backing.0, self.backing.1)
-            }
-            _ => recipe.paper_albedo,
-        };
-        let surface = self.surfaces[Measurement::ALL.iter().position(|g| *g == m).unwrap_or(0)];
         (0..self.wavelengths_nm.len())
             .map(|l| {
-                let (mut mu_a, mut mu_s) = (0.0, 0.0);
-                for (u, f) in self.unit.iter().zip(&recipe.fractions) {
-                    mu_a += f * u[l][0];
-                    mu_s += f * u[l][1];
-                }
-                let r = km::reflectance(2.0 * mu_a, 0.75 * mu_s, recipe.thickness_nm, rg);
-                surface.factor(r)
+                let mu = self.mix(l, &recipe.fractions, [0.0; 2]);
+                self.layer_factor(mu, recipe.thickness_nm, recipe.paper_albedo, m)
             })
             .collect()
+    }
+
+    /// (μa, μs') of palette pigment `s` alone at volume fraction 1 at
+    /// wavelength index `l`, 1/nm.
+    pub fn unit(&self, s: usize, l: usize) -> [f64; 2] {
+        self.unit[s][l]
+    }
+
+    /// (μa, μs') at wavelength index `l` of the palette at volume
+    /// `fractions` plus `extra` (another pigment's own share), 1/nm.
+    pub fn mix(&self, l: usize, fractions: &[f64], extra: [f64; 2]) -> [f64; 2] {
+        let mut mu = extra;
+        for (u, f) in self.unit.iter().zip(fractions) {
+            mu[0] += f * u[l][0];
+            mu[1] += f * u[l][1];
+        }
+        mu
+    }
+
+    /// The reflectance factor geometry `m` reads from a layer of absorption
+    /// and reduced scattering coefficients `mu` (1/nm) and thickness
+    /// `thickness_nm` on a ground of albedo `albedo` (the paper; 0 for a
+    /// black ground): the two-flux reflectance on the model's backing, then
+    /// the surface.
+    pub fn layer_factor(
+        &self,
+        mu: [f64; 2],
+        thickness_nm: f64,
+        albedo: f64,
+        m: Measurement,
+    ) -> f64 {
+        let rg = match self.model {
+            Baseline::KubelkaMunkScene => km::scene_backing(albedo, self.backing.0, self.backing.1),
+            _ => albedo,
+        };
+        let surface = self.surfaces[Measurement::ALL.iter().position(|g| *g == m).unwrap_or(0)];
+        surface.factor(km::reflectance(2.0 * mu[0], 0.75 * mu[1], thickness_nm, rg))
     }
 
     /// CIELAB of a reflectance factor on the grid, for `observer`.

@@ -18,12 +18,15 @@
 //! - [`report`]: the reported recipes (composition, ΔE00 per geometry,
 //!   metamerism indices, uncertainty).
 //! - [`write`]: the HDF5 file and the recipes CSV, written atomically.
+//! - [`fit`]: the inverse of a pigment (`inksim fit-material`): its optical
+//!   constants from measured drawdowns, on the same fast model.
 //!
 //! The method, the report's fields and the limits are documented in
 //! docs/MATCH.md.
 
 pub mod config;
 pub mod correct;
+pub mod fit;
 pub mod forward;
 pub mod problem;
 pub mod report;

@@ -6,6 +6,8 @@
 //! - [`scene`]: `run`, `geometry` and `check` of one scene.
 //! - [`paint`]: `run` and `check` of an effect paint.
 //! - [`study`]: `run`, `check` and `merge` of a study.
+//! - [`effect_study`]: `plan`, `run`, `check` and `merge` of a study of an
+//!   effect paint.
 //! - [`plan`]: `plan`, the variants with their work and estimated time and
 //!   memory.
 //! - [`slurm`]: `slurm`, the sbatch job-array script.
@@ -17,6 +19,7 @@
 //! Shared here: how an error is printed, a broken pipe ends quietly, which
 //! files are studies, the thread count and the shard.
 
+pub mod effect_study;
 pub mod export;
 pub mod fit_material;
 pub mod r#match;

@@ -25,6 +25,9 @@ pub fn plan(
         Some(s) => Shard::parse(s).map_err(anyhow::Error::msg)?,
         None => Shard::ALL,
     };
+    if study.is_paint() {
+        return super::effect_study::plan(&study, profile, shard, only, nthreads);
+    }
     let chosen = study.expand(profile)?.select(&study, only)?;
     let mut others = vec![];
     for p in study.profiles.keys() {
@@ -231,7 +234,7 @@ pub fn estimates(exp: &Expansion) -> Vec<plan::Estimate> {
 }
 
 /// " (only pigment=red, pvc=pvc30)" for a selection, else nothing.
-pub(super) fn selected(exp: &Expansion) -> String {
+pub(super) fn selected<S>(exp: &Expansion<S>) -> String {
     if exp.selection.is_empty() {
         String::new()
     } else {

@@ -3,9 +3,9 @@
 use super::ConfigFile;
 use anyhow::{bail, Context, Result};
 use inksim::pipeline::memory::{human_bytes, MemoryLimit};
-use inksim::study::run::{self as srun, RunOptions, State};
-use inksim::study::sweep::{Expansion, Selection};
-use std::path::PathBuf;
+use inksim::study::run::{self as srun, RunOptions, RunReport, RunScene, State};
+use inksim::study::sweep::{Expansion, Selection, Variant};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The flags of `inksim run` on a study.
@@ -25,14 +25,17 @@ pub fn run(
     nthreads: usize,
     memory: Option<MemoryLimit>,
 ) -> Result<ExitCode> {
+    let study = config.study(flags.output_dir.clone())?;
+    if study.is_paint() {
+        return super::effect_study::run(&study, flags, nthreads);
+    }
     let RunFlags {
-        output_dir,
         profile,
         shard,
         jobs,
         only,
+        ..
     } = flags;
-    let study = config.study(output_dir)?;
     let shard = super::shard_of(shard)?;
     let exp = study.expand(profile)?.select(&study, &only)?;
     let to_run = exp
@@ -71,34 +74,64 @@ pub fn run(
         }
         None => srun::default_jobs(nthreads, peak, to_run, memory),
     };
+    let opts = RunOptions {
+        jobs,
+        shard,
+        quiet: false,
+        memory,
+    };
+    run_then_merge("study", &study, &exp, &opts, || {
+        print_merge(&inksim::study::merge::merge(&study, &exp)?);
+        Ok(())
+    })
+}
+
+/// Say what a run of `exp` will do (`kind`: "study", "effect study"), run
+/// the variants of `opts.shard` and [`finish`].
+pub fn run_then_merge<S: RunScene>(
+    kind: &str,
+    study: &inksim::study::Study,
+    exp: &Expansion<S>,
+    opts: &RunOptions,
+    merge: impl FnOnce() -> Result<()>,
+) -> Result<ExitCode> {
+    let shard = opts.shard;
+    let to_run = exp
+        .variants
+        .iter()
+        .filter(|v| shard.contains(v.index))
+        .count();
     eprintln!(
-        "[inksim] study {} profile {}: {} variants{} ({} in shard {}/{}), results in {}",
+        "[inksim] {kind} {} profile {}: {} variants{} ({} in shard {}/{}, {} job(s)), results \
+         in {}",
         study.name,
         exp.profile.as_deref().unwrap_or("(none)"),
         exp.variants.len(),
-        super::plan::selected(&exp),
+        super::plan::selected(exp),
         to_run,
         shard.index,
         shard.count,
+        opts.jobs,
         exp.study_dir.join("variants").display()
     );
-    let report = srun::run_variants(
-        &exp.variants,
-        &RunOptions {
-            jobs,
-            shard,
-            quiet: false,
-            memory,
-        },
-    );
+    let report = srun::run_variants(&exp.variants, opts);
+    finish(&report, &exp.variants, merge)
+}
+
+/// Print a run's report; merge (by `merge`) when every variant is finished;
+/// the exit code says whether any failed.
+pub fn finish<S: RunScene>(
+    report: &RunReport,
+    variants: &[Variant<S>],
+    merge: impl FnOnce() -> Result<()>,
+) -> Result<ExitCode> {
     print!("{}", report.text());
-    let all_done = exp.variants.iter().all(|v| srun::state(v) == State::Done);
-    if all_done {
+    if variants.iter().all(|v| srun::state(v) == State::Done) {
         println!(
             "all {} variants finished; merging (as `inksim merge` does)",
-            exp.variants.len()
+            variants.len()
         );
-        print_merge(&inksim::study::merge::merge(&study, &exp)?);
+        merge()?;
     }
     Ok(if report.failed().next().is_some() {
         ExitCode::FAILURE
@@ -112,6 +145,9 @@ pub fn run(
 /// many variants each has.
 pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     let study = config.study(None)?;
+    if study.is_paint() {
+        return super::effect_study::check(config, &study);
+    }
     let profiles: Vec<Option<String>> = if study.profiles.is_empty() {
         vec![None]
     } else {
@@ -170,22 +206,26 @@ pub fn merge(
     only: &[Selection],
 ) -> Result<()> {
     let study = config.study(output_dir)?;
+    if study.is_paint() {
+        return super::effect_study::merge(&study, profile, only);
+    }
     let exp = study.expand(profile)?.select(&study, only)?;
     print_merge(&inksim::study::merge::merge(&study, &exp)?);
     Ok(())
 }
 
-/// Say where merge wrote its files.
-fn print_merge(r: &inksim::study::merge::MergeReport) {
-    println!("summary: {}", r.summary_h5.display());
-    println!(
-        "page: {} and {}",
-        r.summary_md.display(),
-        r.summary_html.display()
-    );
-    for g in &r.grids {
+/// Say where merge wrote the summary, the pages and the grids.
+pub fn print_summary(h5: &Path, md: &Path, html: &Path, grids: &[PathBuf]) {
+    println!("summary: {}", h5.display());
+    println!("page: {} and {}", md.display(), html.display());
+    for g in grids {
         println!("grid: {}", g.display());
     }
+}
+
+/// Say where merge wrote its files.
+fn print_merge(r: &inksim::study::merge::MergeReport) {
+    print_summary(&r.summary_h5, &r.summary_md, &r.summary_html, &r.grids);
     for m in &r.de00_maps {
         println!("ΔE00 map: {}", m.display());
     }

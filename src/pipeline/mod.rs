@@ -68,7 +68,7 @@ pub use grains::{
     build_geometry, build_geometry_seeded, grid_of, largest_grain_nm, realisation_seed, Packer,
     RSA_MAX_PVC,
 };
-pub use paint::{paint_files, paint_plan, run_paint, PaintReport};
+pub use paint::{paint_files, paint_plan, probe_paint, run_paint, PaintProbe, PaintReport};
 pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};

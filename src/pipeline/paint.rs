@@ -240,6 +240,23 @@ fn ground_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Ground, PipelineE
     })
 }
 
+/// The paint's reflection at one wavelength, escaping into `air`.
+fn reflect_at(
+    scene: &PaintScene,
+    wavelength_nm: f64,
+    air: &[f64],
+    params: &ModelParams,
+) -> Result<PaintReflection, PipelineError> {
+    Ok(model::reflect(
+        lacquer_index(scene, wavelength_nm)?,
+        &layers_at(scene, wavelength_nm)?,
+        ground_at(scene, wavelength_nm)?,
+        wavelength_nm,
+        air,
+        params,
+    )?)
+}
+
 /// The paint's reflection at every wavelength, in parallel, with progress.
 fn solve(
     scene: &PaintScene,
@@ -251,14 +268,7 @@ fn solve(
         .wavelengths_nm
         .par_iter()
         .map(|&wl| {
-            let r = model::reflect(
-                lacquer_index(scene, wl)?,
-                &layers_at(scene, wl)?,
-                ground_at(scene, wl)?,
-                wl,
-                &air,
-                params,
-            )?;
+            let r = reflect_at(scene, wl, &air, params)?;
             progress.inc(1, &format!("{wl} nm: {} Fourier terms", r.terms.len()));
             Ok(r)
         })
@@ -397,6 +407,27 @@ fn sparkle_table(
         },
         rows,
     }))
+}
+
+/// What the fast model did at one wavelength ([`probe_paint`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PaintProbe {
+    /// Fourier terms kept.
+    pub terms: usize,
+    /// Bytes of the reflection a run keeps for that wavelength until the
+    /// colours are computed (its terms' flux matrices and mirror column).
+    pub kept_bytes: f64,
+}
+
+/// The fast model of `scene` at one wavelength (what `plan` times).
+pub fn probe_paint(scene: &PaintScene, wavelength_nm: f64) -> Result<PaintProbe, PipelineError> {
+    let air = multiangle::air_directions();
+    let r = reflect_at(scene, wavelength_nm, &air, &model_params(scene))?;
+    let square: usize = r.terms.iter().map(|m| m.size() * m.size()).sum();
+    Ok(PaintProbe {
+        terms: r.terms.len(),
+        kept_bytes: 8.0 * (square + r.mirror.len()) as f64,
+    })
 }
 
 /// Run an effect paint and write its files; progress lines unless `quiet`.

@@ -20,10 +20,13 @@
 //! - [`merge`]: the summary HDF5, the comparison grids and the summary page.
 //! - [`slurm`]: a ready sbatch array script.
 //! - [`export`]: the variants' measured colours as one CSV table.
+//! - [`effect`]: a study whose base is an effect paint (`[paint]`): the
+//!   same sweep, expansion and runner, the fast model's plan and merge.
 //!
 //! The user documentation of the format and the commands is docs/STUDY.md.
 
 mod cpu;
+pub mod effect;
 pub mod export;
 pub mod merge;
 pub mod pilot;

@@ -27,6 +27,7 @@
 //! a variant's seed is a function of its name.
 
 use super::sweep::Variant;
+use crate::config::Scene;
 use crate::output::atomic::stale_temporaries;
 use crate::output::h5;
 use crate::output::lock::{self, OutputLock};
@@ -117,7 +118,7 @@ pub enum State {
         found: usize,
         planned: usize,
     },
-    /// The result is there, its tile is not.
+    /// The result is there, its tile (or another picture) is not.
     NoTile,
 }
 
@@ -140,30 +141,64 @@ impl State {
     }
 }
 
+/// A variant's scene as the runner sees it: where its result goes, whether
+/// it is finished and how to compute it. Implemented by the wave-optics
+/// [`Scene`] here and by the effect paint's scene in
+/// [`effect`](crate::study::effect).
+pub trait RunScene: Sync {
+    /// The result file: its lock is the variant's.
+    fn result_path(&self) -> PathBuf;
+    /// Every file a run writes (a killed run's temporaries of them are
+    /// removed before it is redone).
+    fn files(&self) -> Vec<PathBuf>;
+    /// What its files say about it.
+    fn state(&self) -> State;
+    /// Compute it and write its files, quietly, held to `memory`.
+    fn run(&self, memory: Option<MemoryLimit>) -> Result<(), String>;
+}
+
+impl RunScene for Scene {
+    fn result_path(&self) -> PathBuf {
+        pipeline::result_paths(self).0
+    }
+    fn files(&self) -> Vec<PathBuf> {
+        let (h5, png) = pipeline::result_paths(self);
+        vec![h5, png]
+    }
+    fn state(&self) -> State {
+        let (h5, png) = pipeline::result_paths(self);
+        if !h5.exists() {
+            return State::Missing;
+        }
+        match h5::read_summary(&h5) {
+            Err(e) => State::Unreadable(e.to_string()),
+            Ok(s) if s.input_hash != self.provenance.input_hash => State::Mismatch {
+                stored: s.input_hash,
+            },
+            Ok(s) if !complete(self, s.entries.len()) => State::Incomplete {
+                found: s.entries.len(),
+                planned: pipeline::planned_solves(self),
+            },
+            // A stack solved layer by layer draws no tile (pipeline::output_files).
+            Ok(_) if !png.is_file() && pipeline::output_files(self).contains(&png) => State::NoTile,
+            Ok(_) => State::Done,
+        }
+    }
+    fn run(&self, memory: Option<MemoryLimit>) -> Result<(), String> {
+        pipeline::run_with(self, true, memory)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }
+}
+
 /// Result and tile paths of a variant.
 pub fn paths(v: &Variant) -> (PathBuf, PathBuf) {
     pipeline::result_paths(&v.scene)
 }
 
 /// Read the state of a variant from its files.
-pub fn state(v: &Variant) -> State {
-    let (h5, png) = paths(v);
-    if !h5.exists() {
-        return State::Missing;
-    }
-    match h5::read_summary(&h5) {
-        Err(e) => State::Unreadable(e.to_string()),
-        Ok(s) if s.input_hash != v.scene.provenance.input_hash => State::Mismatch {
-            stored: s.input_hash,
-        },
-        Ok(s) if !complete(&v.scene, s.entries.len()) => State::Incomplete {
-            found: s.entries.len(),
-            planned: pipeline::planned_solves(&v.scene),
-        },
-        // A stack solved layer by layer draws no tile (pipeline::output_files).
-        Ok(_) if !png.is_file() && pipeline::output_files(&v.scene).contains(&png) => State::NoTile,
-        Ok(_) => State::Done,
-    }
+pub fn state<S: RunScene>(v: &Variant<S>) -> State {
+    v.scene.state()
 }
 
 /// Whether a result with `entries` solves is a whole run of `scene`: every
@@ -266,9 +301,9 @@ impl RunReport {
 }
 
 /// Run the variants of `opts.shard` that are not finished.
-pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
+pub fn run_variants<S: RunScene>(variants: &[Variant<S>], opts: &RunOptions) -> RunReport {
     let start = Instant::now();
-    let mine: Vec<&Variant> = variants
+    let mine: Vec<&Variant<S>> = variants
         .iter()
         .filter(|v| opts.shard.contains(v.index))
         .collect();
@@ -343,7 +378,7 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
                 loop {
                     let k = next.fetch_add(1, Ordering::SeqCst);
                     let Some(&i) = todo.get(k) else { break };
-                    let (h5_path, _) = paths(mine[i]);
+                    let h5_path = mine[i].scene.result_path();
                     match OutputLock::try_acquire(&h5_path) {
                         Ok(Some(lock)) => run_locked(i, lock),
                         Ok(None) => {
@@ -365,7 +400,7 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
                 // (The guard is released inside `pop`, not held over the wait.)
                 let pop = || deferred.lock().ok().and_then(|mut d| d.pop());
                 while let Some(i) = pop() {
-                    let (h5_path, _) = paths(mine[i]);
+                    let h5_path = mine[i].scene.result_path();
                     progress.log(&format!(
                         "[inksim] waiting for {} ({})",
                         mine[i].name,
@@ -399,21 +434,16 @@ pub fn run_variants(variants: &[Variant], opts: &RunOptions) -> RunReport {
 }
 
 /// Run one variant; a panic inside is caught so the others go on.
-fn run_one(v: &Variant, memory: Option<MemoryLimit>) -> Result<f64, String> {
+fn run_one<S: RunScene>(v: &Variant<S>, memory: Option<MemoryLimit>) -> Result<f64, String> {
     let t = Instant::now();
-    let (h5, png) = paths(v);
     // The caller holds the variant's lock: temporaries of its files are
     // left by a killed run.
-    for p in [&h5, &png] {
-        for tmp in stale_temporaries(p) {
+    for p in v.scene.files() {
+        for tmp in stale_temporaries(&p) {
             let _ = std::fs::remove_file(tmp);
         }
     }
-    guarded(|| {
-        pipeline::run_with(&v.scene, true, memory)
-            .map(|_| t.elapsed().as_secs_f64())
-            .map_err(|e| e.to_string())
-    })
+    guarded(|| v.scene.run(memory).map(|()| t.elapsed().as_secs_f64()))
 }
 
 /// `f`'s result, with a panic inside it (on this thread or a rayon worker

@@ -412,6 +412,8 @@ fn write_sparkle(s: &mut Scales, g: &hdf5::Group, sp: &SparkleTable) -> hdf5::Re
 /// What [`read_paint`] gives back.
 #[derive(Debug, Clone)]
 pub struct PaintRecord {
+    /// The SHA-256 of the scene it was computed from (root attribute).
+    pub input_hash: String,
     pub illuminant: String,
     pub observer_deg: u32,
     pub colours: Vec<AngleRecord>,
@@ -435,6 +437,7 @@ pub fn read_paint(path: &Path) -> Result<PaintRecord, IoError> {
         source,
     };
     let file = super::open(path).map_err(hdf)?;
+    let input_hash = read_str_attr(&file, "input_hash").map_err(hdf)?;
     let g = file.group("paint").map_err(hdf)?;
     let m = g.group("multiangle").map_err(hdf)?;
     let illuminant = read_str_attr(&m, "illuminant").map_err(hdf)?;
@@ -500,6 +503,7 @@ pub fn read_paint(path: &Path) -> Result<PaintRecord, IoError> {
         }
     };
     Ok(PaintRecord {
+        input_hash,
         illuminant,
         observer_deg,
         colours,

@@ -34,7 +34,7 @@ fn axis_labels(study: &Study, axis: &str, only: &Option<Vec<String>>) -> Vec<Str
 
 /// One picture of a grid declaration: its name, title, labels and the
 /// variant of each cell (the same for the grid and its ΔE00 heat map).
-pub(super) struct GridPicture<'a> {
+pub(crate) struct GridPicture<'a, S = crate::config::Scene> {
     /// File name without extension: `<grid>[__<axis>-<label>…]`.
     pub stem: String,
     pub title: String,
@@ -44,16 +44,16 @@ pub(super) struct GridPicture<'a> {
     pub rows: Vec<String>,
     pub cols: Vec<String>,
     /// `cells[row][col]`: the variant there, if any.
-    pub cells: Vec<Vec<Option<&'a Variant>>>,
+    pub cells: Vec<Vec<Option<&'a Variant<S>>>>,
 }
 
 /// The pictures of one grid declaration, one per combination of the labels
 /// of the split axes among the variants that fit it, in expansion order.
-pub(super) fn pictures<'a>(
+pub(crate) fn pictures<'a, S>(
     study: &Study,
-    exp: &'a Expansion,
+    exp: &'a Expansion<S>,
     g: &GridDecl,
-) -> Vec<GridPicture<'a>> {
+) -> Vec<GridPicture<'a, S>> {
     let split: Vec<&str> = study
         .axes
         .iter()
@@ -71,7 +71,7 @@ pub(super) fn pictures<'a>(
             cols.retain(|l| sel.labels.contains(l));
         }
     }
-    let fits = |v: &Variant| {
+    let fits = |v: &Variant<S>| {
         g.where_.iter().all(|(a, l)| v.label(a) == Some(l))
             && v.label(&g.rows)
                 .is_some_and(|l| rows.iter().any(|x| x == l))
@@ -280,7 +280,7 @@ pub fn shrink(src: &Canvas, max: usize) -> Canvas {
 }
 
 /// Lay out a labelled grid of tiles.
-fn compose(
+pub(crate) fn compose(
     title: &str,
     subtitle: &str,
     rows: &[String],

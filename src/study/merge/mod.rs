@@ -47,9 +47,11 @@ mod summary_h5;
 mod summary_values;
 
 pub use de00::{de00_maps, draw as draw_de00_map, De00Cell, De00Map};
+pub(crate) use grid::{compose, pictures};
 pub use grid::{shrink, CELL_PX};
+pub(crate) use summary_h5::{vlu, write_variants};
 
-use super::run::{self, State};
+use super::run::{self, RunScene, State};
 use super::sweep::{Expansion, Study, Variant};
 use super::StudyError;
 use crate::output::atomic;
@@ -127,8 +129,12 @@ fn measured(path: &std::path::Path) -> Result<Option<Measured>, StudyError> {
     }))
 }
 
-/// Merge a finished study (see the module docs).
-pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> {
+/// Every variant of `exp` finished, else an error naming what is missing
+/// and why (at most 20) and the command that finishes them.
+pub(crate) fn all_finished<S: RunScene>(
+    study: &Study,
+    exp: &Expansion<S>,
+) -> Result<(), StudyError> {
     let mut missing = vec![];
     for v in &exp.variants {
         let s = run::state(v);
@@ -136,23 +142,29 @@ pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> 
             missing.push(format!("{} ({})", v.name, s.reason()));
         }
     }
-    if !missing.is_empty() {
-        let n = missing.len();
-        missing.truncate(20);
-        return Err(StudyError::Incomplete(format!(
-            "{}: {n} of {} variants are not finished, so there is nothing to merge yet: {}{}; \
-             run `inksim run {}{}` first",
-            study.path.display(),
-            exp.variants.len(),
-            missing.join(", "),
-            if n > 20 { ", …" } else { "" },
-            study.path.display(),
-            exp.profile
-                .as_deref()
-                .map(|p| format!(" --profile {p}"))
-                .unwrap_or_default()
-        )));
+    if missing.is_empty() {
+        return Ok(());
     }
+    let n = missing.len();
+    missing.truncate(20);
+    Err(StudyError::Incomplete(format!(
+        "{}: {n} of {} variants are not finished, so there is nothing to merge yet: {}{}; \
+         run `inksim run {}{}` first",
+        study.path.display(),
+        exp.variants.len(),
+        missing.join(", "),
+        if n > 20 { ", …" } else { "" },
+        study.path.display(),
+        exp.profile
+            .as_deref()
+            .map(|p| format!(" --profile {p}"))
+            .unwrap_or_default()
+    )))
+}
+
+/// Merge a finished study (see the module docs).
+pub fn merge(study: &Study, exp: &Expansion) -> Result<MergeReport, StudyError> {
+    all_finished(study, exp)?;
     let mut rows = Vec::with_capacity(exp.variants.len());
     for v in &exp.variants {
         let path = run::paths(v).0;

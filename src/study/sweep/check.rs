@@ -186,9 +186,14 @@ impl Checker<'_> {
                 }
                 let mut out = Vec::with_capacity(vals.len());
                 for (j, v) in vals.iter().enumerate() {
+                    let at = format!("{what}, value {}", j + 1);
+                    for k in &v.remove {
+                        check_key(k).map_err(|m| self.err(format!("{at}: remove `{k}`: {m}")))?;
+                    }
                     out.push(AxisValue {
                         label: v.label.clone(),
-                        set: self.overrides(&v.set, &format!("{what}, value {}", j + 1))?,
+                        set: self.overrides(&v.set, &at)?,
+                        remove: v.remove.clone(),
                     });
                 }
                 out
@@ -294,6 +299,7 @@ impl Checker<'_> {
                     key: key.to_string(),
                     value: v.clone(),
                 }],
+                remove: vec![],
             });
         }
         Ok(out)

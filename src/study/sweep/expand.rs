@@ -5,9 +5,11 @@
 //! overrides and checked by [`config::parse_scene`]. An invalid scene is
 //! reported with the override most likely behind it ([`blame`]).
 
-use super::keypath::apply_override;
-use super::{sanitise, variant_id, variant_seed, Expansion, Override, Study, Variant};
-use crate::config;
+use super::keypath::{apply_override, remove_path};
+use super::{
+    sanitise, variant_id, variant_seed, Expansion, Override, Study, Variant, VariantScene,
+};
+use crate::config::{self, paint::PaintScene, Scene};
 use crate::study::StudyError;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -19,6 +21,8 @@ struct Pending {
     name: String,
     labels: Vec<(String, String)>,
     sets: Vec<(String, Override)>,
+    /// Key paths removed after the sets, with where each comes from.
+    removes: Vec<(String, String)>,
     /// Where the variant comes from, for errors.
     origin: String,
 }
@@ -28,6 +32,27 @@ impl Study {
     /// (bad key in an axis, exclusion matching nothing, duplicate names,
     /// invalid scene) is reported here, before any work.
     pub fn expand(&self, profile: Option<&str>) -> Result<Expansion, StudyError> {
+        self.expand_as::<Scene>(profile)
+    }
+
+    /// The same for a study whose base is an effect paint ([`Study::is_paint`]).
+    pub fn expand_paint(&self, profile: Option<&str>) -> Result<Expansion<PaintScene>, StudyError> {
+        self.expand_as::<PaintScene>(profile)
+    }
+
+    fn expand_as<S: VariantScene>(
+        &self,
+        profile: Option<&str>,
+    ) -> Result<Expansion<S>, StudyError> {
+        if self.is_paint() != S::PAINT {
+            return Err(self.err(if self.is_paint() {
+                "the base is an effect paint ([paint]): this command takes a study of \
+                 wave-optics layers (plan, run, check and merge take both)"
+                    .into()
+            } else {
+                "the base is a wave-optics layer, not an effect paint ([paint])".into()
+            }));
+        }
         let profile = self.resolve_profile(profile)?;
         let study_dir = self.study_dir(profile.as_deref());
         let variants_dir = study_dir.join("variants");
@@ -137,16 +162,14 @@ impl Study {
     fn combination(&self, c: &[Option<usize>]) -> Pending {
         let mut labels = vec![];
         let mut sets = vec![];
+        let mut removes = vec![];
         for (a, axis) in self.axes.iter().enumerate() {
             if let Some(j) = c[a] {
                 let v = &axis.values[j];
                 labels.push((axis.name.clone(), v.label.clone()));
-                for o in &v.set {
-                    sets.push((
-                        format!("axis `{}` value `{}`", axis.name, v.label),
-                        o.clone(),
-                    ));
-                }
+                let src = format!("axis `{}` value `{}`", axis.name, v.label);
+                sets.extend(v.set.iter().map(|o| (src.clone(), o.clone())));
+                removes.extend(v.remove.iter().map(|k| (src.clone(), k.clone())));
             }
         }
         let name = labels
@@ -163,6 +186,7 @@ impl Study {
             name,
             labels,
             sets,
+            removes,
             origin,
         }
     }
@@ -172,13 +196,14 @@ impl Study {
         let ev = &self.explicit[i];
         let mut labels = vec![];
         let mut sets = vec![];
+        let mut removes = vec![];
         for axis in &self.axes {
             if let Some(l) = ev.labels.get(&axis.name) {
                 if let Some(v) = axis.values.iter().find(|v| &v.label == l) {
                     labels.push((axis.name.clone(), l.clone()));
-                    for o in &v.set {
-                        sets.push((format!("axis `{}` value `{l}`", axis.name), o.clone()));
-                    }
+                    let src = format!("axis `{}` value `{l}`", axis.name);
+                    sets.extend(v.set.iter().map(|o| (src.clone(), o.clone())));
+                    removes.extend(v.remove.iter().map(|k| (src.clone(), k.clone())));
                 }
             }
         }
@@ -189,19 +214,20 @@ impl Study {
             name: ev.name.clone(),
             labels,
             sets,
+            removes,
             origin: format!("[[variant]] {}", i + 1),
         }
     }
 
     /// Build and check the scene of variant number `index`.
-    fn variant(
+    fn variant<S: VariantScene>(
         &self,
         index: usize,
         p: Pending,
         prof: &[Override],
         profile: Option<&str>,
         variants_dir: &Path,
-    ) -> Result<Variant, StudyError> {
+    ) -> Result<Variant<S>, StudyError> {
         let mut table = self.base.clone();
         for o in prof {
             apply_override(&mut table, o).map_err(|m| {
@@ -220,8 +246,15 @@ impl Study {
                 ))
             })?;
         }
+        for (src, k) in &p.removes {
+            remove_path(&mut table, k).map_err(|m| {
+                self.err(format!("{src}: remove `{k}`: {m} (variant `{}`)", p.name))
+            })?;
+        }
         let seed = variant_seed(self.seed, &p.name);
-        table.insert("seed".into(), Value::Integer(seed as i64));
+        if S::SEEDED {
+            table.insert("seed".into(), Value::Integer(seed as i64));
+        }
         let mut out = Table::new();
         out.insert(
             "dir".into(),
@@ -232,20 +265,15 @@ impl Study {
         let text = toml::to_string(&table)
             .map_err(|e| self.err(format!("variant `{}`: cannot write its scene: {e}", p.name)))?;
         let scene_path = PathBuf::from(format!("{}#{}", self.base_path.display(), p.name));
-        let scene = config::parse_scene(&scene_path, &text).map_err(|e| {
+        let scene = S::parse(&scene_path, &text).map_err(|e| {
             let blame = blame(&e, prof, &p.sets, profile);
             self.err(format!(
                 "variant `{}` ({}) is not a valid scene: {e}{blame}",
                 p.name, p.origin
             ))
         })?;
-        // The merge compares the variants' colours and tiles.
-        if !scene.appearance.products.tile {
-            return Err(self.err(format!(
-                "variant `{}` ({}): appearance.outputs must include \"tile\" in a study (the \
-                 merge compares the variants' colours and tiles)",
-                p.name, p.origin
-            )));
+        if let Some(problem) = scene.study_problem() {
+            return Err(self.err(format!("variant `{}` ({}): {problem}", p.name, p.origin)));
         }
         Ok(Variant {
             index,

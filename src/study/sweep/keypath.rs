@@ -1,7 +1,9 @@
 //! Key paths: checking them and applying an override to a scene table.
 //!
 //! A key path is `.`-separated; an array element is addressed by its index
-//! (`pigment.0.diameter_nm`) or by `*`, every element (`pigment.*.shape`).
+//! (`pigment.0.diameter_nm`), by `*`, every element (`pigment.*.shape`), or
+//! by the value of its `name` key (`paint.layer.basecoat.thickness_um`).
+//! [`remove_path`] removes what a path addresses (a layer of a paint).
 //! A missing table on the way is created (the scene schema's
 //! `deny_unknown_fields` then rejects a misspelt key). The keys the study
 //! sets per variant ([`RESERVED`]) cannot be overridden.
@@ -86,17 +88,94 @@ fn set_path(v: &mut Value, segs: &[&str], val: &Value, done: &str) -> Result<usi
                     )
                 })?;
                 set_path(el, rest, val, &format!("{done}.{i}"))
+            } else if let Some(el) = a.iter_mut().find(|el| named(el, head)) {
+                set_path(el, rest, val, &format!("{done}.{head}"))
             } else {
-                Err(format!(
-                    "`{done}` is an array: address its elements by index (`{done}.0`) or all \
-                     of them by `*`, got `{head}`"
-                ))
+                Err(no_element(done, head, a))
             }
         }
         other => Err(format!(
             "`{done}` is a {}, not a table or an array",
             other.type_str()
         )),
+    }
+}
+
+/// Whether `el` is a table whose `name` is `name`.
+fn named(el: &Value, name: &str) -> bool {
+    el.get("name").and_then(Value::as_str) == Some(name)
+}
+
+/// An array `done` has no element `head`: the ways it can be addressed.
+fn no_element(done: &str, head: &str, a: &[Value]) -> String {
+    let names: Vec<&str> = a
+        .iter()
+        .filter_map(|el| el.get("name").and_then(Value::as_str))
+        .collect();
+    let by_name = if names.is_empty() {
+        String::new()
+    } else {
+        format!(", or by name ({})", names.join(", "))
+    };
+    format!(
+        "`{done}` is an array with no element named `{head}`: address its elements by index \
+         (`{done}.0`), all of them by `*`{by_name}"
+    )
+}
+
+/// Remove what key path `key` addresses: a table's key, or an array's
+/// element by its index or its `name`. It must exist.
+pub fn remove_path(root: &mut Table, key: &str) -> Result<(), String> {
+    let segs: Vec<&str> = key.split('.').collect();
+    let (last, parents) = segs.split_last().ok_or("empty key path")?;
+    let mut here = Value::Table(std::mem::take(root));
+    let r = remove_in(&mut here, parents, last, "");
+    if let Value::Table(t) = here {
+        *root = t;
+    }
+    r
+}
+
+fn remove_in(v: &mut Value, parents: &[&str], last: &str, done: &str) -> Result<(), String> {
+    let at = |s: &str| {
+        if done.is_empty() {
+            s.to_string()
+        } else {
+            format!("{done}.{s}")
+        }
+    };
+    if let Some((head, rest)) = parents.split_first() {
+        let child = match v {
+            Value::Table(t) => t.get_mut(*head),
+            Value::Array(a) => match head.parse::<usize>() {
+                Ok(i) => a.get_mut(i),
+                Err(_) => a.iter_mut().find(|el| named(el, head)),
+            },
+            _ => None,
+        };
+        let child = child.ok_or_else(|| format!("`{}` is not in the scene", at(head)))?;
+        return remove_in(child, rest, last, &at(head));
+    }
+    let gone = match v {
+        Value::Table(t) => t.remove(last).is_some(),
+        Value::Array(a) => match last.parse::<usize>() {
+            Ok(i) if i < a.len() => {
+                a.remove(i);
+                true
+            }
+            Ok(_) => false,
+            Err(_) => {
+                let before = a.len();
+                a.retain(|el| !named(el, last));
+                a.len() < before
+            }
+        },
+        _ => false,
+    };
+    if gone {
+        Ok(())
+    } else {
+        Err(format!("`{}` is not in the scene", at(last)))
     }
 }
 
@@ -135,8 +214,35 @@ mod tests {
         let e = apply_override(&mut t, &o("p.2.d", Value::Float(1.0))).unwrap_err();
         assert!(e.contains("index 2 is out of range: `p` has 2"), "{e}");
         let e = apply_override(&mut t, &o("p.d", Value::Float(1.0))).unwrap_err();
-        assert!(e.contains("`p` is an array"), "{e}");
+        assert!(
+            e.contains("`p` is an array with no element named `d`"),
+            "{e}"
+        );
         let e = apply_override(&mut t, &o("g.c.x", Value::Float(1.0))).unwrap_err();
         assert!(e.contains("`g.c` is a integer"), "{e}");
+    }
+
+    #[test]
+    fn elements_are_addressed_and_removed_by_name() {
+        let mut t =
+            table("[[layer]]\nname = \"clear\"\nt = 1.0\n[[layer]]\nname = \"base\"\nt = 2.0\n");
+        let o = Override {
+            key: "layer.base.t".into(),
+            value: Value::Float(5.0),
+        };
+        assert_eq!(apply_override(&mut t, &o), Ok(1));
+        remove_path(&mut t, "layer.clear").unwrap();
+        assert_eq!(t, table("[[layer]]\nname = \"base\"\nt = 5.0\n"));
+        let e = remove_path(&mut t, "layer.clear").unwrap_err();
+        assert_eq!(e, "`layer.clear` is not in the scene");
+        let bad = Override {
+            key: "layer.top.t".into(),
+            value: Value::Float(1.0),
+        };
+        let e = apply_override(&mut t, &bad).unwrap_err();
+        assert!(
+            e.contains("no element named `top`") && e.contains("by name (base)"),
+            "{e}"
+        );
     }
 }

@@ -39,8 +39,15 @@
 //! set = { "pigment.0.material" = { builtin = "red" } }
 //! ```
 //!
+//! The base is a wave-optics scene (`[layer]`, expanded by
+//! [`Study::expand`]) or an effect paint (`[paint]`, by
+//! [`Study::expand_paint`]); the scene kind is a [`VariantScene`].
+//!
 //! Key paths are `.`-separated; an array element is addressed by its index
-//! (`pigment.0.diameter_nm`) or by `*`, every element (`pigment.*.shape`).
+//! (`pigment.0.diameter_nm`), by `*`, every element (`pigment.*.shape`), or
+//! by its `name` (`paint.layer.basecoat.thickness_um`). An
+//! `[[axis.value]]` may `remove = ["paint.layer.clearcoat"]` (after every
+//! `set`).
 //! A missing table on the way is created (`deny_unknown_fields` of the scene
 //! schema then rejects a misspelt key, and the error names the axis).
 //!
@@ -73,7 +80,8 @@ pub use keypath::apply_override;
 pub use select::Selection;
 
 use super::StudyError;
-use crate::config::Scene;
+use crate::config::paint::PaintScene;
+use crate::config::{ConfigError, Scene};
 use raw::RawSweep;
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -87,11 +95,14 @@ pub struct Override {
     pub value: Value,
 }
 
-/// One value of an axis: its label and what it sets.
+/// One value of an axis: its label, what it sets and what it removes.
 #[derive(Debug, Clone)]
 pub struct AxisValue {
     pub label: String,
     pub set: Vec<Override>,
+    /// Key paths removed from the scene (`paint.layer.clearcoat`), after
+    /// every `set` of the variant.
+    pub remove: Vec<String>,
 }
 
 /// An axis of the sweep.
@@ -150,9 +161,51 @@ struct ExplicitVariant {
     set: Vec<Override>,
 }
 
-/// One expanded variant: a named, seeded, validated scene.
+/// What a variant's scene may be: a wave-optics [`Scene`] (a `[layer]`
+/// base) or an effect paint's [`PaintScene`] (a `[paint]` base).
+pub trait VariantScene: Sized {
+    /// Whether this kind is an effect paint (its base has a `[paint]` table).
+    const PAINT: bool;
+    /// Whether the scene takes a `seed` (the fast model of a paint is
+    /// deterministic and has none).
+    const SEEDED: bool;
+    /// Parse and validate a variant's TOML text.
+    fn parse(path: &Path, text: &str) -> Result<Self, ConfigError>;
+    /// Why this scene cannot be a variant of a study, if it cannot.
+    fn study_problem(&self) -> Option<String>;
+}
+
+impl VariantScene for Scene {
+    const PAINT: bool = false;
+    const SEEDED: bool = true;
+    fn parse(path: &Path, text: &str) -> Result<Self, ConfigError> {
+        crate::config::parse_scene(path, text)
+    }
+    fn study_problem(&self) -> Option<String> {
+        // The merge compares the variants' colours and tiles.
+        (!self.appearance.products.tile).then(|| {
+            "appearance.outputs must include \"tile\" in a study (the merge compares the \
+             variants' colours and tiles)"
+                .into()
+        })
+    }
+}
+
+impl VariantScene for PaintScene {
+    const PAINT: bool = true;
+    const SEEDED: bool = false;
+    fn parse(path: &Path, text: &str) -> Result<Self, ConfigError> {
+        crate::config::parse_paint(path, text)
+    }
+    fn study_problem(&self) -> Option<String> {
+        None
+    }
+}
+
+/// One expanded variant: a named, seeded, validated scene (a wave-optics
+/// layer's, or an effect paint's with `S = PaintScene`).
 #[derive(Debug, Clone)]
-pub struct Variant {
+pub struct Variant<S = Scene> {
     /// Position in the expansion order (what shards split on).
     pub index: usize,
     /// First 8 hex digits of SHA-256(name).
@@ -163,10 +216,10 @@ pub struct Variant {
     pub seed: u64,
     /// The exact scene TOML (embedded in the result file).
     pub text: String,
-    pub scene: Scene,
+    pub scene: S,
 }
 
-impl Variant {
+impl<S> Variant<S> {
     /// This variant's label on `axis`, if any.
     pub fn label(&self, axis: &str) -> Option<&str> {
         self.labels
@@ -178,12 +231,12 @@ impl Variant {
 
 /// The variants of a study for one profile.
 #[derive(Debug, Clone)]
-pub struct Expansion {
+pub struct Expansion<S = Scene> {
     /// The profile used (`None` when the study has no profiles).
     pub profile: Option<String>,
     /// `<output_dir>/<profile>` (or `<output_dir>` without profiles).
     pub study_dir: PathBuf,
-    pub variants: Vec<Variant>,
+    pub variants: Vec<Variant<S>>,
     /// The `--only` restrictions that chose these variants (empty: all).
     pub selection: Vec<Selection>,
 }
@@ -285,6 +338,12 @@ impl Study {
             Some(p) => self.output_dir.join(p),
             None => self.output_dir.clone(),
         }
+    }
+
+    /// Whether the base is an effect paint (a `[paint]` table): its variants
+    /// are expanded by [`Study::expand_paint`] and run by the fast model.
+    pub fn is_paint(&self) -> bool {
+        self.base.get("paint").is_some_and(Value::is_table)
     }
 
     /// Number of combinations of the product (before exclusions).

@@ -63,6 +63,9 @@ pub(super) struct RawAxisValue {
     pub label: String,
     #[serde(default)]
     pub set: Table,
+    /// Key paths to remove (`paint.layer.clearcoat`: a layer by its name).
+    #[serde(default)]
+    pub remove: Vec<String>,
 }
 
 /// `[[variant]]`: an explicit variant.

@@ -44,7 +44,7 @@ impl std::fmt::Display for Selection {
     }
 }
 
-impl Expansion {
+impl<S> Expansion<S> {
     /// Keep only the variants every selection admits. An unknown axis or
     /// label, or a selection that keeps nothing, is an error naming what the
     /// study has.

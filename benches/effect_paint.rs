@@ -1,81 +1,64 @@
 //! Cost of the fast effect-paint model (METHOD §10): the whole BRDF (every
-//! Fourier term on the adding–doubling nodes) of a three-layer metallic
-//! paint — clear coat, a base coat of aluminium flakes with an absorbing
-//! pigment, a scattering primer — on a diffuse ground, at 31 wavelengths
-//! (400–700 nm), the wavelengths in parallel. `cargo bench --bench
-//! effect_paint` (figures in docs/PERFORMANCE.md).
+//! Fourier term on the adding–doubling nodes) of configs/metallic.toml —
+//! clear coat, a base coat of aluminium flakes, a primer of white and black
+//! Mie pigments, on a white ground — at its 31 wavelengths (400–700 nm),
+//! the wavelengths in parallel, layers built from the config as a run builds
+//! them; and configs/pearl.toml the same. The reference in the same run: a
+//! thousand products of two 33 × 33 matrices (the size of the model's flux
+//! matrices), a yardstick of the machine's speed at that moment, so the
+//! ratio model / reference carries over between machines and loads.
+//! `cargo bench --bench effect_paint` (figures in docs/PERFORMANCE.md).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use inksim::optics::baseline::doubling::Medium;
-use inksim::optics::flakes::kernel::FlakeMedium;
-use inksim::optics::flakes::normals::Orientation;
-use inksim::optics::flakes::paint::{self, Ground, ModelParams, PaintLayer};
-use inksim::optics::flakes::reflector::{Layer, Reflector};
-use num_complex::Complex64 as C64;
+use inksim::config::paint::PaintScene;
+use inksim::optics::baseline::matrix::Matrix;
+use inksim::pipeline::paint::{model_params, paint_air_directions, reflect_at};
 use rayon::prelude::*;
+use std::path::Path;
 
-const AIR: [f64; 9] = [0.0, 10.0, 15.0, 20.0, 30.0, 45.0, 60.0, 65.0, 8.0];
-
-fn layers(wavelength_nm: f64) -> Vec<PaintLayer> {
-    let aluminium = Reflector::Metal(Layer {
-        index: C64::new(0.96, 6.69),
-        thickness_nm: 100.0,
-        thickness_sd_nm: 20.0,
-    });
-    let medium = |mu_a: f64, mu_s: f64, g: f64| Medium {
-        mu_a,
-        mu_s,
-        moments: (0..12).map(|l| g.powi(l)).collect(),
-    };
-    vec![
-        PaintLayer {
-            thickness_nm: 40_000.0,
-            pigments: medium(1e-7, 0.0, 0.0),
-            flakes: None,
-        },
-        PaintLayer {
-            thickness_nm: 15_000.0,
-            pigments: medium(2e-5 * (550.0 / wavelength_nm), 5e-6, 0.2),
-            flakes: Some(FlakeMedium {
-                area_per_nm: 8e-5,
-                orientation: Orientation {
-                    sigma_rad: 10f64.to_radians(),
-                },
-                table: aluminium.table(1.5, wavelength_nm),
-            }),
-        },
-        PaintLayer {
-            thickness_nm: 20_000.0,
-            pigments: medium(1e-5, 2e-4, 0.5),
-            flakes: None,
-        },
-    ]
+fn scene(name: &str) -> PaintScene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("configs/{name}.toml"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    inksim::config::parse_paint(&path, &text).unwrap()
 }
 
-fn full_brdf() -> usize {
-    let grid: Vec<f64> = (0..31).map(|i| 400.0 + 10.0 * i as f64).collect();
-    grid.par_iter()
-        .map(|&l| {
-            paint::reflect(
-                1.5,
-                &layers(l),
-                Ground::Lambertian { albedo: 0.8 },
-                l,
-                &AIR,
-                &ModelParams::default(),
-            )
-            .unwrap()
-            .terms
-            .len()
-        })
+/// The whole BRDF at every wavelength; the Fourier terms solved.
+fn full_brdf(scene: &PaintScene) -> usize {
+    let air = paint_air_directions(scene);
+    let params = model_params(scene);
+    scene
+        .wavelengths_nm
+        .par_iter()
+        .map(|&l| reflect_at(scene, &params, &air, l).unwrap().terms.len())
         .sum()
+}
+
+fn products(a: &Matrix, b: &Matrix) -> f64 {
+    let mut s = 0.0;
+    for _ in 0..1000 {
+        s += std::hint::black_box(a).mul(std::hint::black_box(b))[(3, 5)];
+    }
+    s
 }
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("effect_paint");
     g.sample_size(10);
-    g.bench_function("three_layers_31_wavelengths", |b| b.iter(full_brdf));
-    eprintln!("Fourier terms over the 31 wavelengths: {}", full_brdf());
+    let a = Matrix::from_fn(33, |i, j| 1.0 / (1.0 + i as f64 + 2.0 * j as f64));
+    let b = Matrix::from_fn(33, |i, j| ((i * 7 + j * 3) % 11) as f64 / 11.0);
+    g.bench_function("reference_1000_products_33", |bn| {
+        bn.iter(|| products(&a, &b))
+    });
+    for name in ["metallic", "pearl"] {
+        let s = scene(name);
+        g.bench_function(format!("{name}_31_wavelengths"), |bn| {
+            bn.iter(|| full_brdf(&s))
+        });
+        eprintln!(
+            "{name}: Fourier terms over the 31 wavelengths: {}",
+            full_brdf(&s)
+        );
+    }
     g.finish();
 }
 

@@ -233,3 +233,51 @@ fn three_layer_paint(absorbing: bool, spread_deg: f64, albedo: f64) -> paint::Pa
     )
     .unwrap()
 }
+
+/// The pigments' azimuthal terms by the addition theorem against the
+/// azimuthal integral itself, `p_m = (1/2π) ∫ p(cos Θ) cos mΔφ dΔφ` by the
+/// trapezoidal rule on 2048 azimuths (exact for the Legendre series' degree),
+/// for a Henyey–Greenstein phase function of 40 moments, both hemispheres.
+#[test]
+fn the_pigment_terms_match_the_azimuthal_integral() {
+    use inksim::optics::baseline::doubling::phase_series;
+    use inksim::optics::baseline::ordinates::{OrdinateParams, Ordinates};
+    use inksim::optics::flakes::kernel::pigment_kernels;
+    let ords = Ordinates::new(LACQUER, OrdinateParams::default(), &AIR).unwrap();
+    let medium = Medium {
+        mu_a: 0.0,
+        mu_s: 1e-4,
+        moments: hg(0.7, 40),
+    };
+    let (mu_s, chi) = medium.delta_m(2 * ords.len());
+    let modes = 24;
+    let k = pigment_kernels(&ords, &medium, modes);
+    let steps = 2048;
+    let (mut worst, mut scale) = (0.0f64, 0.0f64);
+    let n = ords.len();
+    let sin: Vec<f64> = ords.mu.iter().map(|m| (1.0 - m * m).sqrt()).collect();
+    for (m, km) in k.iter().enumerate().skip(1) {
+        for i in 0..n {
+            for j in 0..n {
+                for (sign, got) in [(1.0, km.same[(i, j)]), (-1.0, km.opposite[(i, j)])] {
+                    let p: f64 = (0..steps)
+                        .map(|q| {
+                            let dphi = 2.0 * std::f64::consts::PI * q as f64 / steps as f64;
+                            let x = sign * ords.mu[i] * ords.mu[j] + sin[i] * sin[j] * dphi.cos();
+                            phase_series(&chi, x) * (m as f64 * dphi).cos()
+                        })
+                        .sum::<f64>()
+                        / steps as f64;
+                    let exact = 0.5 * mu_s * ords.weight[i] * p / ords.mu[j];
+                    worst = worst.max((got - exact).abs());
+                    scale = scale.max(exact.abs());
+                }
+            }
+        }
+    }
+    eprintln!(
+        "pigment terms 1–{}: worst |Δ| {worst:.1e} of {scale:.1e}",
+        modes - 1
+    );
+    assert!(worst < 1e-12 * scale, "{worst} of {scale}");
+}

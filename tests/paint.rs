@@ -254,8 +254,20 @@ fn the_metallic_and_pearl_configs_run_and_export() {
             "{stderr}"
         );
         let h5 = out.join(format!("{name}.h5"));
-        for f in [format!("{name}.png"), format!("{name}-flop.png")] {
-            assert!(out.join(&f).is_file(), "{f}");
+        let pictures = [
+            format!("{name}.png"),
+            format!("{name}-flop.png"),
+            format!("{name}-sparkle.png"),
+        ];
+        for f in &pictures {
+            assert!(out.join(f).is_file(), "{f}");
+        }
+        assert!(stdout.contains(&format!("{name}-sparkle.png")), "{stdout}");
+        // `check` lists every file a run writes.
+        let (ok, listed, stderr) = inksim_in(dir.path(), &["check", config.to_str().unwrap()]);
+        assert!(ok, "{stderr}");
+        for f in &pictures {
+            assert!(listed.contains(f.as_str()), "{f} not in {listed}");
         }
         let p = read_paint(&h5).unwrap();
         assert_eq!(p.colours.len(), 11);

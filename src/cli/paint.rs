@@ -67,6 +67,7 @@ pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
     println!("results: {}", report.result_path.display());
     println!("picture: {}", report.picture_path.display());
     println!("plot: {}", report.flop_path.display());
+    println!("sparkle: {}", report.sparkle_path.display());
     println!(
         "multi-angle colour ({}, {}°):",
         scene.illuminant.name(),

@@ -166,6 +166,8 @@ pub struct SparkleSpec {
     pub viewing_distance_mm: f64,
     pub illumination_deg: Vec<f64>,
     pub acceptance_deg: f64,
+    /// Seed of the sparkle texture's glints.
+    pub seed: u64,
 }
 
 /// Resolution of the fast model; None: the model's default.

@@ -120,6 +120,7 @@ pub struct RawSparkle {
     pub viewing_distance_mm: Option<f64>,
     pub illumination_deg: Option<Vec<f64>>,
     pub acceptance_deg: Option<f64>,
+    pub seed: Option<u64>,
 }
 
 /// `[paint.model]`.

@@ -3,36 +3,35 @@
 //! (lacquer absorption, the ordinary pigments' Mie medium, the flakes'
 //! reflectance table and orientation), solved by `optics::flakes::paint`
 //! (the wavelengths in parallel), then the in-plane BRDF, the multi-angle
-//! colours and flop index, the sparkle figures, the pictures and the result
-//! file.
+//! colours and flop index, the sparkle figures and texture
+//! (`paint_sparkle`), the pictures and the result file.
 
 use std::path::PathBuf;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
 use ndarray::{Array2, Array3};
-use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 
-use crate::config::paint::{FilmSpec, PaintGround, PaintScene, ReflectorSpec};
-use crate::config::{Equation, Material};
+use crate::config::paint::{PaintGround, PaintScene};
+use crate::config::Equation;
 use crate::optics::baseline::doubling::Medium;
 use crate::optics::baseline::ordinates::OrdinateParams;
 use crate::optics::baseline::{transfer, BaselineInput, BaselineSpecies};
-use crate::optics::colour::{self, Observer};
+use crate::optics::colour::Observer;
 use crate::optics::flakes::kernel::FlakeMedium;
 use crate::optics::flakes::multiangle;
 use crate::optics::flakes::normals::Orientation;
 use crate::optics::flakes::paint::{
     self as model, Ground, ModelParams, PaintLayer, PaintReflection,
 };
-use crate::optics::flakes::reflector::{Layer as Film, Reflector};
-use crate::optics::flakes::sparkle;
 use crate::output::atomic;
-use crate::output::h5::{self, AngleRecord, Identity, PaintResultSet, SparkleRecord, SparkleTable};
+use crate::output::h5::{self, AngleRecord, Identity, PaintResultSet, SparkleTable};
 use crate::output::progress::Progress;
 use crate::output::render::multiangle::{flop_png, patches_png, PatchCaption};
 
-use super::{check_output_dir, PipelineError};
+pub use super::paint_optics::lacquer_index;
+use super::paint_optics::{index, reflector};
+use super::{check_output_dir, paint_sparkle, PipelineError};
 
 /// What a paint run wrote and found.
 #[derive(Debug, Clone)]
@@ -40,21 +39,34 @@ pub struct PaintReport {
     pub result_path: PathBuf,
     pub picture_path: PathBuf,
     pub flop_path: PathBuf,
+    pub sparkle_path: PathBuf,
     pub colours: Vec<AngleRecord>,
     pub flop_index: Option<f64>,
     pub sparkle: Option<SparkleTable>,
     pub seconds: f64,
 }
 
-/// The files a paint run writes: the result, the patches and the flop
-/// plot.
-pub fn paint_files(scene: &PaintScene) -> [PathBuf; 3] {
+/// The files a paint run writes: the result, the patches, the flop plot
+/// and the sparkle texture.
+pub fn paint_files(scene: &PaintScene) -> [PathBuf; 4] {
     let (d, n) = (&scene.output.dir, &scene.output.name);
     [
         d.join(format!("{n}.h5")),
         d.join(format!("{n}.png")),
         d.join(format!("{n}-flop.png")),
+        d.join(format!("{n}-sparkle.png")),
     ]
+}
+
+/// The air directions the model solves on: the multi-angle geometries'
+/// and the sparkle lights' (each an air node, so that the texture's colour
+/// under each light is the BRDF's own).
+pub fn paint_air_directions(scene: &PaintScene) -> Vec<f64> {
+    let mut d = multiangle::air_directions();
+    d.extend(scene.sparkle.illumination_deg.iter().copied());
+    d.sort_by(f64::total_cmp);
+    d.dedup();
+    d
 }
 
 /// The plan of a paint run, one line per part.
@@ -104,7 +116,7 @@ pub fn paint_plan(scene: &PaintScene) -> Vec<String> {
 }
 
 /// The model's resolution from the scene's `[paint.model]`.
-fn model_params(scene: &PaintScene) -> ModelParams {
+pub fn model_params(scene: &PaintScene) -> ModelParams {
     let d = ModelParams::default();
     let m = scene.model;
     ModelParams {
@@ -115,41 +127,6 @@ fn model_params(scene: &PaintScene) -> ModelParams {
         max_terms: m.max_terms.unwrap_or(d.max_terms),
         ..d
     }
-}
-
-fn index(m: &Material, wavelength_nm: f64) -> Result<C64, PipelineError> {
-    m.index_at(wavelength_nm)
-        .ok_or_else(|| PipelineError::Material {
-            material: m.to_string(),
-            wavelength_nm,
-        })
-}
-
-/// The paint's lacquer index at a wavelength: the top layer's real part.
-fn lacquer_index(scene: &PaintScene, wavelength_nm: f64) -> Result<f64, PipelineError> {
-    Ok(index(&scene.layers[0].lacquer, wavelength_nm)?.re)
-}
-
-fn film(f: &FilmSpec, wavelength_nm: f64) -> Result<Film, PipelineError> {
-    Ok(Film {
-        index: index(&f.material, wavelength_nm)?,
-        thickness_nm: f.thickness_nm,
-        thickness_sd_nm: f.thickness_sd_nm,
-    })
-}
-
-/// A flake's optics at a wavelength.
-fn reflector(r: &ReflectorSpec, wavelength_nm: f64) -> Result<Reflector, PipelineError> {
-    Ok(match r {
-        ReflectorSpec::Metal { film: f } => Reflector::Metal(film(f, wavelength_nm)?),
-        ReflectorSpec::Spectrum { reflectance, .. } => {
-            Reflector::Spectrum(reflectance.at(wavelength_nm))
-        }
-        ReflectorSpec::Coated { substrate, coating } => Reflector::Coated {
-            coating: film(coating, wavelength_nm)?,
-            substrate: film(substrate, wavelength_nm)?,
-        },
-    })
 }
 
 /// The flakes' orientation at a wavelength (with the diffraction lobe of a
@@ -168,7 +145,7 @@ fn orientation(
 }
 
 /// The model's layers at one wavelength.
-fn layers_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Vec<PaintLayer>, PipelineError> {
+pub fn layers_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Vec<PaintLayer>, PipelineError> {
     let n = lacquer_index(scene, wavelength_nm)?;
     let mut out = Vec::with_capacity(scene.layers.len());
     for l in &scene.layers {
@@ -228,7 +205,8 @@ fn layers_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Vec<PaintLayer>, 
     Ok(out)
 }
 
-fn ground_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Ground, PipelineError> {
+/// What the paint lies on at one wavelength.
+pub fn ground_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Ground, PipelineError> {
     Ok(match &scene.ground {
         PaintGround::Black => Ground::Black,
         PaintGround::Lambertian(g) => Ground::Lambertian {
@@ -240,12 +218,31 @@ fn ground_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Ground, PipelineE
     })
 }
 
-/// The paint's reflection at one wavelength, escaping into `air`.
-fn reflect_at(
+/// The paint's reflection at every wavelength, in parallel, with progress.
+fn solve(
     scene: &PaintScene,
-    wavelength_nm: f64,
-    air: &[f64],
     params: &ModelParams,
+    progress: &Progress,
+) -> Result<Vec<PaintReflection>, PipelineError> {
+    let air = paint_air_directions(scene);
+    scene
+        .wavelengths_nm
+        .par_iter()
+        .map(|&wl| {
+            let r = reflect_at(scene, params, &air, wl)?;
+            progress.inc(1, &format!("{wl} nm: {} Fourier terms", r.terms.len()));
+            Ok(r)
+        })
+        .collect()
+}
+
+/// The paint's reflection at one wavelength on the air directions `air`
+/// ([`paint_air_directions`]).
+pub fn reflect_at(
+    scene: &PaintScene,
+    params: &ModelParams,
+    air: &[f64],
+    wavelength_nm: f64,
 ) -> Result<PaintReflection, PipelineError> {
     Ok(model::reflect(
         lacquer_index(scene, wavelength_nm)?,
@@ -255,24 +252,6 @@ fn reflect_at(
         air,
         params,
     )?)
-}
-
-/// The paint's reflection at every wavelength, in parallel, with progress.
-fn solve(
-    scene: &PaintScene,
-    params: &ModelParams,
-    progress: &Progress,
-) -> Result<Vec<PaintReflection>, PipelineError> {
-    let air = multiangle::air_directions();
-    scene
-        .wavelengths_nm
-        .par_iter()
-        .map(|&wl| {
-            let r = reflect_at(scene, wl, &air, params)?;
-            progress.inc(1, &format!("{wl} nm: {} Fourier terms", r.terms.len()));
-            Ok(r)
-        })
-        .collect()
 }
 
 /// The air polar angles of the escaping nodes, in node order, and the
@@ -328,87 +307,6 @@ fn in_plane(reflections: &[PaintReflection]) -> Result<InPlane, PipelineError> {
     })
 }
 
-/// The sparkle figures: every flake layer's flakes (their glints add, as
-/// independent Poisson counts), the glint's luminous reflectance weighted
-/// by the glints of each layer.
-fn sparkle_table(
-    scene: &PaintScene,
-    obs: &Observer,
-) -> Result<Option<SparkleTable>, PipelineError> {
-    let wl = &scene.wavelengths_nm;
-    let mid = wl[wl.len() / 2];
-    let n = lacquer_index(scene, mid)?;
-    let sp = &scene.sparkle;
-    let cell = sparkle::cell_area_mm2(sp.viewing_distance_mm, sparkle::ARCMINUTE_RAD);
-    let acceptance = sp.acceptance_deg.to_radians();
-    let flaked: Vec<_> = scene
-        .layers
-        .iter()
-        .filter_map(|l| l.flakes.as_ref().map(|f| (l, f)))
-        .collect();
-    if flaked.is_empty() {
-        return Ok(None);
-    }
-    let mut flakes_per_mm2 = 0.0;
-    let mut rows: Vec<SparkleRecord> = sp
-        .illumination_deg
-        .iter()
-        .map(|&deg| SparkleRecord {
-            illumination_deg: deg,
-            glints_per_mm2: 0.0,
-            glints_per_cell: 0.0,
-            glint_reflectance: 0.0,
-        })
-        .collect();
-    for (l, f) in flaked {
-        let per_mm2 = sparkle::flakes_per_mm2(
-            f.volume_fraction,
-            l.thickness_um,
-            f.mean_square_diameter_um2().sqrt(),
-            f.thickness_nm() / 1000.0,
-        );
-        flakes_per_mm2 += per_mm2;
-        let o = Orientation {
-            sigma_rad: f.orientation_sd_deg.to_radians(),
-        };
-        for row in &mut rows {
-            let s = sparkle::sparkle(per_mm2, &o, n, cell, acceptance, Some(row.illumination_deg));
-            let cos_local = sparkle::half_vector_tilt(row.illumination_deg, n).cos();
-            let spectrum = wl
-                .iter()
-                .map(|&w| {
-                    let ni = lacquer_index(scene, w)?;
-                    Ok(reflector(&f.reflector, w)?.powers(ni, w, cos_local).r)
-                })
-                .collect::<Result<Vec<f64>, PipelineError>>()?;
-            let y = colour::xyz_from_reflectance(obs, wl, &spectrum)
-                .map_err(crate::optics::baseline::BaselineError::from)?[1]
-                / 100.0;
-            row.glint_reflectance += s.glints_per_mm2 * y;
-            row.glints_per_mm2 += s.glints_per_mm2;
-            row.glints_per_cell += s.glints_per_cell;
-        }
-    }
-    for row in &mut rows {
-        if row.glints_per_mm2 > 0.0 {
-            row.glint_reflectance /= row.glints_per_mm2;
-        }
-    }
-    let per_cell = flakes_per_mm2 * cell;
-    Ok(Some(SparkleTable {
-        viewing_distance_mm: sp.viewing_distance_mm,
-        acceptance_deg: sp.acceptance_deg,
-        cell_area_mm2: cell,
-        flakes_per_mm2,
-        graininess: if per_cell > 0.0 {
-            1.0 / per_cell.sqrt()
-        } else {
-            0.0
-        },
-        rows,
-    }))
-}
-
 /// What the fast model did at one wavelength ([`probe_paint`]).
 #[derive(Debug, Clone, Copy)]
 pub struct PaintProbe {
@@ -421,8 +319,8 @@ pub struct PaintProbe {
 
 /// The fast model of `scene` at one wavelength (what `plan` times).
 pub fn probe_paint(scene: &PaintScene, wavelength_nm: f64) -> Result<PaintProbe, PipelineError> {
-    let air = multiangle::air_directions();
-    let r = reflect_at(scene, wavelength_nm, &air, &model_params(scene))?;
+    let air = paint_air_directions(scene);
+    let r = reflect_at(scene, &model_params(scene), &air, wavelength_nm)?;
     let square: usize = r.terms.iter().map(|m| m.size() * m.size()).sum();
     Ok(PaintProbe {
         terms: r.terms.len(),
@@ -434,7 +332,7 @@ pub fn probe_paint(scene: &PaintScene, wavelength_nm: f64) -> Result<PaintProbe,
 pub fn run_paint(scene: &PaintScene, quiet: bool) -> Result<PaintReport, PipelineError> {
     let start = Instant::now();
     check_output_dir(&scene.output.dir)?;
-    let [result_path, picture_path, flop_path] = paint_files(scene);
+    let [result_path, picture_path, flop_path, sparkle_path] = paint_files(scene);
     let plan = paint_plan(scene);
     let total = scene.wavelengths_nm.len() as u64;
     let progress = if quiet {
@@ -473,7 +371,7 @@ pub fn run_paint(scene: &PaintScene, quiet: bool) -> Result<PaintReport, Pipelin
             lch: c.lch,
         })
         .collect();
-    let sparkle = sparkle_table(scene, &obs)?;
+    let sparkle = paint_sparkle::sparkle_table(scene, &obs)?;
     let plane = in_plane(&reflections)?;
     let terms: Vec<u64> = reflections.iter().map(|r| r.terms.len() as u64).collect();
 
@@ -504,6 +402,10 @@ pub fn run_paint(scene: &PaintScene, quiet: bool) -> Result<PaintReport, Pipelin
     )?;
     atomic::write_atomic(&picture_path, &tile)?;
     atomic::write_atomic(&flop_path, &flop)?;
+    let textures = paint_sparkle::textures(scene, &obs, &reflections)?;
+    let graininess = sparkle.as_ref().map_or(0.0, |s| s.graininess);
+    let texture = paint_sparkle::texture_png(scene, &obs, &conditions, &textures, graininess)?;
+    atomic::write_atomic(&sparkle_path, &texture)?;
     let mut plan_lines = plan;
     plan_lines.push(format!(
         "Fourier terms kept per wavelength: {}–{}",
@@ -546,6 +448,7 @@ pub fn run_paint(scene: &PaintScene, quiet: bool) -> Result<PaintReport, Pipelin
         result_path,
         picture_path,
         flop_path,
+        sparkle_path,
         colours,
         flop_index,
         sparkle,

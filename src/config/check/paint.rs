@@ -370,6 +370,7 @@ impl Checker<'_> {
             viewing_distance_mm,
             illumination_deg,
             acceptance_deg,
+            seed: raw.and_then(|s| s.seed).unwrap_or(1),
         })
     }
 

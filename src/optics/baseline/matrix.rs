@@ -164,15 +164,24 @@ impl Matrix {
         if b[row * n..].iter().any(|v| v.abs() > tolerance) {
             return Err(BaselineError::Singular);
         }
+        // Back substitution a row of X at a time (contiguous rows).
         let mut x = vec![0.0; n * n];
         for (r, &col) in pivots.iter().enumerate().rev() {
             let p = a[r * n + col];
-            for k in 0..n {
-                let mut v = b[r * n + k];
-                for c in col + 1..n {
-                    v -= a[r * n + c] * x[c * n + k];
+            let (done, rest) = x.split_at_mut((col + 1) * n);
+            let target = &mut done[col * n..];
+            target.copy_from_slice(&b[r * n..(r + 1) * n]);
+            for (c, xc) in rest.chunks_exact(n).enumerate() {
+                let f = a[r * n + col + 1 + c];
+                if f == 0.0 {
+                    continue;
                 }
-                x[col * n + k] = v / p;
+                for (t, v) in target.iter_mut().zip(xc) {
+                    *t -= f * v;
+                }
+            }
+            for t in target.iter_mut() {
+                *t /= p;
             }
         }
         Ok(Matrix { n, data: x })

@@ -40,12 +40,14 @@
 //! the baseline's grain models, δ-M truncated): term 0 is the baseline's
 //! azimuth-averaged phase matrix with its energy correction; term `m ≥ 1` is
 //! `μs w_i p_m(μ_i, μ_j)/(2 μ_j)` with `p_m = (1/2π) ∫ p(cos Θ) cos(mΔφ)
-//! dΔφ` by the trapezoidal rule on enough azimuths to be exact for the
-//! Legendre series (a trigonometric polynomial of degree `L` in `Δφ`).
+//! dΔφ`, by the addition theorem of the Legendre polynomials `p_m(μ, μ') =
+//! Σ_{l≥m} (2l + 1) χ_l (l − m)!/(l + m)! P_l^m(μ) P_l^m(μ')` (exact for
+//! the truncated series; `tests/effect_paint.rs` checks it against the
+//! azimuthal integral by quadrature).
 
 use super::normals::Orientation;
 use super::reflector::LocalTable;
-use crate::optics::baseline::doubling::{phase_matrices, phase_series, FluxKernel, Medium};
+use crate::optics::baseline::doubling::{phase_matrices, FluxKernel, Medium};
 use crate::optics::baseline::matrix::Matrix;
 use crate::optics::baseline::ordinates::{gauss_legendre, Ordinates};
 use std::f64::consts::PI;
@@ -128,51 +130,38 @@ pub fn pigment_kernels(ords: &Ordinates, medium: &Medium, modes: usize) -> Vec<F
     if modes <= 1 {
         return out;
     }
-    // Terms m ≥ 1 by the trapezoidal rule in Δφ.
+    // Terms m ≥ 1 by the addition theorem: p_m(μ_i, μ_j) = Σ_{l≥m} (2l + 1)
+    // χ_l q_l^m(μ_i) q_l^m(μ_j), q_l^m = √((l − m)!/(l + m)!) P_l^m, and
+    // q_l^m(−μ) = (−1)^{l+m} q_l^m(μ) for the opposite hemisphere.
     let degree = chi.len();
-    let steps = 2 * (degree + modes) + 8;
-    let sin: Vec<f64> = ords
-        .mu
-        .iter()
-        .map(|mu| (1.0 - mu * mu).max(0.0).sqrt())
-        .collect();
-    let phase = |x: f64| phase_series(&chi, x);
+    let top = modes.min(degree);
+    let q = normalised_legendre(&ords.mu, degree, top);
     let mut terms_same = vec![Matrix::zeros(n); modes];
     let mut terms_opp = vec![Matrix::zeros(n); modes];
-    // The integrand is even in Δφ: the nodes q and steps − q coincide, so
-    // the half range [0, π] is summed with each inner node counted twice.
-    let half = steps / 2;
-    let azimuths: Vec<(f64, f64, Vec<f64>)> = (0..=half)
-        .map(|q| {
-            let dphi = 2.0 * PI * q as f64 / steps as f64;
-            let twice = q != 0 && 2 * q != steps;
-            let weight = if twice { 2.0 } else { 1.0 } / steps as f64;
-            (
-                dphi.cos(),
-                weight,
-                (0..modes).map(|m| (m as f64 * dphi).cos()).collect(),
-            )
-        })
-        .collect();
-    let (mut acc_same, mut acc_opp) = (vec![0.0; modes], vec![0.0; modes]);
-    // Symmetric in (i, j): the phase function's argument is.
-    for i in 0..n {
-        for j in i..n {
-            acc_same.iter_mut().for_each(|v| *v = 0.0);
-            acc_opp.iter_mut().for_each(|v| *v = 0.0);
-            for (cos_dphi, weight, cs) in &azimuths {
-                let ss = sin[i] * sin[j] * cos_dphi;
-                let ps = weight * phase(ords.mu[i] * ords.mu[j] + ss);
-                let po = weight * phase(-ords.mu[i] * ords.mu[j] + ss);
-                for m in 1..modes {
-                    acc_same[m] += ps * cs[m];
-                    acc_opp[m] += po * cs[m];
+    for (m, (same_m, opp_m)) in terms_same
+        .iter_mut()
+        .zip(terms_opp.iter_mut())
+        .enumerate()
+        .take(top)
+        .skip(1)
+    {
+        for i in 0..n {
+            let qi = &q[(i * top + m) * degree..(i * top + m + 1) * degree];
+            for j in i..n {
+                let qj = &q[(j * top + m) * degree..(j * top + m + 1) * degree];
+                // The sums over even and odd l − m.
+                let (mut even, mut odd) = (0.0, 0.0);
+                for l in m..degree {
+                    let v = (2 * l + 1) as f64 * chi[l] * qi[l] * qj[l];
+                    if (l - m) % 2 == 0 {
+                        even += v;
+                    } else {
+                        odd += v;
+                    }
                 }
-            }
-            for m in 1..modes {
                 for (a, b) in [(i, j), (j, i)] {
-                    terms_same[m][(a, b)] = acc_same[m];
-                    terms_opp[m][(a, b)] = acc_opp[m];
+                    same_m[(a, b)] = even + odd;
+                    opp_m[(a, b)] = even - odd;
                 }
             }
         }
@@ -185,6 +174,40 @@ pub fn pigment_kernels(ords: &Ordinates, medium: &Medium, modes: usize) -> Vec<F
         });
     }
     out
+}
+
+/// `q_l^m(μ) = √((l − m)!/(l + m)!) P_l^m(μ)` (no Condon–Shortley sign) of
+/// every node, order `m < orders` and degree `l < degree`, at
+/// `[(node · orders + m) · degree + l]` (0 for `l < m`), by the stable
+/// recurrences `q_m^m = √((2m − 1)/(2m)) √(1 − μ²) q_{m−1}^{m−1}`,
+/// `q_{m+1}^m = √(2m + 1) μ q_m^m` and `√(l² − m²) q_l^m = (2l − 1) μ
+/// q_{l−1}^m − √((l − 1)² − m²) q_{l−2}^m`.
+fn normalised_legendre(mu: &[f64], degree: usize, orders: usize) -> Vec<f64> {
+    let mut q = vec![0.0; mu.len() * orders * degree];
+    for (i, &x) in mu.iter().enumerate() {
+        let s = (1.0 - x * x).max(0.0).sqrt();
+        let mut diagonal = 1.0;
+        for m in 0..orders {
+            if m > 0 {
+                diagonal *= ((2 * m - 1) as f64 / (2 * m) as f64).sqrt() * s;
+            }
+            let row = &mut q[(i * orders + m) * degree..(i * orders + m + 1) * degree];
+            if m >= degree {
+                continue;
+            }
+            row[m] = diagonal;
+            if m + 1 < degree {
+                row[m + 1] = ((2 * m + 1) as f64).sqrt() * x * diagonal;
+            }
+            for l in m + 2..degree {
+                let (lf, mf) = (l as f64, m as f64);
+                row[l] = ((2 * l - 1) as f64 * x * row[l - 1]
+                    - ((lf - 1.0) * (lf - 1.0) - mf * mf).sqrt() * row[l - 2])
+                    / (lf * lf - mf * mf).sqrt();
+            }
+        }
+    }
+    q
 }
 
 /// The flakes' kernels per nm of thickness (reciprocal, energy-consistent).
@@ -312,7 +335,6 @@ fn integrate_lobes(
 ) {
     let n = ords.len();
     let sigma = flakes.orientation.sigma_rad;
-    let density = flakes.orientation.density();
     let a = flakes.area_per_nm;
     let azimuths = ((8.0 * PI / sigma).ceil() as usize).clamp(128, 2048);
     let dphi = PI / azimuths as f64;
@@ -344,53 +366,83 @@ fn integrate_lobes(
         cells.push((lo, hi));
         lo = hi;
     }
+    // The Gauss–Legendre rules of 3 to 24 points, once.
+    let rules: Vec<(Vec<f64>, Vec<f64>)> = (0..=24).map(|p| gauss_legendre(p.max(1))).collect();
+    // The density against the half vector's cosine, tabulated (no `acos`,
+    // no `exp` in the loop). At a fixed `μ_o` the half vector leans further
+    // as the azimuth from the mirror side grows (`|ω − o|² = 2 − 2 ω·o`
+    // grows while its `z` part stays), so the azimuths it reaches within
+    // the density's extent are a leading run: the loop stops at the first
+    // beyond.
+    let table = flakes.orientation.density_table();
     let mut profile = vec![0.0; azimuths];
+    // Per cell and hemisphere, the azimuthal profile summed over the cell's
+    // points (the projection on `cos mφ` is linear, so it is done once per
+    // cell), and how far it reaches.
+    let mut cell_profile = [vec![0.0; azimuths], vec![0.0; azimuths]];
     let mut coefficients = vec![0.0; modes];
     for j in 0..n {
         let mu_j = ords.mu[j];
         let wj = [(1.0 - mu_j * mu_j).max(0.0).sqrt(), 0.0, mu_j];
+        let scale = 0.25 * a / mu_j;
         for (k, &(lo, hi)) in cells.iter().enumerate() {
             let span = (lo.clamp(0.0, 1.0).acos() - hi.clamp(0.0, 1.0).acos()).abs();
             let points = ((2.0 * span / sigma).ceil() as usize).clamp(3, 24);
-            let (x, w) = gauss_legendre(points);
-            for (x, w) in x.iter().zip(&w) {
+            let (x, w) = &rules[points];
+            let mut reach = [0usize; 2];
+            for (x, w) in x.iter().zip(w) {
                 let mu_o = lo + 0.5 * (hi - lo) * (x + 1.0);
                 let weight = 0.5 * (hi - lo) * w;
                 let sin_o = (1.0 - mu_o * mu_o).max(0.0).sqrt();
-                for (sign, target) in [(1.0, &mut *same), (-1.0, &mut *opp)] {
-                    let mut any = false;
+                for (side, sign) in [1.0, -1.0].into_iter().enumerate() {
+                    let vz = wj[2] - sign * mu_o;
+                    let mut end = 0;
                     for (q, &(c, s)) in phis.iter().enumerate() {
-                        let o = [sin_o * c, sin_o * s, sign * mu_o];
-                        let v = [wj[0] - o[0], wj[1] - o[1], wj[2] - o[2]];
+                        let v = [wj[0] - sin_o * c, -sin_o * s, vz];
                         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                        profile[q] = 0.0;
                         if len < 1e-12 {
+                            profile[q] = 0.0;
+                            end = q + 1;
                             continue;
                         }
-                        let d = density((v[2] / len).abs().clamp(0.0, 1.0).acos());
-                        if d == 0.0 {
-                            continue;
+                        let cos_h = vz.abs() / len;
+                        if cos_h < table.lo {
+                            break;
                         }
+                        let d = table.at_cos(cos_h).max(0.0);
                         let local = (wj[0] * v[0] + wj[2] * v[2]).abs() / len;
-                        profile[q] = 0.25 * a * d * flakes.table.at(local).r / mu_j;
-                        any = true;
+                        profile[q] = scale * d * flakes.table.at(local).r;
+                        end = q + 1;
                     }
-                    if !any {
+                    let target = &mut cell_profile[side];
+                    // Clear what this cell has not written yet.
+                    if end > reach[side] {
+                        target[reach[side]..end].iter_mut().for_each(|v| *v = 0.0);
+                        reach[side] = end;
+                    }
+                    for (t, p) in target.iter_mut().zip(&profile[..end]) {
+                        *t += weight * p;
+                    }
+                }
+            }
+            for (side, matrices) in [(0, &mut *same), (1, &mut *opp)] {
+                let end = reach[side];
+                if end == 0 {
+                    continue;
+                }
+                coefficients.iter_mut().for_each(|c| *c = 0.0);
+                for (q, g) in cell_profile[side][..end].iter().enumerate() {
+                    if *g == 0.0 {
                         continue;
                     }
-                    coefficients.iter_mut().for_each(|c| *c = 0.0);
-                    for (q, g) in profile.iter().enumerate() {
-                        if *g == 0.0 {
-                            continue;
-                        }
-                        let row = &cos_table[q * modes..(q + 1) * modes];
-                        for (c, cm) in coefficients.iter_mut().zip(row) {
-                            *c += 2.0 * g * cm * dphi;
-                        }
+                    let gw = 2.0 * g * dphi;
+                    let row = &cos_table[q * modes..(q + 1) * modes];
+                    for (c, cm) in coefficients.iter_mut().zip(row) {
+                        *c += gw * cm;
                     }
-                    for (m, c) in coefficients.iter().enumerate() {
-                        target[m][(k, j)] += weight * c;
-                    }
+                }
+                for (m, c) in coefficients.iter().enumerate() {
+                    matrices[m][(k, j)] += c;
                 }
             }
         }

@@ -16,7 +16,8 @@
 //!   explicit disc flakes;
 //! - [`multiangle`]: the multi-angle geometries, their colours and the flop
 //!   index;
-//! - [`sparkle`]: Poisson glints per resolution cell and graininess.
+//! - [`sparkle`]: Poisson glints per resolution cell and graininess;
+//! - [`sparkle_texture`]: a patch of resolution cells with its glints drawn.
 
 pub mod kernel;
 pub mod montecarlo;
@@ -25,4 +26,5 @@ pub mod normals;
 pub mod paint;
 pub mod reflector;
 pub mod sparkle;
+pub mod sparkle_texture;
 pub mod thin_film;

@@ -233,7 +233,7 @@ fn mean_cos(o: &Orientation) -> f64 {
 }
 
 /// A Poisson count of mean `mean` (inversion; the means here are small).
-fn poisson(mean: f64, rng: &mut impl Rng) -> usize {
+pub(crate) fn poisson(mean: f64, rng: &mut impl Rng) -> usize {
     let (mut k, mut p) = (0usize, (-mean).exp());
     let mut cum = p;
     let u = rng.gen::<f64>();

@@ -26,9 +26,21 @@
 //!
 //! Each layer's series is cut where its kernel of term `m` is below
 //! [`ModelParams::mode_tolerance`] of its term 0 (at most
-//! [`ModelParams::max_terms`]; beyond its cut a layer only attenuates), the
-//! paint's at the longest of them; angular detail finer than the nodes' spacing
-//! in `μ` (and than the cut in azimuth) is not resolved.
+//! [`ModelParams::max_terms`]; beyond its cut a layer only attenuates). The
+//! paint's series is cut sooner, where no layer's kernel **into or out of an
+//! escaping node** is above the tolerance: light from air enters on an
+//! escaping node and leaves on one, so every path from air to air begins
+//! with a scattering out of an escaping node and ends with one into an
+//! escaping node, and the term `m` of a path is the product of its
+//! scatterings' terms, each no larger than its term 0 (the kernels are
+//! positive). The trapped nodes near grazing keep a lobe narrow in azimuth
+//! (a grazing ray mirrored by a tilted flake barely turns), whose terms decay
+//! slowly but reach air only through those first and last scatterings.
+//! The Fejér weights are those of [`ModelParams::max_terms`] whatever the
+//! cut (the terms beyond it count as zero), so the cut changes the sum only
+//! by the terms it drops, not its azimuthal resolution (`360°/M`, M =
+//! `max_terms`). Angular detail finer than the nodes' spacing in `μ` is not
+//! resolved.
 
 use super::kernel::{layer_kernels, FlakeMedium, NormalQuadrature};
 use super::thin_film;
@@ -97,6 +109,9 @@ pub struct PaintReflection {
     pub terms: Vec<Matrix>,
     /// The mirror part's reflectance per bin.
     pub mirror: Vec<f64>,
+    /// The length `M` of the Fejér sum (≥ `terms.len()`; the terms beyond
+    /// those kept count as zero).
+    pub fejer_terms: usize,
 }
 
 impl PaintReflection {
@@ -118,7 +133,7 @@ impl PaintReflection {
     ) -> Result<f64, BaselineError> {
         let (i, j) = (self.node(view_deg)?, self.node(incidence_deg)?);
         let phi = azimuth_deg.to_radians();
-        let count = self.terms.len() as f64;
+        let count = self.fejer_terms.max(self.terms.len()) as f64;
         let mut sum = self.terms[0][(i, j)];
         for (m, t) in self.terms.iter().enumerate().skip(1) {
             let fejer = 1.0 - m as f64 / count;
@@ -163,11 +178,18 @@ pub fn reflect(
         })
         .collect();
     // Per layer, the terms that matter; beyond them a layer only attenuates.
+    let every = vec![true; n];
     let counts: Vec<usize> = kernels
         .iter()
-        .map(|k| significant_terms(k, params.mode_tolerance))
+        .map(|k| significant_terms(k, params.mode_tolerance, &every))
         .collect();
-    let terms = counts.iter().copied().max().unwrap_or(1);
+    // The paint's: those that reach air.
+    let escaping: Vec<bool> = ords.mu_air.iter().map(Option::is_some).collect();
+    let terms = kernels
+        .iter()
+        .map(|k| significant_terms(k, params.mode_tolerance, &escaping))
+        .max()
+        .unwrap_or(1);
     let surface = adding::surface_air_over_binder(&ords, Fresnel::Unpolarised);
     let mirror_ground: Vec<f64> = match ground {
         Ground::Mirror { index } => ords
@@ -214,17 +236,21 @@ pub fn reflect(
         ords,
         terms: out,
         mirror,
+        fejer_terms: params.max_terms.max(1),
     })
 }
 
-/// How many leading terms of a layer's kernels are not negligible.
-fn significant_terms(kernels: &[FluxKernel], tolerance: f64) -> usize {
+/// How many leading terms of a layer's kernels are not negligible on the
+/// node pairs with at least one node in `nodes` (row or column).
+fn significant_terms(kernels: &[FluxKernel], tolerance: f64, nodes: &[bool]) -> usize {
     let largest = |k: &FluxKernel| {
         let n = k.rate.len();
         let mut m = 0.0f64;
         for i in 0..n {
             for j in 0..n {
-                m = m.max(k.same[(i, j)].abs()).max(k.opposite[(i, j)].abs());
+                if nodes[i] || nodes[j] {
+                    m = m.max(k.same[(i, j)].abs()).max(k.opposite[(i, j)].abs());
+                }
             }
         }
         m

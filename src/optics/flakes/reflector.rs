@@ -53,7 +53,8 @@ impl LocalTable {
     /// `(R, T)` at `cos_local` in `[0, 1]`, linear between nodes.
     pub fn at(&self, cos_local: f64) -> Powers {
         let x = cos_local.clamp(0.0, 1.0) * (TABLE_NODES - 1) as f64;
-        let i = (x.floor() as usize).min(TABLE_NODES - 2);
+        // `x ≥ 0`: truncation is the floor.
+        let i = (x as usize).min(TABLE_NODES - 2);
         let f = x - i as f64;
         Powers {
             r: self.r[i] + f * (self.r[i + 1] - self.r[i]),

@@ -54,6 +54,7 @@ mod geometry;
 pub mod multiangle;
 pub mod plot;
 pub mod preview;
+pub mod sparkle;
 mod spectra;
 pub mod tile;
 
@@ -477,6 +478,15 @@ fn incidence_cmp(a: &Incidence, b: &Incidence) -> Ordering {
     a.polar_deg
         .total_cmp(&b.polar_deg)
         .then(a.azimuth_deg.total_cmp(&b.azimuth_deg))
+}
+
+/// Three significant digits (at least the units).
+pub(crate) fn fmt_sig(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return fmt_num(v);
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
 }
 
 /// A number with at most two decimals, trailing zeros dropped.

@@ -9,7 +9,7 @@
 use super::canvas::{Canvas, GLYPH_HEIGHT, SMALL_HEIGHT, TITLE_HEIGHT};
 use super::plot::{self, Panel, PanelSize, Point, Scale, Series};
 use super::tile::{ink_on, mark_moved, patch_numbers, PATCH_PX};
-use super::{fmt_num, RenderError};
+use super::{fmt_num, fmt_sig, RenderError};
 use crate::optics::colour::{gamut, Observer};
 use crate::output::h5::{AngleRecord, SparkleTable};
 
@@ -154,17 +154,17 @@ pub fn patches_png(
                 format!(
                     "{}°: {} glints/mm² ({} per cell)",
                     fmt_num(r.illumination_deg),
-                    sig(r.glints_per_mm2),
-                    sig(r.glints_per_cell)
+                    fmt_sig(r.glints_per_mm2),
+                    fmt_sig(r.glints_per_cell)
                 )
             })
             .collect();
         lines.push(format!(
             "Sparkle at {} mm (cell {} mm²): {}; graininess {} under diffuse light",
             fmt_num(sp.viewing_distance_mm),
-            sig(sp.cell_area_mm2),
+            fmt_sig(sp.cell_area_mm2),
             per.join(", "),
-            sig(sp.graininess)
+            fmt_sig(sp.graininess)
         ));
     }
     let width = MARGIN * 2 + row_head + per_row * (PATCH_PX + GAP);
@@ -217,13 +217,4 @@ pub fn patches_png(
         img.text(MARGIN, y0 + k * (GLYPH_HEIGHT + 4), l, DIM_TEXT);
     }
     img.encode_png(&format!("{}: multi-angle colour", caption.name))
-}
-
-/// Three significant digits.
-fn sig(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return fmt_num(v);
-    }
-    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
-    format!("{v:.digits$}")
 }

@@ -17,9 +17,9 @@ impl RunScene for PaintScene {
         pipeline::paint_files(self).to_vec()
     }
     /// Done when the result reads back with this scene's input hash and
-    /// both pictures exist.
+    /// its pictures (patches, flop curves, sparkle texture) exist.
     fn state(&self) -> State {
-        let [path, patches, flop] = pipeline::paint_files(self);
+        let [path, patches, flop, sparkle] = pipeline::paint_files(self);
         if !path.exists() {
             return State::Missing;
         }
@@ -28,7 +28,7 @@ impl RunScene for PaintScene {
             Ok(r) if r.input_hash != self.provenance.input_hash => State::Mismatch {
                 stored: r.input_hash,
             },
-            Ok(_) if !patches.is_file() || !flop.is_file() => State::NoTile,
+            Ok(_) if !patches.is_file() || !flop.is_file() || !sparkle.is_file() => State::NoTile,
             Ok(_) => State::Done,
         }
     }

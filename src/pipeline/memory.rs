@@ -4,7 +4,8 @@
 //! `BASELINE_BYTES + voxels × (B_method + 32 + 8 × species)`, with
 //! `B_method` the solver's own peak per voxel from its registry
 //! (`Solver::bytes_per_voxel`, measured by `examples/solver_memory`,
-//! docs/PERFORMANCE.md "Memory"; [`MAXWELL_PER_SCALAR`] times that for
+//! docs/PERFORMANCE.md "Memory") plus the 16 B of a looser answer a
+//! tighter solve starts from ([`MAXWELL_PER_SCALAR`] times both for
 //! Maxwell's three components), 32 B for the pipeline's ε grid and its
 //! flipped copy for the solves from below, and 8 B per species for the
 //! raster's volume fractions. The grid is the one the run solves on
@@ -33,15 +34,20 @@ pub const BASELINE_BYTES: f64 = 25e6;
 /// and precision, docs/PERFORMANCE.md "Memory"); the largest is kept.
 pub const MAXWELL_PER_SCALAR: f64 = 3.2;
 
+/// The field of a looser answer a tighter solve starts from (one complex
+/// f64 per unknown; three unknowns a voxel in Maxwell), held while it
+/// runs.
+pub const WARM_START_BYTES: f64 = 16.0;
+
 /// Bytes per voxel of a solve: the method's own peak from the solver's
-/// registry (times [`MAXWELL_PER_SCALAR`] for Maxwell) plus the pipeline's
-/// ε grid and its flipped copy (16 B each).
+/// registry plus the warm start's field (times [`MAXWELL_PER_SCALAR`] for
+/// Maxwell), plus the pipeline's ε grid and its flipped copy (16 B each).
 pub fn bytes_per_voxel(m: Method, p: Precision, e: Equation) -> f64 {
     let factor = match e {
         Equation::Helmholtz => 1.0,
         Equation::Maxwell => MAXWELL_PER_SCALAR,
     };
-    factor * m.solver().bytes_per_voxel(p) + 32.0
+    factor * (m.solver().bytes_per_voxel(p) + WARM_START_BYTES) + 32.0
 }
 
 /// The grid a scene solves on, `[nx, ny, nz]`.
@@ -293,13 +299,13 @@ mod tests {
         let h = Equation::Helmholtz;
         assert_eq!(
             bytes_per_voxel(Method::TimeMarching, Precision::F64, h),
-            118.0
+            134.0
         );
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64, h), 197.0);
-        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32, h), 141.0);
-        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64, h), 453.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F64, h), 213.0);
+        assert_eq!(bytes_per_voxel(Method::BiCgStab, Precision::F32, h), 157.0);
+        assert_eq!(bytes_per_voxel(Method::Gmres, Precision::F64, h), 469.0);
         let m = bytes_per_voxel(Method::BiCgStab, Precision::F32, Equation::Maxwell);
-        assert!((m - (3.2 * 109.0 + 32.0)).abs() < 1e-9, "{m}");
+        assert!((m - (3.2 * (109.0 + 16.0) + 32.0)).abs() < 1e-9, "{m}");
         assert_eq!(human_bytes(2.5e9), "2.5 GB");
         assert_eq!(human_bytes(2.05e5), "205 kB");
         assert_eq!(human_bytes(2.2e14), "220.0 TB");

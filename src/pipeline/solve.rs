@@ -191,7 +191,9 @@ pub fn heartbeat_interval() -> std::time::Duration {
 /// record, whose cost includes the attempts it replaced. Where the tighter
 /// solve fails, the answer at the looser tolerance is kept and the log and
 /// the note say so. A solve `auto` finished on another background than the
-/// one asked for is solved again on the background that answered.
+/// one asked for is solved again on the background that answered. A
+/// tighter solve starts from the looser answer's field (the memory model
+/// counts that copy, [`super::memory::WARM_START_BYTES`]).
 fn solve_balanced(
     p: &Problem,
     method: Method,
@@ -202,9 +204,12 @@ fn solve_balanced(
 ) -> Result<(Efficiencies, SolveRecord), solver::SolveError> {
     // Attempts a tighter solve replaced, and why.
     let (mut replaced, mut again) = (Vec::<(Efficiencies, SolveRecord)>::new(), String::new());
+    // The looser answer's field: a tighter solve starts from it.
+    let mut warm: Option<ndarray::Array3<num_complex::Complex64>> = None;
     let (efficiencies, mut record) = loop {
-        let solved = heartbeat::scope(heartbeat_interval(), beat, || {
-            solver::solve(p, method, &ctl)
+        let solved = heartbeat::scope(heartbeat_interval(), beat, || match &warm {
+            Some(f) => solver::solve_from(p, method, &ctl, f),
+            None => solver::solve(p, method, &ctl),
         });
         let sol = match (solved, replaced.pop()) {
             (Ok(sol), previous) => {
@@ -254,6 +259,7 @@ fn solve_balanced(
             // same problem would stall the same way again.
             ctl.background = sol.record.background;
         }
+        warm = Some(sol.field);
         replaced.push((eff, sol.record));
     };
     for (_, r) in &replaced {

@@ -304,3 +304,14 @@ impl Solution {
 pub fn solve(p: &Problem, method: Method, ctl: &Controls) -> Result<Solution, SolveError> {
     method.solver().solve(p, ctl)
 }
+
+/// As [`solve`], starting from `start` (the field of an earlier solve of
+/// the same problem).
+pub fn solve_from(
+    p: &Problem,
+    method: Method,
+    ctl: &Controls,
+    start: &Array3<C64>,
+) -> Result<Solution, SolveError> {
+    method.solver().solve_from(p, ctl, Some(start))
+}

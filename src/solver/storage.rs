@@ -37,6 +37,11 @@ impl Field {
             Field::F32(_) => Precision::F32,
         }
     }
+
+    /// Every entry from `src` (same shape), rounded to this storage.
+    pub fn load_from(&mut self, src: &Array3<C64>) {
+        on_field!(self, u => ndarray::Zip::from(u).and(src).par_for_each(|u, s| *u = Storage::store(*s)))
+    }
 }
 
 /// `$body` with `$u` bound to the array inside a [`Field`] (by value,

@@ -68,7 +68,7 @@ impl Solver for Auto {
             }
         }
         let mut last_err = None;
-        for (m, background) in chain {
+        for (i, (m, background)) in chain.into_iter().enumerate() {
             if let Some(bg) = background {
                 sys.use_background(bg);
                 notes.push(format!(
@@ -77,7 +77,11 @@ impl Solver for Auto {
                     sys.describe_background()
                 ));
             }
-            sys.set_start_field(u);
+            // The first method starts from the field it was given (the
+            // start field, or an earlier answer); after a failure, afresh.
+            if i > 0 {
+                sys.set_start_field(u);
+            }
             match m.run(sys, scr, u, ctl) {
                 Ok(mut o) => {
                     o.applications += spent;

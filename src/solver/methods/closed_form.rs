@@ -48,8 +48,13 @@ impl Solver for Airy {
 
     /// The slab at the lattice's `k0` and `|κ| = |q|` (exactly the lateral
     /// wavenumber of the incidence when the lattice is built at azimuth 0).
-    /// Field storage does not apply: the answer is a formula.
-    fn solve(&self, p: &Problem, _ctl: &Controls) -> Result<Solution, SolveError> {
+    /// Field storage and a start field do not apply: the answer is a formula.
+    fn solve_from(
+        &self,
+        p: &Problem,
+        _ctl: &Controls,
+        _start: Option<&Array3<C64>>,
+    ) -> Result<Solution, SolveError> {
         let start = Instant::now();
         let eps = homogeneous(p.eps).ok_or_else(|| {
             SolveError::Invalid("the closed form solves a layer without grains".into())

@@ -42,6 +42,8 @@ use super::storage::Field;
 use super::system::{Scratch, System};
 use super::{Controls, Problem, Solution, SolveError, SolveRecord};
 use crate::config::{Method, Precision};
+use ndarray::Array3;
+use num_complex::Complex64 as C64;
 use std::time::Instant;
 
 /// The registry: each [`Method`] (named by the scene schema) to its
@@ -118,15 +120,27 @@ pub trait Solver: Sync {
     /// Solve one problem: build its [`System`], start from its start field (u_bg for Born)
     /// stored at `ctl.precision` and [`Solver::run`].
     fn solve(&self, p: &Problem, ctl: &Controls) -> Result<Solution, SolveError> {
+        self.solve_from(p, ctl, None)
+    }
+
+    /// As [`Solver::solve`], starting from `start` where given (the field
+    /// of an earlier solve of the same problem, e.g. at a looser
+    /// tolerance; the unknown is the same on either background).
+    fn solve_from(
+        &self,
+        p: &Problem,
+        ctl: &Controls,
+        start_field: Option<&Array3<C64>>,
+    ) -> Result<Solution, SolveError> {
         let start = Instant::now();
         let mut sys = System::new(p, ctl.background)?;
         let mut scr = sys.scratch();
         let mut u = Field::zeros(ctl.precision, sys.unknown_dim());
-        if self.method() == Method::Born {
+        match start_field {
+            Some(f) if f.dim() == sys.unknown_dim() => u.load_from(f),
             // Born iterates the plain equation, from u_bg on any background.
-            sys.set_background_field(&mut u);
-        } else {
-            sys.set_start_field(&mut u);
+            _ if self.method() == Method::Born => sys.set_background_field(&mut u),
+            _ => sys.set_start_field(&mut u),
         }
         let out = self.run(&mut sys, &mut scr, &mut u, ctl)?;
         let mut note = out.note;

@@ -296,8 +296,8 @@ fn geometry_command_writes_particles_and_picture() {
     assert!(!out.join("tiny.h5").exists(), "no solves were run");
 }
 
-/// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (197 + 8) B
-/// + 25 MB = 68.8 GB by the memory model.
+/// The tiny scene on a 4096 × 4096 × 20 grid: 335.5 M voxels × (213 + 8) B
+/// + 25 MB = 74.2 GB by the memory model.
 fn huge_scene() -> SceneToml {
     SceneToml::tiny()
         .fragment_nm(4096.0)
@@ -311,7 +311,7 @@ fn assert_memory_line(err: &str) {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     for needle in [
         "scene.toml: grid 4096 × 4096 × 20",
-        "estimated peak memory 68.8 GB",
+        "estimated peak memory 74.2 GB",
         "exceeds 1.0 GB (--max-memory)",
         "cell_nm",
         "raise --max-memory",
@@ -343,7 +343,8 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert_memory_line(&err);
     assert!(t.elapsed().as_secs_f64() < 10.0, "no work before the check");
     assert!(!out.exists(), "a refused run leaves nothing behind");
-    // Maxwell: 3.2× the method's own 165 B per voxel (f64 BiCGStab), named
+    // Maxwell: 3.2× the method's own 165 B per voxel (f64 BiCGStab) and the
+    // 16 B of the warm start, named
     // with the equation and the scalar equation as a way out.
     let maxwell = huge_scene().equation("maxwell").write(dir.path());
     let (ok, _, err) = inksim(&["check", maxwell.to_str().unwrap(), "--max-memory", "1G"]);
@@ -351,7 +352,7 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     for needle in [
         "f64 fields, maxwell",
-        "190.6 GB",
+        "207.8 GB",
         "precision = \"f32\"",
         "equation = \"helmholtz\"",
     ] {

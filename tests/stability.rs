@@ -211,7 +211,8 @@ fn a_solve_is_held_to_its_energy_balance_not_only_to_its_residual() {
 fn a_tighter_solve_that_fails_keeps_the_looser_answer_and_says_so() {
     let dir = tempfile::tempdir().unwrap();
     let report = common::scene::SceneToml::tiny()
-        .tolerance(1e-2)
+        .no_substrate()
+        .tolerance(5e-2)
         .method("time-marching")
         .max_iterations(MAX_ITERATIONS)
         .run(dir.path());
@@ -227,13 +228,13 @@ fn a_tighter_solve_that_fails_keeps_the_looser_answer_and_says_so() {
             "{}",
             e.record.note
         );
-        assert!(e.record.residual <= 1e-2, "{}", e.record.residual);
+        assert!(e.record.residual <= 5e-2, "{}", e.record.residual);
         assert!(e.efficiencies.energy_balance.is_finite());
         // The spent budget of the failed attempt is counted in its cost.
         assert!(e.record.operator_applications > MAX_ITERATIONS as usize);
     }
 }
-const MAX_ITERATIONS: i64 = 100;
+const MAX_ITERATIONS: i64 = 35;
 
 /// Rutile-like grains (n 2.8, lossless) in binder: BiCGStab without a
 /// preconditioner on the mean background plateaus for good. `auto` must

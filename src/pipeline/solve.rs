@@ -203,24 +203,25 @@ fn solve_balanced(
     label: &str,
 ) -> Result<(Efficiencies, SolveRecord), solver::SolveError> {
     // Attempts a tighter solve replaced, and why.
-    let (mut replaced, mut again) = (Vec::<(Efficiencies, SolveRecord)>::new(), String::new());
-    // The looser answer's field: a tighter solve starts from it.
-    let mut warm: Option<ndarray::Array3<num_complex::Complex64>> = None;
+    let (mut replaced, mut again) = (Vec::<SolveRecord>::new(), String::new());
+    // The looser answer a tighter solve is to replace: kept if that solve
+    // fails, and the field it starts from.
+    let mut looser: Option<(Efficiencies, solver::Solution)> = None;
     let (efficiencies, mut record) = loop {
-        let solved = heartbeat::scope(heartbeat_interval(), beat, || match &warm {
-            Some(f) => solver::solve_from(p, method, &ctl, f),
+        let solved = heartbeat::scope(heartbeat_interval(), beat, || match &looser {
+            Some((_, s)) => solver::solve_from(p, method, &ctl, &s.field),
             None => solver::solve(p, method, &ctl),
         });
-        let sol = match (solved, replaced.pop()) {
+        let sol = match (solved, looser.take()) {
             (Ok(sol), previous) => {
-                replaced.extend(previous);
+                replaced.extend(previous.map(|(_, s)| s.record));
                 sol
             }
             (Err(e), None) => return Err(e),
             // A tighter solve that fails keeps the answer at the looser
             // tolerance, which met its own residual: said in the log and
             // the note, its energy balance recorded as it is.
-            (Err(e), Some((eff, mut previous))) => {
+            (Err(e), Some((eff, previous))) => {
                 progress.log(&format!(
                     "[inksim] {label}: the solve to {:.0e} failed ({e}); keeping the answer at \
                      {:.0e} (energy balance {:.1e})",
@@ -232,8 +233,9 @@ fn solve_balanced(
                     "; the solve to {:.0e} failed ({e}), this answer kept",
                     ctl.tolerance
                 ));
-                previous.operator_applications += e.applications();
-                break (eff, previous);
+                let mut kept = previous.record;
+                kept.operator_applications += e.applications();
+                break (eff, kept);
             }
         };
         let eff = farfield::efficiencies(&sol);
@@ -259,10 +261,9 @@ fn solve_balanced(
             // same problem would stall the same way again.
             ctl.background = sol.record.background;
         }
-        warm = Some(sol.field);
-        replaced.push((eff, sol.record));
+        looser = Some((eff, sol));
     };
-    for (_, r) in &replaced {
+    for r in &replaced {
         record.add(r);
     }
     record.note.push_str(&again);

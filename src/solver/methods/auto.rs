@@ -44,7 +44,7 @@ impl Solver for Auto {
             (Method::TimeMarching.solver(), None),
         ];
         let mut notes = vec![];
-        let mut spent = born::ESTIMATE_STEPS;
+        let mut spent = born::ESTIMATE_APPLICATIONS;
         if sys.background() == Background::Mean {
             // BiCGStab on the mean background needs about as many
             // applications as Born's estimate alone (docs/PERFORMANCE.md).

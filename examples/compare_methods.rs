@@ -56,6 +56,7 @@ fn main() -> anyhow::Result<()> {
                 inc.azimuth_deg,
             );
             let p = Problem {
+                tensor: None,
                 lattice: lat,
                 eps: &eps,
                 eps_binder: eps_b,

@@ -139,6 +139,7 @@ fn main() {
                 for polar in [0.0, 60.0] {
                     let lat = Problem::lattice([grid.nx, grid.ny, grid.nz], size, wl, polar, 0.0);
                     let p = Problem {
+                        tensor: None,
                         lattice: lat,
                         eps: &eps,
                         eps_binder: eps_b,

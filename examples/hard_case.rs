@@ -50,6 +50,7 @@ fn main() {
     raster.epsilon_into(C64::new(eps_b, 0.0), &[n * n], &mut eps);
     let lat = Problem::lattice([grid.nx, grid.ny, grid.nz], size, 450.0, 40.0, 0.0);
     let p = Problem {
+        tensor: None,
         lattice: lat,
         eps: &eps,
         eps_binder: eps_b,

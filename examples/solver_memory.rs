@@ -78,6 +78,7 @@ fn main() {
     let with_grid = peak_rss();
     let size = [10.0 * nx as f64, 10.0 * ny as f64, 10.0 * nz as f64];
     let p = Problem {
+        tensor: None,
         lattice: Problem::lattice([nx, ny, nz], size, 450.0, 40.0, 0.0),
         eps: &eps,
         eps_binder: eb,

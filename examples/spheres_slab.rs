@@ -160,6 +160,7 @@ fn run(a: &Args) -> Result<(), String> {
             0.0,
         );
         let p = Problem {
+            tensor: None,
             lattice,
             eps: &eps,
             eps_binder: eps_b,

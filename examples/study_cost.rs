@@ -223,6 +223,7 @@ fn child(layer: &str, name: &str) {
                 0.0,
             );
             let p = Problem {
+                tensor: None,
                 lattice,
                 eps: &eps,
                 eps_binder: eps_b,

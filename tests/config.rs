@@ -903,6 +903,28 @@ fn natural_light_is_checked() {
     assert!(err.to_string().contains("random-phase"), "{err}");
 }
 
+/// `grid.voxel_permittivity`: auto by default (anisotropic cut voxels in
+/// Maxwell, the average in Helmholtz), average anywhere, anisotropic only in
+/// Maxwell (refused naming the key and the way out), unknown names listed.
+#[test]
+fn voxel_permittivity_is_checked() {
+    let maxwell = || base().set("solver.equation", "maxwell");
+    let s = parse(&base()).unwrap();
+    assert_eq!(s.grid.voxel_permittivity, VoxelPermittivity::Auto);
+    assert!(!s.grid.voxel_permittivity.anisotropic(s.solver.equation));
+    let s = parse(&maxwell()).unwrap();
+    assert!(s.grid.voxel_permittivity.anisotropic(s.solver.equation));
+    let s = parse(&maxwell().set("grid.voxel_permittivity", "average")).unwrap();
+    assert!(!s.grid.voxel_permittivity.anisotropic(s.solver.equation));
+    let s = parse(&maxwell().set("grid.voxel_permittivity", "anisotropic")).unwrap();
+    assert!(s.grid.voxel_permittivity.anisotropic(s.solver.equation));
+    let (key, msg) = invalid(&base().set("grid.voxel_permittivity", "anisotropic"));
+    assert_eq!(key, "grid.voxel_permittivity", "{msg}");
+    assert!(msg.contains("maxwell"), "{msg}");
+    let err = parse(&maxwell().set("grid.voxel_permittivity", "harmonic")).unwrap_err();
+    assert!(err.to_string().contains("anisotropic"), "{err}");
+}
+
 #[test]
 fn a_library_crystal_loads_as_its_orientation_average_and_hashes_both_tables() {
     let scene = base().pigment(PigmentToml::library("hematite").pvc(0.2).diameter_nm(200.0));

@@ -28,6 +28,7 @@ fn solve(
     background: Background,
 ) -> Solution {
     let p = Problem {
+        tensor: None,
         lattice: lat,
         eps,
         eps_binder: EPS_B,

@@ -61,6 +61,7 @@ fn worst_error(eps_s: C64, polar_deg: f64, l: f64, cells: usize) -> f64 {
     let (eps, lattice) = one_sphere_lattice(l, h, a, cells, eps_s, wl, polar_deg);
     let sol = solver::solve(
         &Problem {
+            tensor: None,
             lattice,
             eps: &eps,
             eps_binder: 1.0,

@@ -106,6 +106,7 @@ fn solve(eps_s: C64, polarisation: Linear, polar_deg: f64, cells: usize) -> Solu
         one_sphere_lattice(PERIOD, HEIGHT, RADIUS, cells, eps_s, WAVELENGTH, polar_deg);
     solver::solve(
         &Problem {
+            tensor: None,
             lattice,
             eps: &eps,
             eps_binder: 1.0,

@@ -115,6 +115,7 @@ fn solve_case_as(
         0.0,
     );
     let p = Problem {
+        tensor: None,
         lattice,
         eps: &eps,
         eps_binder: c.eps_binder,

@@ -226,6 +226,7 @@ fn measured(material: &Material, d: f64, pvc: f64, wl: f64, polar: f64) -> (f64,
     let mut eps = Array3::zeros((grid.nz, grid.ny, grid.nx));
     raster.epsilon_into(C64::new(eps_b, 0.0), &[eps_p], &mut eps);
     let p = Problem {
+        tensor: None,
         lattice: Problem::lattice([32, 32, 40], size, wl, polar, 0.0),
         eps: &eps,
         eps_binder: eps_b,

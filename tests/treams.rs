@@ -7,15 +7,18 @@
 //! 0° and 45° in s and p, converged in the multipole order and the
 //! plane-wave cutoff to well below 1e-4 (checked here). We rasterise the
 //! same spheres by volume fraction (`inksim::raster`, 4³ sub-samples in the
-//! cut voxels) and solve at 20 and 10 nm cells. The error (largest |ΔR_mn|,
-//! |ΔT_mn|, |ΔA|) must fall with the cell and be below a per-case
-//! tolerance at 10 nm ([`COMPARED`]); the error against the other
-//! polarisation's reference must be well above it (the comparison can fail). The 5 nm grid is an ignored
-//! test: `cargo test --release --test treams -- --ignored`.
+//! cut voxels), with the cut voxels anisotropic (the default of Maxwell
+//! runs: the average along the surface, the harmonic mean across it), and
+//! solve at 20 and 10 nm cells. The error (largest |ΔR_mn|, |ΔT_mn|, |ΔA|)
+//! must fall with the cell and be below a per-case tolerance at 10 nm
+//! ([`COMPARED`]), and well below the error of plain volume averaging on
+//! the same grid; the error against the other polarisation's reference
+//! must be well above it (the comparison can fail). The 5 nm grid is an
+//! ignored test: `cargo test --release --test treams -- --ignored`.
 use inksim::config::{Background, Linear, Method};
 use inksim::geometry::{Geometry, Particle, Sphere};
 use inksim::optics::farfield::efficiencies;
-use inksim::raster::{rasterize, Grid};
+use inksim::raster::{rasterize, Anisotropy, Grid};
 use inksim::solver::{self, Controls, Problem, Wave};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
@@ -92,8 +95,17 @@ fn error(a: &Result, b: &Result) -> f64 {
         .fold((a.absorption - b.absorption).abs(), f64::max)
 }
 
+/// How the solves see the voxels a sphere surface cuts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Voxels {
+    /// The volume average of ε.
+    Average,
+    /// The average along the surface, the harmonic mean across it.
+    Anisotropic,
+}
+
 /// Our solve of a fixture case on cells of `cell` nm (x, y and z).
-fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64) -> Result {
+fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64, voxels: Voxels) -> Result {
     let (l, h) = (c.num("period_nm"), c.num("thickness_nm"));
     let eps_b = c.num("n_binder").powi(2);
     let spheres = c.arr("spheres");
@@ -133,6 +145,8 @@ fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64) -> Result {
     let raster = rasterize(&geom, &grid, 4);
     let mut eps = Array3::zeros((nz, n, n));
     raster.epsilon_into(C64::new(eps_b, 0.0), &eps_s, &mut eps);
+    let mut tensor = Anisotropy::default();
+    raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_s, &mut tensor);
     let azimuth = c.num("azimuth_deg");
     let lattice = Problem::lattice(
         [n, n, nz],
@@ -147,6 +161,7 @@ fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64) -> Result {
         _ => panic!("polarisation {pol}"),
     };
     let p = Problem {
+        tensor: (voxels == Voxels::Anisotropic).then_some(&tensor),
         lattice,
         eps: &eps,
         eps_binder: eps_b,
@@ -164,7 +179,7 @@ fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64) -> Result {
     );
     let r = &sol.record;
     eprintln!(
-        "  {} {polar}° {pol} at {cell} nm ({n}×{n}×{nz}): {} iterations, {:.2} s",
+        "  {} {polar}° {pol} at {cell} nm ({n}×{n}×{nz}, {voxels:?}): {} iterations, {:.2} s",
         c.str("name"),
         r.iterations,
         r.seconds
@@ -223,23 +238,25 @@ fn fixture_is_a_converged_treams_reference() {
 }
 
 /// The incidences compared (a subset: the test's time) and the largest
-/// per-order (and absorption) error accepted at 10 nm cells. The error is
-/// about first order in the cell (arithmetic volume-fraction averaging of ε
-/// in the voxels the sphere surface cuts, where the normal E component
-/// wants the harmonic mean), so its size follows the contrast: ~1e-3 for
-/// the absorbing sphere, 2–4e-2 for rutile (ε 7.3 in a binder of 2.4).
+/// per-order (and absorption) error accepted at 10 nm cells with
+/// anisotropic cut voxels. Measured (20 → 10 → 5 nm): absorbing 6.1e-4 →
+/// 1.8e-4 → 7.7e-5 (0° s) and 5.3e-4 → 1.5e-4 → 3.0e-5 (45° p); rutile
+/// 2.1e-3 → 1.7e-3 → 1.1e-3 (0° s) and 1.2e-2 → 2.5e-3 → 6.1e-4 (45° s);
+/// the pair 9.2e-4 → 3.2e-4. Volume averaging on the same grids: about
+/// first order, 1.0–1.5e-3 (absorbing) and 2.4–4.3e-2 (rutile) at 10 nm.
 const COMPARED: [(&str, f64, &str, f64); 5] = [
-    ("absorbing_r150", 0.0, "s", 2e-3),
-    ("absorbing_r150", 45.0, "p", 2e-3),
-    ("rutile_r110", 0.0, "s", 3e-2),
-    ("rutile_r110", 45.0, "s", 5e-2),
-    ("pair", 45.0, "s", 2e-3),
+    ("absorbing_r150", 0.0, "s", 4e-4),
+    ("absorbing_r150", 45.0, "p", 4e-4),
+    ("rutile_r110", 0.0, "s", 3e-3),
+    ("rutile_r110", 45.0, "s", 5e-3),
+    ("pair", 45.0, "s", 6e-4),
 ];
 
 /// Per-order R, T and A against treams at 20 and 10 nm cells: the error
-/// must fall under refinement and be below the case's tolerance at 10 nm,
-/// and the same solution against the other polarisation's reference must
-/// fail that tolerance by a factor of 2 (where s and p differ).
+/// must fall under refinement, be below the case's tolerance at 10 nm and
+/// below 1/2.5 of volume averaging's there (measured 3.3–17×), and the same
+/// solution against the other polarisation's reference must fail that
+/// tolerance by a factor of 2 (where s and p differ).
 #[test]
 fn sphere_lattices_match_treams() {
     let root = fixture();
@@ -248,20 +265,27 @@ fn sphere_lattices_match_treams() {
         let c = case(&root, name);
         let want = reference(c, polar, pol);
         let other = reference(c, polar, if pol == "s" { "p" } else { "s" });
-        let coarse = solve_case(c, polar, pol, 20.0);
-        let fine = solve_case(c, polar, pol, 10.0);
+        let coarse = solve_case(c, polar, pol, 20.0, Voxels::Anisotropic);
+        let fine = solve_case(c, polar, pol, 10.0, Voxels::Anisotropic);
+        let average = solve_case(c, polar, pol, 10.0, Voxels::Average);
         let (e20, e10) = (error(&coarse, &want), error(&fine, &want));
+        let e_avg = error(&average, &want);
         let wrong = error(&fine, &other);
         let line = format!(
             "{name} {polar}° {pol}: error {e20:.2e} (20 nm), {e10:.2e} (10 nm), \
-             order {:.2}; against the other polarisation {wrong:.2e}",
+             order {:.2}; volume average {e_avg:.2e} (10 nm); against the other \
+             polarisation {wrong:.2e}",
             (e20 / e10).log2()
         );
         eprintln!("{line}");
         report.push(line);
         assert!(
-            e10 < tolerance && e10 < 0.8 * e20,
+            e10 < tolerance && e10 < 0.9 * e20,
             "{name} {polar}° {pol}: {e20:.2e} → {e10:.2e}"
+        );
+        assert!(
+            2.5 * e10 < e_avg,
+            "{name} {polar}° {pol}: anisotropic {e10:.2e} against average {e_avg:.2e}"
         );
         // At normal incidence the centred sphere's s and p are the same
         // problem (rotated by 90°): there the test is an s/p swap of the
@@ -286,8 +310,8 @@ fn sphere_lattices_match_treams_at_5_nm() {
     for (name, polar, pol, tolerance) in [COMPARED[1], COMPARED[3]] {
         let c = case(&root, name);
         let want = reference(c, polar, pol);
-        let e10 = error(&solve_case(c, polar, pol, 10.0), &want);
-        let e5 = error(&solve_case(c, polar, pol, 5.0), &want);
+        let e10 = error(&solve_case(c, polar, pol, 10.0, Voxels::Anisotropic), &want);
+        let e5 = error(&solve_case(c, polar, pol, 5.0, Voxels::Anisotropic), &want);
         eprintln!("{name} {polar}° {pol}: error {e10:.2e} (10 nm), {e5:.2e} (5 nm)");
         assert!(
             e5 < 0.8 * e10 && e5 < tolerance / 2.0,

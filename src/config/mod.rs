@@ -218,6 +218,42 @@ pub struct GridSpec {
     pub nx: usize,
     pub ny: usize,
     pub nz: usize,
+    /// The permittivity of voxels a grain surface cuts.
+    pub voxel_permittivity: VoxelPermittivity,
+}
+
+/// How a voxel cut by a grain surface sees its two media (METHOD §3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum VoxelPermittivity {
+    /// Anisotropic in Maxwell's equations, the average in the scalar one
+    /// (the default).
+    #[default]
+    Auto,
+    /// The volume average `Σ f_i ε_i` for every field direction.
+    Average,
+    /// The average along the surface and the harmonic mean `1/Σ f_i/ε_i`
+    /// along its normal (Maxwell only).
+    Anisotropic,
+}
+
+impl VoxelPermittivity {
+    /// Whether cut voxels are anisotropic in a solve of `equation`.
+    pub fn anisotropic(self, equation: Equation) -> bool {
+        match self {
+            VoxelPermittivity::Auto => equation == Equation::Maxwell,
+            VoxelPermittivity::Average => false,
+            VoxelPermittivity::Anisotropic => true,
+        }
+    }
+
+    /// The name of what a solve of `equation` uses, for plans and notes.
+    pub fn describe(self, equation: Equation) -> &'static str {
+        if self.anisotropic(equation) {
+            "anisotropic (average along the grain surface, harmonic mean across it)"
+        } else {
+            "volume average"
+        }
+    }
 }
 
 /// How the solver stores its fields.

@@ -280,6 +280,17 @@ pub struct RawGrid {
     pub nx: Option<i64>,
     pub ny: Option<i64>,
     pub nz: Option<i64>,
+    /// `"auto"`, `"average"` or `"anisotropic"`: the permittivity of voxels
+    /// a grain surface cuts.
+    pub voxel_permittivity: Option<RawVoxelPermittivity>,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RawVoxelPermittivity {
+    Auto,
+    Average,
+    Anisotropic,
 }
 
 #[derive(Debug, Deserialize)]

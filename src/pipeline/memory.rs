@@ -8,7 +8,9 @@
 //! tighter solve starts from ([`MAXWELL_PER_SCALAR`] times both for
 //! Maxwell's three components), 32 B for the pipeline's ε grid and its
 //! flipped copy for the solves from below, and 8 B per species for the
-//! raster's volume fractions. The grid is the one the run solves on
+//! raster's volume fractions. With anisotropic cut voxels (Maxwell) the
+//! voxels a grain surface cuts hold [`CUT_VOXEL_BYTES`] more, their share
+//! estimated by [`cut_share`]. The grid is the one the run solves on
 //! (including the cells a relief adds on top).
 //!
 //! The limit is the smaller of `--max-memory` and the machine's available
@@ -39,6 +41,29 @@ pub const MAXWELL_PER_SCALAR: f64 = 3.2;
 /// runs.
 pub const WARM_START_BYTES: f64 = 16.0;
 
+/// Bytes a cut voxel holds with anisotropic voxels: its surface normal
+/// (32 B) and the tensor term of each wavelength's grid and its flipped
+/// copy (48 B each).
+pub const CUT_VOXEL_BYTES: f64 = 128.0;
+
+/// The estimated share of voxels a grain surface cuts: `Σ 15 f_s c / d_s`
+/// (at most 1) over the species, with `f_s` the volume fraction, `d_s` the
+/// diameter and `c` the cell. Grains of area `A` cut about `1–2.5 A/c²`
+/// voxels (tests/voxel_tensor.rs), and spheres have `A/V = 6/d`.
+pub fn cut_share(scene: &Scene) -> f64 {
+    let [nx, ny, nz] = solve_grid(scene);
+    let cell = (scene.layer.fragment_x_nm / nx as f64)
+        .max(scene.layer.fragment_y_nm / ny as f64)
+        .max(scene.layer.thickness_nm / nz as f64);
+    scene
+        .species
+        .iter()
+        .filter(|s| s.shape != crate::config::GrainShape::Molecular && s.diameter_nm > 0.0)
+        .map(|s| 15.0 * s.volume_fraction * cell / s.diameter_nm)
+        .sum::<f64>()
+        .min(1.0)
+}
+
 /// Bytes per voxel of a solve: the method's own peak from the solver's
 /// registry plus the warm start's field (times [`MAXWELL_PER_SCALAR`] for
 /// Maxwell), plus the pipeline's ε grid and its flipped copy (16 B each).
@@ -65,7 +90,22 @@ pub fn estimate_bytes(scene: &Scene) -> f64 {
                 scene.solver.method,
                 scene.solver.precision,
                 scene.solver.equation,
-            ) + 8.0 * scene.species.len() as f64)
+            ) + 8.0 * scene.species.len() as f64
+                + anisotropic_bytes(scene))
+}
+
+/// The cut voxels' share of [`CUT_VOXEL_BYTES`] per voxel (0 without
+/// anisotropic voxels).
+fn anisotropic_bytes(scene: &Scene) -> f64 {
+    if scene
+        .grid
+        .voxel_permittivity
+        .anisotropic(scene.solver.equation)
+    {
+        CUT_VOXEL_BYTES * cut_share(scene)
+    } else {
+        0.0
+    }
 }
 
 /// A run whose memory estimate exceeds the limit: what to say about it.

@@ -174,6 +174,23 @@ fn grain_lines(scene: &Scene) -> Vec<String> {
         "surface relief: none (grains stay inside the binder)".to_string()
     });
     lines.push(surface_line(scene));
+    let vp = scene.grid.voxel_permittivity;
+    lines.push(format!(
+        "voxels cut by a grain surface: {}{}",
+        vp.describe(scene.solver.equation),
+        if vp.anisotropic(scene.solver.equation) {
+            format!(
+                ", about {:.0} % of the voxels",
+                100.0 * super::memory::cut_share(scene)
+            )
+        } else if scene.solver.equation == crate::config::Equation::Maxwell {
+            " (grid.voxel_permittivity = \"average\"; \"auto\" would make them anisotropic, \
+             the smaller grid error)"
+                .to_string()
+        } else {
+            String::new()
+        }
+    ));
     if scene.layer.equilibrate_sweeps > 0 {
         lines.push(format!(
             "equilibration: {} hard-particle Monte Carlo sweeps after packing \

@@ -10,7 +10,7 @@ use crate::config::{Incidence, Method, Scene};
 use crate::optics::farfield::{self, Efficiencies, Side, SolveEntry};
 use crate::output::progress::Progress;
 use crate::raster::structure::EpsGrid;
-use crate::raster::{Grid, Raster};
+use crate::raster::{Anisotropy, Grid, Raster};
 use crate::solver::heartbeat::{self, Beat};
 use crate::solver::{self, Controls, Jones, Problem, SolveRecord, Wave};
 use rand::{RngCore, SeedableRng};
@@ -92,12 +92,29 @@ pub fn solve_layer(
         .below
         .as_ref()
         .map(|_| Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0)));
+    // The cut voxels' tensor part (Maxwell, anisotropic voxels), and its
+    // mirror image for light from below.
+    let anisotropic = scene
+        .grid
+        .voxel_permittivity
+        .anisotropic(scene.solver.equation);
+    let mut tensor = Anisotropy::empty(g.nz, (g.ny, g.nx));
+    let mut tensor_below = Anisotropy::empty(g.nz, (g.ny, g.nx));
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
         match layer {
             LayerEps::Raster(raster) => {
                 let eps_species = fraction_eps(scene, lambda)?;
                 raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
+                if anisotropic {
+                    raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_species, &mut tensor);
+                    if plan.embedded {
+                        tensor.scale(C64::new(outside, 0.0));
+                    }
+                    if flipped.is_some() {
+                        tensor_below = tensor.flipped();
+                    }
+                }
             }
             LayerEps::Grid(grid_eps, _) => grid_eps.epsilon_into(lambda, &mut eps),
         }
@@ -116,9 +133,9 @@ pub fn solve_layer(
                 inc.polar_deg,
                 inc.azimuth_deg,
             );
-            let grid_eps = match (side, flipped.as_ref()) {
-                (Side::Below, Some(f)) => f,
-                _ => &eps,
+            let (grid_eps, grid_tensor) = match (side, flipped.as_ref()) {
+                (Side::Below, Some(f)) => (f, &tensor_below),
+                _ => (&eps, &tensor),
             };
             let phase = plan
                 .seeds
@@ -147,6 +164,7 @@ pub fn solve_layer(
             let mut parts = Vec::with_capacity(waves.len());
             for &wave in &waves {
                 let p = Problem {
+                    tensor: Some(grid_tensor).filter(|t| !t.is_empty()),
                     lattice,
                     eps: grid_eps,
                     eps_binder: eps_b / outside,
@@ -411,6 +429,7 @@ pub fn solve_analytic(
             let mut parts = Vec::new();
             for wave in waves(scene, inc, None) {
                 let p = Problem {
+                    tensor: None,
                     lattice,
                     eps: &mean,
                     eps_binder: eps_b / outside,

@@ -38,8 +38,11 @@
 //! Particles are assumed narrower than the lateral period (the packer ensures
 //! half of it); parts outside the grid (`z₀ ≤ z ≤ H`) are not rasterised.
 
+pub mod anisotropy;
 pub mod structure;
 pub mod surface;
+
+pub use anisotropy::{Anisotropy, Normal, SurfaceNormals};
 
 use crate::geometry::{Geometry, Sphere};
 use ndarray::{Array2, Array3, ArrayViewMut2, Axis};
@@ -175,6 +178,9 @@ pub struct Raster {
     /// The binder surface's depth below `z = 0` per column, `(ny, nx)`
     /// ([`surface`]); None: the plane `z = 0`, the top cells vacuum.
     pub surface_nm: Option<Array2<f64>>,
+    /// The grain surface's normal in every voxel it cuts ([`anisotropy`]),
+    /// one list per z-slice; empty for an explicit structure.
+    pub normals: SurfaceNormals,
 }
 
 /// A particle ready for rasterising: its spheres unwrapped next to the first
@@ -407,12 +413,13 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         }
     }
 
-    slices
+    let normals = slices
         .into_par_iter()
         .zip(per_slice.par_iter())
         .enumerate()
-        .for_each(|(iz, (mut views, members))| {
+        .map(|(iz, (mut views, members))| {
             let mut active = Vec::new();
+            let mut normals = Vec::new();
             let z_lo = z_origin + iz as f64 * dz;
             let z_hi = z_lo + dz;
             for &pi in members {
@@ -437,6 +444,15 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                         if f > 0.0 {
                             view[[wy, wx]] += f;
                         }
+                        if f > 0.0 && f < 1.0 {
+                            let centre = [x_lo + 0.5 * dx, y_lo + 0.5 * dy, z_lo + 0.5 * dz];
+                            let n = surface_normal(sph, centre);
+                            let w = f * (1.0 - f);
+                            normals.push(Normal {
+                                index: (wx + nx * wy) as u32,
+                                n: [w * n[0], w * n[1], w * n[2]],
+                            });
+                        }
                     }
                 }
             }
@@ -450,14 +466,41 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                     }
                 }
             }
-        });
+            SurfaceNormals::merge_slice(normals)
+        })
+        .collect();
 
     Raster {
         grid: *grid,
         fractions,
         top_cells,
         surface_nm: None,
+        normals: SurfaceNormals { slices: normals },
     }
+}
+
+/// The outward normal of a union of spheres near `x`: that of the sphere
+/// whose surface is nearest, `(x − c)/|x − c|` for the sphere with the
+/// largest `r − |x − c|` (the union's signed depth); zero at a centre.
+fn surface_normal(spheres: &[Sphere], x: [f64; 3]) -> [f64; 3] {
+    let mut best = (f64::NEG_INFINITY, [0.0; 3]);
+    for sp in spheres {
+        let d = [
+            x[0] - sp.center[0],
+            x[1] - sp.center[1],
+            x[2] - sp.center[2],
+        ];
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let depth = sp.radius - len;
+        if depth > best.0 {
+            best = if len > 0.0 {
+                (depth, [d[0] / len, d[1] / len, d[2] / len])
+            } else {
+                (depth, [0.0; 3])
+            };
+        }
+    }
+    best.1
 }
 
 impl Raster {
@@ -536,6 +579,57 @@ impl Raster {
         }
     }
 
+    /// The tensor part of the permittivity at `eps_binder`, `eps_species`
+    /// ([`anisotropy`]): for every voxel with a surface normal, the term
+    /// `(ε_n − ε_t) n̂ n̂ᵀ` with `ε_t` the arithmetic mean of
+    /// [`Raster::epsilon_into`] and `ε_n` the harmonic mean of the same
+    /// shares; written into `out`, whose allocation is reused.
+    pub fn anisotropy_into(
+        &self,
+        eps_binder: Complex64,
+        eps_species: &[Complex64],
+        out: &mut Anisotropy,
+    ) {
+        assert_eq!(
+            eps_species.len(),
+            self.fractions.len(),
+            "anisotropy_into: one permittivity per species"
+        );
+        let g = &self.grid;
+        out.clear(g.nz, (g.ny, g.nx));
+        for (iz, normals) in self.normals.slices.iter().enumerate().take(g.nz) {
+            for nv in normals {
+                let i = nv.index as usize;
+                let (iy, ix) = (i / g.nx, i % g.nx);
+                let depth = self.surface_nm.as_ref().map_or(1.0, |s| s[[iy, ix]]);
+                let eps_bg = self.background(eps_binder, iz, depth);
+                let shares = || {
+                    self.fractions
+                        .iter()
+                        .zip(eps_species)
+                        .map(move |(f, &e)| (f[[iz, iy, ix]], e))
+                };
+                let total: f64 = shares().map(|(f, _)| f).sum();
+                let eps_t = shares().fold(eps_bg * (1.0 - total), |acc, (f, e)| acc + e * f);
+                let Some(eps_n) = anisotropy::harmonic_mean(eps_bg, shares()) else {
+                    continue;
+                };
+                let delta = eps_n - eps_t;
+                if delta.norm() > 1e-12 * eps_t.norm() {
+                    out.terms.push(anisotropy::Term {
+                        index: nv.index,
+                        axis: nv.n,
+                        delta,
+                    });
+                }
+            }
+            out.offsets[iz + 1] = out.terms.len();
+        }
+        for iz in self.normals.slices.len().min(g.nz)..g.nz {
+            out.offsets[iz + 1] = out.terms.len();
+        }
+    }
+
     /// Rasterised grain volume per species over the binder layer's volume
     /// (`Lx·Ly·H`, the cells above the binder excluded from the
     /// denominator, included in the numerator): comparable with the PVC.
@@ -597,6 +691,12 @@ impl Raster {
             fractions,
             top_cells: self.top_cells + k,
             surface_nm: self.surface_nm,
+            normals: SurfaceNormals {
+                slices: (0..k)
+                    .map(|_| Vec::new())
+                    .chain(self.normals.slices)
+                    .collect(),
+            },
         }
     }
 

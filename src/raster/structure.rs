@@ -254,6 +254,7 @@ pub fn rasterize_primitives(primitives: &[Primitive], grid: &Grid) -> Raster {
         fractions,
         top_cells: 0,
         surface_nm: None,
+        normals: Default::default(),
     }
 }
 

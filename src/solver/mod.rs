@@ -65,6 +65,7 @@ pub mod shift;
 pub mod simd;
 pub mod storage;
 pub mod system;
+pub mod tensor;
 
 use crate::config::{Background, Linear, Method, Precision};
 use ndarray::{Array2, Array3};
@@ -160,6 +161,11 @@ pub struct Problem<'a> {
     pub eps_binder: f64,
     /// The wave equation and, for Maxwell's, the incident polarisation.
     pub wave: Wave,
+    /// The tensor part of the permittivity (Maxwell only): uniaxial terms
+    /// `δ â âᵀ` added to `eps` per voxel, such as the anisotropic
+    /// permittivity of cut voxels ([`crate::raster::anisotropy`]). None:
+    /// isotropic.
+    pub tensor: Option<&'a crate::raster::Anisotropy>,
 }
 
 /// Which wave equation a problem is solved in (METHOD §4, §9).

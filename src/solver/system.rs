@@ -20,8 +20,10 @@ use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
 use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
+use super::tensor;
 use super::{Jones, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
 use crate::config::Background;
+use crate::raster::Anisotropy;
 use ndarray::{s, Array2, Array3, Ix3, Zip};
 use num_complex::Complex64 as C64;
 
@@ -64,6 +66,9 @@ pub struct System<'a> {
     op: BackgroundOperator,
     lat: Lattice,
     eps: &'a Array3<C64>,
+    /// The tensor part of the permittivity (Maxwell; None: isotropic or
+    /// no terms).
+    tensor: Option<&'a Anisotropy>,
     eps_binder: f64,
     /// k0².
     k2: f64,
@@ -148,20 +153,42 @@ enum OpWorkspace {
     Vector(VectorWorkspace),
 }
 
-/// Real centre and radius of the permittivity values: (ε_r, max|ε − ε_r|).
-pub fn shift_of(eps: &Array3<C64>, eps_binder: f64) -> (f64, f64) {
+/// Real centre and radius of the permittivity values: (ε_r, max|ε − ε_r|),
+/// the tensor voxels' spectra included ([`spread`]).
+pub fn shift_of(eps: &Array3<C64>, tensor: Option<&Anisotropy>, eps_binder: f64) -> (f64, f64) {
     let (mut lo, mut hi) = (eps_binder, eps_binder);
     for e in eps.iter() {
         lo = lo.min(e.re);
         hi = hi.max(e.re);
     }
+    if let Some(a) = tensor {
+        for (e, sum, bound) in tensor::voxels(a, eps) {
+            lo = lo.min(e.re + sum.re.min(0.0) - (bound - sum.norm()));
+            hi = hi.max(e.re + sum.re.max(0.0) + (bound - sum.norm()));
+        }
+    }
     let er = 0.5 * (lo + hi);
     let rad = eps
         .iter()
-        .map(|e| (e - er).norm_sqr())
-        .fold((eps_binder - er).powi(2), f64::max)
-        .sqrt();
-    (er, rad)
+        .map(|e| (e - er).norm())
+        .fold((eps_binder - er).abs(), f64::max);
+    (er, rad.max(spread(eps, tensor, C64::new(er, 0.0))))
+}
+
+/// The largest `‖ε_v − centre‖` over the tensor voxels: exact
+/// (`max(|ε_v − c|, |ε_v + δ − c|)`) for one axis per voxel, the triangle
+/// bound `|ε_v − c| + Σ|δ|` otherwise; 0 without a tensor part.
+fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64) -> f64 {
+    let Some(a) = tensor else { return 0.0 };
+    tensor::voxels(a, eps)
+        .map(|(e, sum, bound)| {
+            if bound - sum.norm() <= 1e-12 * bound {
+                (e - centre).norm().max((e + sum - centre).norm())
+            } else {
+                (e - centre).norm() + bound
+            }
+        })
+        .fold(0.0, f64::max)
 }
 
 impl<'a> System<'a> {
@@ -201,6 +228,17 @@ impl<'a> System<'a> {
                 "permittivity must be finite with Im ε ≥ 0 (passive)".into(),
             ));
         }
+        let tensor = p.tensor.filter(|a| !a.is_empty());
+        if let Some(a) = tensor {
+            if p.wave == Wave::Scalar {
+                return Err(SolveError::Invalid(
+                    "a tensor permittivity needs Maxwell's equations".into(),
+                ));
+            }
+            if let Some(e) = tensor::check(a, p.eps) {
+                return Err(SolveError::Invalid(e));
+            }
+        }
         let k2 = lat.k0 * lat.k0;
         let (op, ubg, r_bg, t_bg) = match p.wave {
             Wave::Scalar => {
@@ -236,7 +274,7 @@ impl<'a> System<'a> {
         };
         let ubg_norm =
             (ubg.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
-        let shift = Shift::new(&op, &lat, p.eps, p.eps_binder, &ubg, params);
+        let shift = Shift::new(&op, &lat, (p.eps, tensor), p.eps_binder, &ubg, params);
         Ok(System {
             shift,
             params,
@@ -244,6 +282,7 @@ impl<'a> System<'a> {
             op,
             lat,
             eps: p.eps,
+            tensor,
             eps_binder: p.eps_binder,
             ubg,
             r_bg,
@@ -275,7 +314,7 @@ impl<'a> System<'a> {
             self.shift = Shift::new(
                 &self.op,
                 &self.lat,
-                self.eps,
+                (self.eps, self.tensor),
                 self.eps_binder,
                 &self.ubg,
                 self.params,
@@ -299,9 +338,15 @@ impl<'a> System<'a> {
         &self.lat
     }
 
-    /// Total permittivity per voxel, (nz, ny, nx).
+    /// Total permittivity per voxel, (nz, ny, nx) (its scalar part where
+    /// [`System::tensor`] has terms).
     pub fn eps(&self) -> &Array3<C64> {
         self.eps
+    }
+
+    /// The tensor part of the permittivity; None: isotropic.
+    pub fn tensor(&self) -> Option<&Anisotropy> {
+        self.tensor
     }
 
     /// The background of the shifted form in use.
@@ -353,7 +398,8 @@ impl<'a> System<'a> {
         })
     }
 
-    /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)`.
+    /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)` (ε a tensor
+    /// where [`System::tensor`] has terms).
     fn load_scaled<S: Storage>(&self, scr: &mut Scratch, x: &Array3<S>, shift: C64) {
         let (k2, eb) = (self.k2, self.eps_binder);
         for c in 0..self.components() {
@@ -361,6 +407,9 @@ impl<'a> System<'a> {
                 .and(x.slice(self.block(c)))
                 .and(self.eps)
                 .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
+        }
+        if let Some(a) = self.tensor {
+            tensor::add_contrast(a, k2, x, &mut scr.field);
         }
     }
 
@@ -491,6 +540,9 @@ impl<'a> System<'a> {
                 .and(self.eps)
                 .par_for_each(|x, e| *x = S::store(x.load() * (1.0 + C64::i() * (e - er) / es)));
         }
+        if let Some(a) = self.tensor {
+            tensor::add_precondition(a, self.eps.view(), er, es, x);
+        }
     }
 
     /// ‖x‖ / ‖u_bg‖.
@@ -573,7 +625,8 @@ impl<'a> System<'a> {
                 let f = |u: &S, e: &C64| e.im * u.load().norm_sqr();
                 sum_slices(u.slice(self.block(c)), f, self.eps.view())
             })
-            .sum();
+            .sum::<f64>()
+            + self.tensor.map_or(0.0, |a| tensor::absorption(a, u));
         let beta00 = lat.beta(0, 0).re;
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
@@ -589,7 +642,7 @@ impl Shift {
     fn new(
         op: &BackgroundOperator,
         lat: &Lattice,
-        eps: &Array3<C64>,
+        (eps, tensor): (&Array3<C64>, Option<&Anisotropy>),
         eps_binder: f64,
         ubg: &[C64],
         params: ShiftParams,
@@ -597,17 +650,22 @@ impl Shift {
         let kind = params.background;
         let (bg, cbs) = match kind {
             Background::Binder => {
-                let (er, rad) = shift_of(eps, eps_binder);
+                let (er, rad) = shift_of(eps, tensor, eps_binder);
                 let es = (params.margin * rad).max(1e-9);
                 (C64::new(er, es), Some((er, es)))
             }
             Background::Mean => {
-                let m = mean_eps(eps);
+                // The tensor voxels add a third of their trace to the mean.
+                let m = mean_eps(eps)
+                    + tensor.map_or(C64::new(0.0, 0.0), |a| {
+                        a.terms.iter().map(|t| t.delta).sum::<C64>() / (3.0 * eps.len() as f64)
+                    });
                 let rad = eps
                     .iter()
                     .map(|e| (e - m).norm_sqr())
                     .fold(0.0, f64::max)
-                    .sqrt();
+                    .sqrt()
+                    .max(spread(eps, tensor, m));
                 let floor = params.mean_loss_floor * rad * rad;
                 (C64::new(m.re, m.im.max(floor).max(1e-9)), None)
             }

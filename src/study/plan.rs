@@ -204,6 +204,7 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
         ),
     };
     let p = Problem {
+        tensor: None,
         lattice,
         eps: &eps,
         eps_binder: eb,

@@ -88,6 +88,31 @@ pub fn tmm(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
     ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
 }
 
+/// [`tmm`] in p polarisation: the magnetic field H_y and `H_y'/(iε)`,
+/// both continuous, propagated from the bottom; power reflectance and
+/// transmittance (vacuum on both sides).
+#[allow(dead_code)]
+pub fn tmm_p(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
+    let k0 = 2.0 * PI / wl;
+    let kx = k0 * polar.to_radians().sin();
+    let kz = |eps: C64| kz(eps * k0 * k0 - kx * kx);
+    let b = kz(C64::new(1.0, 0.0));
+    let (mut u, mut w) = (C64::new(1.0, 0.0), b);
+    for &(eps, d) in layers.iter().rev() {
+        let g = kz(eps);
+        let (c, s) = ((g * d).cos(), (g * d).sin());
+        let (u2, w2) = (
+            c * u - C64::i() * s * eps * w / g,
+            -C64::i() * g * s * u / eps + c * w,
+        );
+        u = u2;
+        w = w2;
+    }
+    let a = (u + w / b) / 2.0;
+    let r = (u - w / b) / 2.0;
+    ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
+}
+
 /// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points (the
 /// diffuse terms of a closed-form slab, `R_dd` and `T_d`).
 pub fn hemispherical(f: impl Fn(f64) -> f64) -> f64 {

@@ -14,6 +14,7 @@ pub const EPS_B: f64 = 1.558 * 1.558;
 /// The problem of a layer `eps` in the reference binder.
 pub fn in_binder(lattice: Lattice, eps: &Array3<C64>) -> Problem<'_> {
     Problem {
+        tensor: None,
         lattice,
         eps,
         eps_binder: EPS_B,
@@ -126,4 +127,41 @@ pub fn one_sphere_lattice(
     raster.epsilon_into(C64::new(1.0, 0.0), &[eps_s], &mut eps);
     let lattice = Problem::lattice([cells, cells, nz], [l, l, h], wl, polar_deg, 0.0);
     (eps, lattice)
+}
+
+/// A slab of `eps_s` from depth `z1` to `z2` (nm) inside the reference
+/// binder of thickness `h`, on `nz` cells of a 2 × 2 lateral grid whose
+/// faces need not meet the slab's: the cut cells hold the volume average
+/// `ε_t` in the grid and, in the tensor, the term `(ε_n − ε_t) ẑẑᵀ` with
+/// `ε_n` the harmonic mean (the exact homogenisation of a laminate for the
+/// field across it).
+#[allow(dead_code)]
+pub fn laminate(
+    nz: usize,
+    (z1, z2, h): (f64, f64, f64),
+    eps_s: C64,
+) -> (Array3<C64>, inksim::raster::Anisotropy) {
+    use inksim::raster::anisotropy::Term;
+    let eps_b = C64::new(EPS_B, 0.0);
+    let dz = h / nz as f64;
+    let mut eps = Array3::from_elem((nz, 2, 2), eps_b);
+    let mut tensor = inksim::raster::Anisotropy::empty(nz, (2, 2));
+    for k in 0..nz {
+        let (lo, hi) = (k as f64 * dz, (k + 1) as f64 * dz);
+        let f = ((hi.min(z2) - lo.max(z1)) / dz).clamp(0.0, 1.0);
+        let eps_t = f * eps_s + (1.0 - f) * eps_b;
+        eps.slice_mut(ndarray::s![k, .., ..]).fill(eps_t);
+        if f > 1e-12 && f < 1.0 - 1e-12 {
+            let eps_n = 1.0 / (f / eps_s + (1.0 - f) / eps_b);
+            for index in 0..4 {
+                tensor.terms.push(Term {
+                    index,
+                    axis: [0.0, 0.0, 1.0],
+                    delta: eps_n - eps_t,
+                });
+            }
+        }
+        tensor.offsets[k + 1] = tensor.terms.len();
+    }
+    (eps, tensor)
 }

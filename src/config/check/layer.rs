@@ -2,10 +2,10 @@
 //! `[grid]` (from a cell size or explicit FFT-friendly counts).
 
 use super::{Checker, REL_EPS};
-use crate::config::raw::{RawGrid, RawLayer, RawSurface};
+use crate::config::raw::{RawGrid, RawLayer, RawSurface, RawVoxelPermittivity};
 use crate::config::{
-    ConfigError, GridSpec, Layer, Surface, MAX_EQUILIBRATE_SWEEPS, MAX_FILM_FRACTION,
-    MAX_RELIEF_FRACTION, MAX_ROUGH_RMS_FRACTION,
+    ConfigError, GridSpec, Layer, Surface, VoxelPermittivity, MAX_EQUILIBRATE_SWEEPS,
+    MAX_FILM_FRACTION, MAX_RELIEF_FRACTION, MAX_ROUGH_RMS_FRACTION,
 };
 
 const MAX_THICKNESS_NM: f64 = 20_000.0;
@@ -175,7 +175,12 @@ impl Checker<'_> {
                         format!("needs {nz} cells along z, more than {MAX_GRID_DIM}"),
                     ));
                 }
-                Ok(GridSpec { nx, ny, nz })
+                Ok(GridSpec {
+                    nx,
+                    ny,
+                    nz,
+                    voxel_permittivity: voxel(raw),
+                })
             }
             None => {
                 let mut n = [0usize; 3];
@@ -209,9 +214,20 @@ impl Checker<'_> {
                     nx: n[0],
                     ny: n[1],
                     nz: n[2],
+                    voxel_permittivity: voxel(raw),
                 })
             }
         }
+    }
+}
+
+/// The checked `grid.voxel_permittivity` (its pairing with the equation is
+/// checked with the solver).
+fn voxel(raw: &RawGrid) -> VoxelPermittivity {
+    match raw.voxel_permittivity {
+        None | Some(RawVoxelPermittivity::Auto) => VoxelPermittivity::Auto,
+        Some(RawVoxelPermittivity::Average) => VoxelPermittivity::Average,
+        Some(RawVoxelPermittivity::Anisotropic) => VoxelPermittivity::Anisotropic,
     }
 }
 

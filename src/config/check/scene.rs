@@ -136,6 +136,16 @@ impl Checker<'_> {
         if let Some(st) = &stack {
             self.stack_products(st, &appearance, realisation_target.is_some())?;
         }
+        if solver.equation == crate::config::Equation::Helmholtz
+            && grid.voxel_permittivity == crate::config::VoxelPermittivity::Anisotropic
+        {
+            return Err(self.invalid(
+                "grid.voxel_permittivity",
+                "\"anisotropic\" treats the field components along and across a grain surface \
+                 apart, and the scalar Helmholtz equation has one component: use \
+                 solver.equation = \"maxwell\", or \"average\" or \"auto\"",
+            ));
+        }
         if solver.equation == crate::config::Equation::Maxwell {
             // What does not honour both polarisations yet is refused rather
             // than mixed silently into a Maxwell result.

@@ -40,7 +40,7 @@ impl Solver for Airy {
     }
 
     fn validity(&self, sys: &mut System, _scr: &mut Scratch, _precision: Precision) -> Validity {
-        match homogeneous(sys.eps()) {
+        match homogeneous(sys.eps()).filter(|_| sys.tensor().is_none()) {
             Some(_) => Validity::Always,
             None => Validity::Unlikely("the layer has grains".into()),
         }
@@ -56,7 +56,8 @@ impl Solver for Airy {
         _start: Option<&Array3<C64>>,
     ) -> Result<Solution, SolveError> {
         let start = Instant::now();
-        let eps = homogeneous(p.eps).ok_or_else(|| {
+        let isotropic = p.tensor.is_none_or(|a| a.is_empty());
+        let eps = homogeneous(p.eps).filter(|_| isotropic).ok_or_else(|| {
             SolveError::Invalid("the closed form solves a layer without grains".into())
         })?;
         let lat = p.lattice;
@@ -181,6 +182,7 @@ mod tests {
         let lat = Problem::lattice([3, 2, 5], [400.0, 300.0, 700.0], 450.0, 40.0, 0.0);
         let mut grid = Array3::from_elem((5, 2, 3), eps);
         let p = Problem {
+            tensor: None,
             lattice: lat,
             eps: &grid,
             eps_binder: 2.4,
@@ -197,6 +199,7 @@ mod tests {
         let column = Array3::from_elem((4000, 1, 1), eps);
         let sol = solve(
             &Problem {
+                tensor: None,
                 lattice: thin,
                 eps: &column,
                 eps_binder: 2.4,
@@ -210,6 +213,7 @@ mod tests {
         assert!((sol.field[[3999, 0, 0]] - want.t).norm() < 1e-2);
         grid[[2, 1, 1]] = C64::new(3.0, 0.1);
         let p = Problem {
+            tensor: None,
             lattice: lat,
             eps: &grid,
             eps_binder: 2.4,

@@ -6,14 +6,16 @@
 //! the given spheres in each `L × L` cell, lit from above at polar angle θ
 //! (azimuth 0, plane of incidence x-z) in s or p. The spheres are
 //! rasterised by volume fraction (`inksim::raster`, 4³ sub-samples in the
-//! voxels the surface cuts). For each cell size it prints one
+//! voxels the surface cuts), the cut voxels anisotropic (the default of a
+//! Maxwell run; `--voxels average` for volume averaging). For each cell
+//! size it prints one
 //! `RESULT {json}` line: grid, iterations, CPU and wall seconds (CPU of the
 //! raster + solve + far field, this process), and R, T of every
 //! propagating order (both outgoing polarisations summed) and absorption.
 //!
 //! `cargo run --release --example spheres_slab -- --period 800 --thickness 600
 //!  --polar 45 --pol p --sphere 400,400,300,150,1.4,0.7 [--sphere ...]
-//!  [--tol 1e-8] [--supersample 4] 20 10`
+//!  [--tol 1e-8] [--supersample 4] [--voxels anisotropic|average] 20 10`
 //! (sphere: x, y, z, radius in nm, then n' and n'' relative to vacuum;
 //! cells in nm, equal in x, y and z; each must divide L and H.)
 
@@ -37,6 +39,7 @@ struct Args {
     spheres: Vec<([f64; 3], f64, C64)>,
     tolerance: f64,
     supersample: usize,
+    anisotropic: bool,
     cells: Vec<f64>,
 }
 
@@ -49,6 +52,7 @@ fn parse_args() -> Result<Args, String> {
         spheres: vec![],
         tolerance: 1e-8,
         supersample: 4,
+        anisotropic: true,
         cells: vec![],
     };
     let mut it = std::env::args().skip(1);
@@ -66,6 +70,13 @@ fn parse_args() -> Result<Args, String> {
             "--polar" => a.polar = num("--polar", it.next())?,
             "--tol" => a.tolerance = num("--tol", it.next())?,
             "--supersample" => a.supersample = num("--supersample", it.next())? as usize,
+            "--voxels" => {
+                a.anisotropic = match it.next().as_deref() {
+                    Some("anisotropic") => true,
+                    Some("average") => false,
+                    v => return Err(format!("--voxels: {v:?} is not anisotropic or average")),
+                }
+            }
             "--pol" => {
                 a.pol = match it.next().as_deref() {
                     Some("s") => Linear::S,
@@ -152,6 +163,10 @@ fn run(a: &Args) -> Result<(), String> {
         let raster = rasterize(&geom, &grid, a.supersample);
         let mut eps = Array3::zeros((nz, n, n));
         raster.epsilon_into(C64::new(eps_b, 0.0), &eps_s, &mut eps);
+        let mut tensor = inksim::raster::Anisotropy::default();
+        if a.anisotropic {
+            raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_s, &mut tensor);
+        }
         let lattice = Problem::lattice(
             [n, n, nz],
             [a.period, a.period, a.thickness],
@@ -160,7 +175,7 @@ fn run(a: &Args) -> Result<(), String> {
             0.0,
         );
         let p = Problem {
-            tensor: None,
+            tensor: Some(&tensor),
             lattice,
             eps: &eps,
             eps_binder: eps_b,
@@ -184,8 +199,13 @@ fn run(a: &Args) -> Result<(), String> {
             })
             .collect();
         println!(
-            "cell {cell} nm ({n}×{n}×{nz}): {} {} iterations, {} applications, \
+            "cell {cell} nm ({n}×{n}×{nz}, {} voxels): {} {} iterations, {} applications, \
              {cpu:.2} CPU s, {wall:.2} s, R {:.6} T {:.6} A {:.6}, balance {:.1e}",
+            if a.anisotropic {
+                "anisotropic"
+            } else {
+                "average"
+            },
             r.method,
             r.iterations,
             r.operator_applications,

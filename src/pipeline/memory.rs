@@ -48,13 +48,15 @@ pub const CUT_VOXEL_BYTES: f64 = 128.0;
 
 /// The estimated share of voxels a grain surface cuts: `Σ 15 f_s c / d_s`
 /// (at most 1) over the species, with `f_s` the volume fraction, `d_s` the
-/// diameter and `c` the cell. Grains of area `A` cut about `1–2.5 A/c²`
-/// voxels (tests/voxel_tensor.rs), and spheres have `A/V = 6/d`.
+/// diameter and `c` the mean of the cell's three edges. Grains of area `A`
+/// cut about `1–2.5 A/c²` cubic voxels (tests/voxel_tensor.rs), and
+/// spheres have `A/V = 6/d`.
 pub fn cut_share(scene: &Scene) -> f64 {
     let [nx, ny, nz] = solve_grid(scene);
-    let cell = (scene.layer.fragment_x_nm / nx as f64)
-        .max(scene.layer.fragment_y_nm / ny as f64)
-        .max(scene.layer.thickness_nm / nz as f64);
+    let cell = (scene.layer.fragment_x_nm / nx as f64
+        + scene.layer.fragment_y_nm / ny as f64
+        + scene.layer.thickness_nm / nz as f64)
+        / 3.0;
     scene
         .species
         .iter()

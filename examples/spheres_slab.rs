@@ -165,7 +165,14 @@ fn run(a: &Args) -> Result<(), String> {
         raster.epsilon_into(C64::new(eps_b, 0.0), &eps_s, &mut eps);
         let mut tensor = inksim::raster::Anisotropy::default();
         if a.anisotropic {
-            raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_s, &mut tensor);
+            raster.anisotropy_into(
+                C64::new(eps_b, 0.0),
+                &eps_s,
+                &[],
+                true,
+                &mut eps,
+                &mut tensor,
+            );
         }
         let lattice = Problem::lattice(
             [n, n, nz],

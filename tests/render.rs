@@ -670,6 +670,7 @@ fn geometry_picture_has_axes_scale_bar_and_section() {
         top_cells: 0,
         surface_nm: None,
         normals: Default::default(),
+        crystal: Vec::new(),
     };
     let lines = vec!["pigment volume fraction 0.2 (µm³ per µm³)".to_string()];
     let png = geometry_png(&raster, "demo layer", &lines).unwrap();

@@ -24,6 +24,7 @@ fn a_rough_surface_keeps_the_binder_volume_and_follows_its_heights() {
         top_cells: top,
         surface_nm: Some(s.clone()),
         normals: Default::default(),
+        crystal: Vec::new(),
     };
     let eps_b = C64::new(2.4, 0.0);
     let mut eps = Array3::zeros((nz, 32, 32));
@@ -65,6 +66,7 @@ fn a_surface_map_at_the_plane_is_the_flat_surface() {
         top_cells: top,
         surface_nm: None,
         normals: Default::default(),
+        crystal: Vec::new(),
     };
     let (eps_b, eps_s) = (C64::new(2.4, 0.0), [C64::new(4.0, 0.3)]);
     let mut a = Array3::zeros((nz, 4, 4));

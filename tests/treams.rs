@@ -146,7 +146,14 @@ fn solve_case(c: &Json, polar: f64, pol: &str, cell: f64, voxels: Voxels) -> Res
     let mut eps = Array3::zeros((nz, n, n));
     raster.epsilon_into(C64::new(eps_b, 0.0), &eps_s, &mut eps);
     let mut tensor = Anisotropy::default();
-    raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_s, &mut tensor);
+    raster.anisotropy_into(
+        C64::new(eps_b, 0.0),
+        &eps_s,
+        &[],
+        true,
+        &mut eps,
+        &mut tensor,
+    );
     let azimuth = c.num("azimuth_deg");
     let lattice = Problem::lattice(
         [n, n, nz],

@@ -149,8 +149,12 @@ fn a_sphere_has_radial_normals_and_harmonic_terms() {
         "{cut} vs {shell}"
     );
     let (eb, es) = (C64::new(EPS_B, 0.0), C64::new(2.0, 0.8).powi(2));
+    let mut eps_grid = ndarray::Array3::zeros((n, n, n));
+    raster.epsilon_into(eb, &[es], &mut eps_grid);
+    let before = eps_grid.clone();
     let mut t = Anisotropy::default();
-    raster.anisotropy_into(eb, &[es], &mut t);
+    raster.anisotropy_into(eb, &[es], &[], true, &mut eps_grid, &mut t);
+    assert_eq!(eps_grid, before, "no crystal: the scalar part is unchanged");
     assert_eq!(t.terms.len(), cut);
     for iz in 0..n {
         for term in t.slice(iz) {
@@ -184,7 +188,7 @@ fn sphere_layer(centre: [f64; 3], n: usize, eps_s: C64) -> (ndarray::Array3<C64>
     let mut eps = ndarray::Array3::zeros((n, n, n));
     raster.epsilon_into(eb, &[eps_s], &mut eps);
     let mut t = Anisotropy::default();
-    raster.anisotropy_into(eb, &[eps_s], &mut t);
+    raster.anisotropy_into(eb, &[eps_s], &[], true, &mut eps, &mut t);
     (eps, t)
 }
 
@@ -257,4 +261,223 @@ fn a_sphere_lattice_with_its_tensor_balances_rotates_and_mirrors() {
     let two = common::threads::on_threads(2, run);
     assert_eq!(one.1.to_bits(), two.1.to_bits());
     assert!(one.0.iter().zip(two.0.iter()).all(|(a, b)| a == b));
+}
+
+/// A uniaxial crystal filling the layer, its optic axis along z or x: the
+/// tensor terms `(ε_e − ε_o) ĉĉᵀ` on every voxel against the exact
+/// anisotropic transfer matrix in p (ε_xx, ε_zz) and s (ε_yy = ε_o), at
+/// second order in the z cell; the orientation average instead is far off.
+#[test]
+fn a_uniaxial_crystal_slab_matches_the_anisotropic_transfer_matrix() {
+    use inksim::raster::anisotropy::Term;
+    // Rutile near 550 nm: n_o 2.65, n_e 2.95, a little loss.
+    let (eo, ee) = (C64::new(2.65, 0.01).powi(2), C64::new(2.95, 0.01).powi(2));
+    let h = 300.0;
+    for axis in [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]] {
+        let (exx, ezz) = if axis[2] == 1.0 { (eo, ee) } else { (ee, eo) };
+        let (rp, _) = common::airy::tmm_p_uniaxial(&[(exx, ezz, h)], 550.0, 50.0);
+        let (rs, _) = tmm(&[(eo, h)], 550.0, 50.0);
+        let mut errors = vec![];
+        for nz in [60, 120] {
+            let eps = ndarray::Array3::from_elem((nz, 2, 2), eo);
+            let mut t = Anisotropy::empty(nz, (2, 2));
+            for k in 0..nz {
+                for index in 0..4 {
+                    t.terms.push(Term {
+                        index,
+                        axis,
+                        delta: ee - eo,
+                    });
+                }
+                t.offsets[k + 1] = t.terms.len();
+            }
+            let lat = Problem::lattice([2, 2, nz], [300.0, 300.0, h], 550.0, 50.0, 0.0);
+            let solve = |pol: Linear, tensor: Option<&Anisotropy>, eps| {
+                let p = Problem {
+                    lattice: lat,
+                    eps,
+                    tensor,
+                    eps_binder: EPS_B,
+                    wave: Wave::Vector {
+                        polarisation: pol.into(),
+                        azimuth_deg: 0.0,
+                    },
+                };
+                let sol = solver::solve(&p, Method::Auto, &tight(Background::Binder)).unwrap();
+                let ff = efficiencies(&sol);
+                assert!(ff.energy_balance.abs() < 1e-8, "{}", ff.energy_balance);
+                ff.total_reflectance
+            };
+            let p = solve(Linear::P, Some(&t), &eps);
+            let s = solve(Linear::S, Some(&t), &eps);
+            errors.push(((p - rp).abs(), (s - rs).abs()));
+            if nz == 120 {
+                let mean = ndarray::Array3::from_elem((nz, 2, 2), (2.0 * eo + ee) / 3.0);
+                let avg = solve(Linear::P, None, &mean);
+                assert!(
+                    (avg - rp).abs() > 20.0 * (p - rp).abs(),
+                    "the average {avg} should be off against {p} (exact {rp})"
+                );
+            }
+        }
+        eprintln!("axis {axis:?}: p, s errors {errors:?}");
+        assert!(errors[1].0 < 1e-3 && errors[1].1 < 1e-3, "{errors:?}");
+        assert!(
+            errors[0].0 / errors[1].0 > 3.0,
+            "p not second order: {errors:?}"
+        );
+    }
+}
+
+/// Crystal grains rasterised with their axes: each grain's shares add up
+/// to its species' fraction, its terms are `f (ε_e − ε_o) ĉĉᵀ` and the
+/// scalar part moves by `f (ε_o − ε̄)`; ε_o = ε_e leaves the grid isotropic
+/// and unchanged; the axes of many spheres are isotropic (⟨ĉĉᵀ⟩ = I/3); a
+/// two-sphere grain's axis is along it.
+#[test]
+fn crystal_grains_carry_their_axis_into_the_tensor() {
+    use inksim::raster::rasterize_keeping_axes;
+    let (l, h) = (1000.0, 1000.0);
+    let mut particles = vec![];
+    for i in 0..8 {
+        for j in 0..8 {
+            for k in 0..8 {
+                let c = [i, j, k].map(|v| 62.5 + 125.0 * v as f64);
+                particles.push(Particle {
+                    species: 0,
+                    spheres: vec![Sphere {
+                        center: c,
+                        radius: 40.0,
+                    }],
+                });
+            }
+        }
+    }
+    let geom = Geometry {
+        size_nm: [l, l, h],
+        particles,
+        stats: Default::default(),
+    };
+    let n = 40;
+    let grid = Grid::new(n, n, n, [l, l, h]).unwrap();
+    let raster = rasterize_keeping_axes(&geom, &grid, 4, &[true]);
+    // Shares add up to the fraction, voxel by voxel.
+    for iz in 0..n {
+        let mut sum = ndarray::Array2::<f64>::zeros((n, n));
+        for g in &raster.crystal[iz] {
+            sum[[g.index as usize / n, g.index as usize % n]] += g.share;
+        }
+        let f = raster.fractions[0].index_axis(ndarray::Axis(0), iz);
+        assert!(sum.iter().zip(f.iter()).all(|(a, b)| (a - b).abs() < 1e-12));
+    }
+    // One axis per grain, isotropic over the 512 grains.
+    let mut axes: Vec<[f64; 3]> = raster.crystal.iter().flatten().map(|g| g.axis).collect();
+    axes.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    axes.dedup();
+    assert_eq!(axes.len(), 512);
+    for k in 0..3 {
+        let m: f64 = axes.iter().map(|a| a[k] * a[k]).sum::<f64>() / 512.0;
+        // ⟨c_k²⟩ = 1/3 with s.d. √(4/45/512) = 0.013.
+        assert!((m - 1.0 / 3.0).abs() < 0.05, "⟨c{k}²⟩ = {m}");
+    }
+    let eb = C64::new(EPS_B, 0.0);
+    let (eo, ee) = (C64::new(7.0, 0.02), C64::new(8.7, 0.03));
+    let mean = (2.0 * eo + ee) / 3.0;
+    let mut eps = ndarray::Array3::zeros((n, n, n));
+    raster.epsilon_into(eb, &[mean], &mut eps);
+    let before = eps.clone();
+    let mut t = Anisotropy::default();
+    raster.anisotropy_into(eb, &[mean], &[Some((eo, ee))], false, &mut eps, &mut t);
+    for iz in 0..n {
+        for term in t.slice(iz) {
+            let i = term.index as usize;
+            let f = raster.fractions[0][[iz, i / n, i % n]];
+            assert!((term.delta - f * (ee - eo)).norm() < 1e-12);
+            let moved = eps[[iz, i / n, i % n]] - before[[iz, i / n, i % n]];
+            assert!((moved - f * (eo - mean)).norm() < 1e-12);
+        }
+    }
+    let grain_voxels = raster.fractions[0].iter().filter(|&&f| f > 0.0).count();
+    assert_eq!(t.terms.len(), grain_voxels);
+    // No birefringence: an isotropic tensor on the average, unchanged.
+    let mut same = before.clone();
+    raster.anisotropy_into(eb, &[eo], &[Some((eo, eo))], false, &mut same, &mut t);
+    assert!(t.terms.iter().all(|t| t.delta.norm() == 0.0));
+    assert!(same
+        .iter()
+        .zip(&before)
+        .all(|(a, b)| (a - b).norm() < 1e-12));
+    // A rod's axis is along it.
+    let rod = Geometry {
+        size_nm: [400.0, 400.0, 400.0],
+        particles: vec![Particle {
+            species: 0,
+            spheres: vec![
+                Sphere {
+                    center: [150.0, 200.0, 150.0],
+                    radius: 40.0,
+                },
+                Sphere {
+                    center: [250.0, 200.0, 250.0],
+                    radius: 40.0,
+                },
+            ],
+        }],
+        stats: Default::default(),
+    };
+    let r = rasterize_keeping_axes(
+        &rod,
+        &Grid::new(20, 20, 20, rod.size_nm).unwrap(),
+        4,
+        &[true],
+    );
+    let a = r.crystal.iter().flatten().next().unwrap().axis;
+    let s = 0.5f64.sqrt();
+    assert!((a[0] - s).abs() < 1e-12 && a[1].abs() < 1e-12 && (a[2] - s).abs() < 1e-12);
+}
+
+/// A run of library rutile grains: in Maxwell the plan says each grain is a
+/// tensor and every solve's record counts its anisotropic cut voxels and
+/// crystal-grain voxels (energy balance held); in Helmholtz the plan says
+/// orientation average and no solve has a tensor.
+#[test]
+fn a_rutile_run_takes_a_tensor_per_grain_in_maxwell_only() {
+    use common::scene::{PigmentToml, SceneToml};
+    let dir = tempfile::tempdir().unwrap();
+    let base = SceneToml::grains()
+        .seed(5)
+        .thickness_nm(300.0)
+        .fragment_nm(400.0)
+        .pigment(PigmentToml::library("rutile").pvc(0.1).diameter_nm(120.0))
+        .grid_n([16, 16, 12])
+        .wavelengths_nm(&[550.0])
+        .polar_deg(&[0.0])
+        .tolerance(1e-6)
+        .outputs(&["tile"])
+        .output(dir.path(), "r");
+    for (equation, tensor) in [("maxwell", true), ("helmholtz", false)] {
+        let scene = base.clone().equation(equation).scene(dir.path());
+        let plan = inksim::pipeline::RunPlan::of(&scene).lines.join("\n");
+        let want = if tensor {
+            "as a tensor per grain"
+        } else {
+            "orientation average"
+        };
+        assert!(plan.contains(want), "{equation}: {plan}");
+        let rep = inksim::pipeline::run(&scene).unwrap();
+        for e in &rep.entries {
+            assert!(e.efficiencies.energy_balance.abs() < 1e-4);
+            let note = &e.record.note;
+            if tensor {
+                let count = |what: &str| -> usize {
+                    let before = note.split(what).next().unwrap();
+                    before.rsplit(' ').next().unwrap().parse().unwrap()
+                };
+                assert!(count(" cut voxels") > 0, "{note}");
+                assert!(count(" crystal-grain voxels") > 100, "{note}");
+            } else {
+                assert!(!note.contains("tensor"), "{note}");
+            }
+        }
+    }
 }

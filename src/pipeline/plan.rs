@@ -191,6 +191,19 @@ fn grain_lines(scene: &Scene) -> Vec<String> {
             String::new()
         }
     ));
+    for s in scene.species.iter().filter(|s| s.material.axes().is_some()) {
+        lines.push(format!(
+            "crystal grains: `{}` {}",
+            s.name,
+            if scene.solver.equation == crate::config::Equation::Maxwell {
+                "as a tensor per grain (ordinary and extraordinary ε, the c axis along a \
+                 rod's length or uniform at random for a sphere)"
+            } else {
+                "as its orientation average (2ε_o + ε_e)/3 (the scalar equation has no \
+                 direction; Maxwell's takes a tensor per grain)"
+            }
+        ));
+    }
     if scene.layer.equilibrate_sweeps > 0 {
         lines.push(format!(
             "equilibration: {} hard-particle Monte Carlo sweeps after packing \

@@ -92,22 +92,33 @@ pub fn solve_layer(
         .below
         .as_ref()
         .map(|_| Array3::from_elem((g.nz, g.ny, g.nx), C64::new(0.0, 0.0)));
-    // The cut voxels' tensor part (Maxwell, anisotropic voxels), and its
-    // mirror image for light from below.
-    let anisotropic = scene
+    // The tensor part (Maxwell: anisotropic cut voxels, crystal grains),
+    // and its mirror image for light from below.
+    let surfaces = scene
         .grid
         .voxel_permittivity
         .anisotropic(scene.solver.equation);
+    let maxwell = scene.solver.equation == crate::config::Equation::Maxwell;
     let mut tensor = Anisotropy::empty(g.nz, (g.ny, g.nx));
     let mut tensor_below = Anisotropy::empty(g.nz, (g.ny, g.nx));
+    // (surface terms, crystal terms) of the wavelength's tensor.
+    let mut tensor_counts = (0, 0);
     let mut entries = Vec::new();
     for &lambda in &scene.wavelengths_nm {
         match layer {
             LayerEps::Raster(raster) => {
                 let eps_species = fraction_eps(scene, lambda)?;
                 raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
-                if anisotropic {
-                    raster.anisotropy_into(C64::new(eps_b, 0.0), &eps_species, &mut tensor);
+                let crystals = crystal_eps(scene, lambda, maxwell);
+                if surfaces || crystals.iter().any(Option::is_some) {
+                    tensor_counts = raster.anisotropy_into(
+                        C64::new(eps_b, 0.0),
+                        &eps_species,
+                        &crystals,
+                        surfaces,
+                        &mut eps,
+                        &mut tensor,
+                    );
                     if plan.embedded {
                         tensor.scale(C64::new(outside, 0.0));
                     }
@@ -174,7 +185,7 @@ pub fn solve_layer(
                     "{lambda} nm, {}° {side}",
                     (inc.polar_deg * 100.0).round() / 100.0
                 );
-                let (efficiencies, record) =
+                let (efficiencies, mut record) =
                     solve_balanced(&p, scene.solver.method, ctl, &beat, progress, &label).map_err(
                         |source| PipelineError::Solve {
                             wavelength_nm: lambda,
@@ -182,6 +193,12 @@ pub fn solve_layer(
                             source,
                         },
                     )?;
+                if p.tensor.is_some() {
+                    record.note.push_str(&format!(
+                        "; tensor ε: {} cut voxels anisotropic, {} crystal-grain voxels",
+                        tensor_counts.0, tensor_counts.1
+                    ));
+                }
                 parts.push((wave, efficiencies, record));
             }
             let entry = combine(parts, lambda, inc, *side, realisation);
@@ -190,6 +207,22 @@ pub fn solve_layer(
         }
     }
     Ok(entries)
+}
+
+/// Each species' `(ε_o, ε_e)` where it is a uniaxial crystal and the scene
+/// is solved in Maxwell's equations (a tensor per grain, METHOD §8), else
+/// None (its orientation average).
+fn crystal_eps(scene: &Scene, lambda: f64, maxwell: bool) -> Vec<Option<(C64, C64)>> {
+    scene
+        .species
+        .iter()
+        .map(|s| {
+            s.material.axes()?;
+            maxwell
+                .then(|| s.material.epsilon_axes_at(lambda))
+                .flatten()
+        })
+        .collect()
 }
 
 /// How often a long solve reports: `INKSIM_HEARTBEAT_S` seconds when set

@@ -23,6 +23,12 @@
 //! uniaxial terms `δ â âᵀ`, sorted by voxel, several allowed per voxel, so
 //! that other tensor parts (a crystal's axis) take the same form.
 //!
+//! A uniaxial crystal grain (ordinary `ε_o`, extraordinary `ε_e`, optic axis
+//! ĉ) is the tensor `ε_o I + (ε_e − ε_o) ĉĉᵀ`. Where the grid holds its
+//! orientation average `ε̄ = (2ε_o + ε_e)/3` at share `f`, the voxel's scalar
+//! part moves by `f (ε_o − ε̄)` and it gains the term `f (ε_e − ε_o) ĉĉᵀ`;
+//! a cut voxel's surface term takes the crystal's `ε_o` in its means.
+//!
 //! Where the harmonic mean is not used: a voxel with a constituent whose
 //! `Re ε ≤ 0` (a metal; the harmonic mean can pass through a pole there), a
 //! voxel whose grain share rounds to 0 or 1, and the surface of an explicit
@@ -33,6 +39,19 @@ use num_complex::Complex64;
 
 /// Grain shares within this of 0 or 1 make a voxel uncut.
 pub const CUT_SHARE: f64 = 1e-9;
+
+/// A crystal grain's share of one voxel of a slice, with its axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GrainShare {
+    /// `ix + nx · iy` within the slice.
+    pub index: u32,
+    /// The grain's species.
+    pub species: u32,
+    /// The grain's volume fraction of the voxel.
+    pub share: f64,
+    /// The crystal's optic (c) axis, a unit vector.
+    pub axis: [f64; 3],
+}
 
 /// The grain surface's unit normal in one voxel of a slice.
 #[derive(Debug, Clone, Copy, PartialEq)]

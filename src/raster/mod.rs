@@ -42,7 +42,7 @@ pub mod anisotropy;
 pub mod structure;
 pub mod surface;
 
-pub use anisotropy::{Anisotropy, Normal, SurfaceNormals};
+pub use anisotropy::{Anisotropy, GrainShare, Normal, SurfaceNormals};
 
 use crate::geometry::{Geometry, Sphere};
 use ndarray::{Array2, Array3, ArrayViewMut2, Axis};
@@ -181,6 +181,10 @@ pub struct Raster {
     /// The grain surface's normal in every voxel it cuts ([`anisotropy`]),
     /// one list per z-slice; empty for an explicit structure.
     pub normals: SurfaceNormals,
+    /// Per z-slice, each kept species' particles' shares of the voxels with
+    /// the particle's crystal axis, sorted by voxel
+    /// ([`rasterize_keeping_axes`]); empty otherwise.
+    pub crystal: Vec<Vec<GrainShare>>,
 }
 
 /// A particle ready for rasterising: its spheres unwrapped next to the first
@@ -191,6 +195,41 @@ struct Prepared {
     len: usize,
     lo: [f64; 3],
     hi: [f64; 3],
+    /// The crystal axis ([`crystal_axis`]).
+    axis: [f64; 3],
+}
+
+/// A particle's crystal axis: along a cluster's long axis (first to last
+/// sphere, unwrapped; needles and rods grow along their c axis), for a
+/// single sphere a direction uniform on the sphere drawn from a hash of the
+/// particle's index and centre (fixed by the geometry, the same for any
+/// thread count).
+fn crystal_axis(index: usize, spheres: &[Sphere]) -> [f64; 3] {
+    if let (Some(a), Some(b)) = (spheres.first(), spheres.last()) {
+        let d = [0, 1, 2].map(|k| b.center[k] - a.center[k]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        if spheres.len() > 1 && len > 0.0 {
+            return d.map(|v| v / len);
+        }
+    }
+    let mut h = (index as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    for s in spheres.iter().take(1) {
+        for c in s.center {
+            h = (h ^ c.to_bits()).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            h ^= h >> 31;
+        }
+    }
+    let mut next = || {
+        h = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = h;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let cos = 2.0 * next() - 1.0;
+    let phi = 2.0 * std::f64::consts::PI * next();
+    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+    [sin * phi.cos(), sin * phi.sin(), cos]
 }
 
 fn prepare(geometry: &Geometry, size: [f64; 3]) -> (Vec<Prepared>, Vec<Sphere>) {
@@ -232,6 +271,7 @@ fn prepare(geometry: &Geometry, size: [f64; 3]) -> (Vec<Prepared>, Vec<Sphere>) 
             len: p.spheres.len(),
             lo,
             hi,
+            axis: crystal_axis(preps.len(), &spheres[first..]),
         });
     }
     (preps, spheres)
@@ -359,6 +399,18 @@ fn voxel_fraction(
 /// geometry's fragment, or its height is not `H` plus a whole number of
 /// cells (relative 1e-9): programming errors, not input.
 pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster {
+    rasterize_keeping_axes(geometry, grid, supersample, &[])
+}
+
+/// [`rasterize`], keeping for the species with `keep[s]` each particle's
+/// share of every voxel it touches with its crystal axis
+/// ([`Raster::crystal`]; for the tensor of uniaxial crystal grains).
+pub fn rasterize_keeping_axes(
+    geometry: &Geometry,
+    grid: &Grid,
+    supersample: usize,
+    keep: &[bool],
+) -> Raster {
     if let Err(e) = grid.check() {
         panic!("rasterize: {e}");
     }
@@ -420,6 +472,7 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         .map(|(iz, (mut views, members))| {
             let mut active = Vec::new();
             let mut normals = Vec::new();
+            let mut shares = Vec::new();
             let z_lo = z_origin + iz as f64 * dz;
             let z_hi = z_lo + dz;
             for &pi in members {
@@ -428,6 +481,7 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                 let (x0, x1) = voxel_range(p.lo[0], p.hi[0], dx, nx);
                 let (y0, y1) = voxel_range(p.lo[1], p.hi[1], dy, ny);
                 let view = &mut views[p.species];
+                let kept = keep.get(p.species).copied().unwrap_or(false);
                 for iy in y0..=y1 {
                     let wy = iy.rem_euclid(ny as i64) as usize;
                     let y_lo = iy as f64 * dy;
@@ -443,6 +497,14 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                         );
                         if f > 0.0 {
                             view[[wy, wx]] += f;
+                            if kept {
+                                shares.push(GrainShare {
+                                    index: (wx + nx * wy) as u32,
+                                    species: p.species as u32,
+                                    share: f,
+                                    axis: p.axis,
+                                });
+                            }
                         }
                         if f > 0.0 && f < 1.0 {
                             let centre = [x_lo + 0.5 * dx, y_lo + 0.5 * dy, z_lo + 0.5 * dz];
@@ -456,6 +518,16 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                     }
                 }
             }
+            // Shares are scaled as the fractions are below, where overlaps
+            // pushed a voxel above 1.
+            shares.sort_by_key(|g: &GrainShare| g.index);
+            for g in &mut shares {
+                let i = g.index as usize;
+                let total: f64 = views.iter().map(|v| v[[i / nx, i % nx]]).sum();
+                if total > 1.0 {
+                    g.share /= total;
+                }
+            }
             for iy in 0..ny {
                 for ix in 0..nx {
                     let total: f64 = views.iter().map(|v| v[[iy, ix]]).sum();
@@ -466,9 +538,15 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
                     }
                 }
             }
-            SurfaceNormals::merge_slice(normals)
+            (SurfaceNormals::merge_slice(normals), shares)
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let (normals, crystal): (Vec<_>, Vec<_>) = normals.into_iter().unzip();
+    let crystal = if crystal.iter().all(Vec::is_empty) {
+        Vec::new()
+    } else {
+        crystal
+    };
 
     Raster {
         grid: *grid,
@@ -476,6 +554,7 @@ pub fn rasterize(geometry: &Geometry, grid: &Grid, supersample: usize) -> Raster
         top_cells,
         surface_nm: None,
         normals: SurfaceNormals { slices: normals },
+        crystal,
     }
 }
 
@@ -580,54 +659,98 @@ impl Raster {
     }
 
     /// The tensor part of the permittivity at `eps_binder`, `eps_species`
-    /// ([`anisotropy`]): for every voxel with a surface normal, the term
-    /// `(ε_n − ε_t) n̂ n̂ᵀ` with `ε_t` the arithmetic mean of
-    /// [`Raster::epsilon_into`] and `ε_n` the harmonic mean of the same
-    /// shares; written into `out`, whose allocation is reused.
+    /// ([`anisotropy`]), written into `out`, whose allocation is reused:
+    /// - with `surfaces`, for every voxel with a surface normal, the term
+    ///   `(ε_n − ε_t) n̂ n̂ᵀ` with `ε_t` the voxel's scalar part and `ε_n` the
+    ///   harmonic mean of the same shares;
+    /// - for the species with `crystals[s] = Some((ε_o, ε_e))` (whose
+    ///   `eps_species` entry is the orientation average `(2ε_o + ε_e)/3`)
+    ///   and kept axes ([`rasterize_keeping_axes`]), each grain's term
+    ///   `f (ε_e − ε_o) ĉĉᵀ`, and `eps` (the grid of
+    ///   [`Raster::epsilon_into`]) moved by `f (ε_o − ε̄)` in its voxels.
+    ///
+    /// Terms are sorted by voxel within each slice. Returns the number of
+    /// surface terms and of crystal terms.
     pub fn anisotropy_into(
         &self,
         eps_binder: Complex64,
         eps_species: &[Complex64],
+        crystals: &[Option<(Complex64, Complex64)>],
+        surfaces: bool,
+        eps: &mut Array3<Complex64>,
         out: &mut Anisotropy,
-    ) {
+    ) -> (usize, usize) {
         assert_eq!(
             eps_species.len(),
             self.fractions.len(),
             "anisotropy_into: one permittivity per species"
         );
+        let (mut surface_terms, mut crystal_terms) = (0, 0);
         let g = &self.grid;
+        assert_eq!(
+            eps.dim(),
+            (g.nz, g.ny, g.nx),
+            "anisotropy_into: ε grid shape"
+        );
         out.clear(g.nz, (g.ny, g.nx));
-        for (iz, normals) in self.normals.slices.iter().enumerate().take(g.nz) {
+        let crystal = |s: usize| crystals.get(s).copied().flatten();
+        // The species' permittivity in the surface means: a crystal's ε_o.
+        let eps_mean: Vec<Complex64> = eps_species
+            .iter()
+            .enumerate()
+            .map(|(s, &e)| crystal(s).map_or(e, |(o, _)| o))
+            .collect();
+        let mut slice_terms = Vec::new();
+        for iz in 0..g.nz {
+            slice_terms.clear();
+            if let Some(shares) = self.crystal.get(iz) {
+                for sh in shares {
+                    let i = sh.index as usize;
+                    let (iy, ix) = (i / g.nx, i % g.nx);
+                    let s = sh.species as usize;
+                    let Some((o, e)) = crystal(s) else { continue };
+                    eps[[iz, iy, ix]] += sh.share * (o - eps_species[s]);
+                    slice_terms.push(anisotropy::Term {
+                        index: sh.index,
+                        axis: sh.axis,
+                        delta: sh.share * (e - o),
+                    });
+                    crystal_terms += 1;
+                }
+            }
+            let normals = match self.normals.slices.get(iz) {
+                Some(v) if surfaces => &v[..],
+                _ => &[][..],
+            };
             for nv in normals {
                 let i = nv.index as usize;
                 let (iy, ix) = (i / g.nx, i % g.nx);
                 let depth = self.surface_nm.as_ref().map_or(1.0, |s| s[[iy, ix]]);
                 let eps_bg = self.background(eps_binder, iz, depth);
-                let shares = || {
-                    self.fractions
-                        .iter()
-                        .zip(eps_species)
-                        .map(move |(f, &e)| (f[[iz, iy, ix]], e))
-                };
-                let total: f64 = shares().map(|(f, _)| f).sum();
-                let eps_t = shares().fold(eps_bg * (1.0 - total), |acc, (f, e)| acc + e * f);
-                let Some(eps_n) = anisotropy::harmonic_mean(eps_bg, shares()) else {
+                let shares = self
+                    .fractions
+                    .iter()
+                    .zip(&eps_mean)
+                    .map(|(f, &e)| (f[[iz, iy, ix]], e));
+                let Some(eps_n) = anisotropy::harmonic_mean(eps_bg, shares) else {
                     continue;
                 };
+                let eps_t = eps[[iz, iy, ix]];
                 let delta = eps_n - eps_t;
                 if delta.norm() > 1e-12 * eps_t.norm() {
-                    out.terms.push(anisotropy::Term {
+                    slice_terms.push(anisotropy::Term {
                         index: nv.index,
                         axis: nv.n,
                         delta,
                     });
+                    surface_terms += 1;
                 }
             }
+            slice_terms.sort_by_key(|t| t.index);
+            out.terms.extend_from_slice(&slice_terms);
             out.offsets[iz + 1] = out.terms.len();
         }
-        for iz in self.normals.slices.len().min(g.nz)..g.nz {
-            out.offsets[iz + 1] = out.terms.len();
-        }
+        (surface_terms, crystal_terms)
     }
 
     /// Rasterised grain volume per species over the binder layer's volume
@@ -691,6 +814,11 @@ impl Raster {
             fractions,
             top_cells: self.top_cells + k,
             surface_nm: self.surface_nm,
+            crystal: if self.crystal.is_empty() {
+                Vec::new()
+            } else {
+                (0..k).map(|_| Vec::new()).chain(self.crystal).collect()
+            },
             normals: SurfaceNormals {
                 slices: (0..k)
                     .map(|_| Vec::new())

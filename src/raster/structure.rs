@@ -255,6 +255,7 @@ pub fn rasterize_primitives(primitives: &[Primitive], grid: &Grid) -> Raster {
         top_cells: 0,
         surface_nm: None,
         normals: Default::default(),
+        crystal: Vec::new(),
     }
 }
 

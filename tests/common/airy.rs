@@ -113,6 +113,30 @@ pub fn tmm_p(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
     ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
 }
 
+/// [`tmm_p`] for uniaxial layers `(ε_xx, ε_zz, thickness)` whose optic
+/// axis lies along x or z (plane of incidence x-z): H_y and `H_y'/(iε_xx)`
+/// continuous, `k_z² = ε_xx (k0² − κ²/ε_zz)` inside.
+#[allow(dead_code)]
+pub fn tmm_p_uniaxial(layers: &[(C64, C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
+    let k0 = 2.0 * PI / wl;
+    let kx = k0 * polar.to_radians().sin();
+    let b = kz(C64::new(k0 * k0 - kx * kx, 0.0));
+    let (mut u, mut w) = (C64::new(1.0, 0.0), b);
+    for &(exx, ezz, d) in layers.iter().rev() {
+        let g = kz(exx * (k0 * k0 - kx * kx / ezz));
+        let (c, s) = ((g * d).cos(), (g * d).sin());
+        let (u2, w2) = (
+            c * u - C64::i() * s * exx * w / g,
+            -C64::i() * g * s * u / exx + c * w,
+        );
+        u = u2;
+        w = w2;
+    }
+    let a = (u + w / b) / 2.0;
+    let r = (u - w / b) / 2.0;
+    ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
+}
+
 /// `2 ∫₀¹ f(μ) μ dμ` by composite Simpson with many points (the
 /// diffuse terms of a closed-form slab, `R_dd` and `T_d`).
 pub fn hemispherical(f: impl Fn(f64) -> f64) -> f64 {

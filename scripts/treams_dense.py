@@ -27,6 +27,10 @@ Usage (in a venv with `pip install treams==0.4.7 numpy`):
     python scripts/treams_dense.py [--out tests/fixtures/treams_dense.json] [--incidence 45:p ...]
     target/release/examples/spheres_slab $(python scripts/treams_dense.py --inksim-args 45:p) 20 10 \
         | python scripts/treams_dense.py --compare dense16:45:p
+    # cost against the number of spheres per cell: the same layer tiled 2 x 2 (64 spheres per cell)
+    python scripts/treams_dense.py --supercell 2 --time 2:3 --incidence 45:p
+    target/release/examples/spheres_slab $(python scripts/treams_dense.py --supercell 2 --inksim-args 45:p) 10 \
+        | python scripts/treams_dense.py --supercell 2 --compare dense16:45:p
 """
 import os
 
@@ -219,17 +223,72 @@ def write_fixture(out, incidences):
     print(f"wrote {out} ({fixture['total_cpu_seconds']:.0f} CPU s)")
 
 
-def inksim_args(path, what):
-    """The examples/spheres_slab arguments of the stored layer."""
+def supercell(case, k):
+    """The stored layer tiled k x k: the same structure with k^2 N spheres per cell."""
+    if k == 1:
+        return case
+    period = case["period_nm"]
+    sph = [dict(s, center_nm=[s["center_nm"][0] + i * period, s["center_nm"][1] + j * period, s["center_nm"][2]])
+           for i in range(k) for j in range(k) for s in case["spheres"]]
+    return dict(case, period_nm=k * period, spheres=sph)
+
+
+def inksim_args(path, what, k=1):
+    """The examples/spheres_slab arguments of the stored layer (tiled k x k)."""
     polar, pol = what.split(":")
     with open(path) as f:
-        case = json.load(f)["cases"][0]
+        case = supercell(json.load(f)["cases"][0], k)
     args = ["--period", f"{case['period_nm']:g}", "--thickness", f"{case['thickness_nm']:g}",
             "--polar", polar, "--pol", pol]
     for s in case["spheres"]:
         x, y, z = s["center_nm"]
         args += ["--sphere", f"{x:g},{y:g},{z:g},{s['radius_nm']:g},{s['n'][0]:g},{s['n'][1]:g}"]
     print(" ".join(args))
+
+
+def tiled_error(orders, a_tot, inc, k):
+    """Largest per-order |dR|, |dT| and |dA| of a K x K tiling's orders against the layer's reference:
+    order (K m, K n) is the layer's (m, n), every other order is zero."""
+    ref = {(o["m"], o["n"]): (o["R"], o["T"]) for o in inc["orders"]}
+    seen = set()
+    err = abs(a_tot - inc["A"])
+    for m, n, r, t in orders:
+        key = (m // k, n // k) if m % k == 0 and n % k == 0 else None
+        want = ref.get(key, (0.0, 0.0))
+        seen.add(key)
+        err = max(err, abs(r - want[0]), abs(t - want[1]))
+    assert set(ref) <= seen, "orders of the layer missing from the tiling"
+    return err
+
+
+def load_incidence(path, polar, pol):
+    with open(path) as f:
+        case = json.load(f)["cases"][0]
+    inc = next(i for i in case["incidence"] if i["polar_deg"] == float(polar) and i["pol"] == pol)
+    return case, inc
+
+
+def supercell_compare(path, what, k):
+    """inksim's RESULT lines for the K x K tiling (stdin) against the layer's reference."""
+    _, polar, pol = what.split(":")
+    _, inc = load_incidence(path, polar, pol)
+    for line in sys.stdin:
+        if line.startswith("RESULT "):
+            r = json.loads(line[len("RESULT "):])
+            err = tiled_error(r["orders"], r["A"], inc, k)
+            print(f"inksim {k}x{k} tiling, {r['cell_nm']:g} nm ({r['nx']}x{r['nx']}x{r['nz']}): max error {err:.2e}, "
+                  f"{r['iterations']} iterations, {r['cpu_seconds']:.2f} CPU s")
+
+
+def supercell_time(path, setting, incidence, k):
+    """One timed treams solve of the K x K tiling against the layer's reference."""
+    lmax, bmax = int(setting.split(":")[0]), float(setting.split(":")[1])
+    polar, pol = incidence.split(":")
+    case, inc = load_incidence(path, polar, pol)
+    res = tr.timed(supercell(case, k), float(polar), pol, lmax, k * bmax)
+    err = tiled_error([(o["m"], o["n"], o["R"], o["T"]) for o in res["orders"]], res["A"], inc, k)
+    print(f"treams {k}x{k} tiling ({k * k * len(case['spheres'])} spheres per cell), lmax {lmax}, "
+          f"bmax {bmax:g} (2 pi / L of the layer): max error {err:.2e}, {res['cpu_seconds']:.1f} CPU s")
 
 
 def main():
@@ -241,11 +300,21 @@ def main():
     ap.add_argument("--compare", metavar="CASE:POLAR:POL",
                     help="read examples/spheres_slab RESULT lines from stdin and print their error "
                          "against the fixture (--out), e.g. dense16:45:p")
+    ap.add_argument("--supercell", type=int, default=1, metavar="K",
+                    help="with --inksim-args, --compare or --time: the layer tiled K x K (K^2 N spheres per "
+                         "cell, the same structure; order (m, n) of the layer is order (K m, K n) of the tiling)")
+    ap.add_argument("--time", metavar="LMAX:BMAX",
+                    help="time one treams solve of the (tiled) layer at the first --incidence, bmax in 2 pi / L "
+                         "of the layer, and print its error against the fixture's reference")
     args = ap.parse_args()
     if args.inksim_args:
-        inksim_args(args.out, args.inksim_args)
+        inksim_args(args.out, args.inksim_args, args.supercell)
+    elif args.compare and args.supercell > 1:
+        supercell_compare(args.out, args.compare, args.supercell)
     elif args.compare:
         tr.compare(args.out, args.compare)
+    elif args.time:
+        supercell_time(args.out, args.time, args.incidence[0], args.supercell)
     else:
         inc = [(float(w.split(":")[0]), w.split(":")[1]) for w in args.incidence]
         write_fixture(args.out, inc)

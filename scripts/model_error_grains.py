@@ -7,9 +7,14 @@ realisations' paired differences. Writes a Markdown table to stdout.
 
 The fidelity is fixed below (1 µm layer, 1 × 1 µm fragments, 25 nm cells,
 20 nm z cells, 400–700 nm every 30 nm, tolerance 1e-4). Both equations see
-the same discretised layer, so the table measures the model error at that
-fidelity; the discretisation's own error (docs/ACCURACY.md) largely cancels
-in the difference.
+the same discretised layer, volume-averaged voxels included
+(grid.voxel_permittivity = "average"), so the table measures the model error
+at that fidelity; the discretisation's own error (docs/ACCURACY.md) largely
+cancels in the difference.
+
+With --compare voxels it measures instead what Maxwell's anisotropic cut
+voxels (the default of a Maxwell run) change against volume averaging on
+the same fragments: both runs in Maxwell, "average" against "anisotropic".
 
 Usage: python3 scripts/model_error_grains.py [--inksim target/release/inksim]
        [--realisations 3] [--pigments red,blue,yellow] [--pvc 0.15,0.3,0.5]
@@ -42,6 +47,8 @@ diameter_nm = {diameter}
 [grid]
 cell_nm = 25.0
 z_cell_nm = 20.0
+voxel_permittivity = "{voxels}"
+
 [illumination]
 wavelength_range_nm = {{ start = 400.0, stop = 700.0, step = 30.0 }}
 polar_deg = [0.0]
@@ -62,12 +69,13 @@ quadrature_points = 4
 GEOMETRIES = {"45/0": "45_0", "d/8 SCI": "d8_sci", "d/8 SCE": "d8_sce"}
 
 
-def realisation_labs(inksim, work, equation, **kw):
+def realisation_labs(inksim, work, equation, voxels="average", **kw):
     """CIELAB of every realisation per geometry, (R, 3) each."""
-    out = os.path.join(work, "{pigment}-{pvc}-{diameter}-".format(**kw) + equation)
+    out = os.path.join(work, "{pigment}-{pvc}-{diameter}-".format(**kw)
+                       + equation + "-" + voxels)
     scene = os.path.join(work, "scene.toml")
     with open(scene, "w") as f:
-        f.write(SCENE.format(equation=equation, out=out, **kw))
+        f.write(SCENE.format(equation=equation, voxels=voxels, out=out, **kw))
     subprocess.run([inksim, "run", scene], check=True, capture_output=True)
     with h5py.File(os.path.join(out, "r.h5"), "r") as f:
         return {g: f[f"appearance/measured/{k}/lab_realisations"][()].reshape(-1, 3)
@@ -97,9 +105,16 @@ def main():
     ap.add_argument("--pigments", default="red,blue,yellow")
     ap.add_argument("--pvc", default="0.15,0.3,0.5")
     ap.add_argument("--diameters", default="100,200,300")
+    ap.add_argument("--compare", choices=["equations", "voxels"], default="equations")
     args = ap.parse_args()
+    if args.compare == "equations":
+        runs = (("helmholtz", "average"), ("maxwell", "average"))
+        title = "Helmholtz → Maxwell"
+    else:
+        runs = (("maxwell", "average"), ("maxwell", "anisotropic"))
+        title = "average → anisotropic"
     print("| pigment | PVC | diameter | " + " | ".join(GEOMETRIES)
-          + " | L* 45/0, Helmholtz → Maxwell |")
+          + f" | L* 45/0, {title} |")
     print("|---|---|---|" + "---|" * len(GEOMETRIES) + "---|")
     with tempfile.TemporaryDirectory() as work:
         for pigment in args.pigments.split(","):
@@ -107,8 +122,8 @@ def main():
                 for diameter in (float(d) for d in args.diameters.split(",")):
                     kw = dict(pigment=pigment, pvc=pvc, diameter=diameter, seed=20240601,
                               realisations=args.realisations)
-                    h = realisation_labs(args.inksim, work, "helmholtz", **kw)
-                    m = realisation_labs(args.inksim, work, "maxwell", **kw)
+                    h = realisation_labs(args.inksim, work, *runs[0], **kw)
+                    m = realisation_labs(args.inksim, work, *runs[1], **kw)
                     cells = []
                     for g in GEOMETRIES:
                         d, se = difference(h[g], m[g])

@@ -5,7 +5,11 @@
 //! value: the tile's colours (CIEDE2000, max and mean over its cells), the
 //! BRDF of layer + paper (relative L2), and R, T, A (max abs difference).
 //!
-//! `cargo run --release --example accuracy -- [case ...] [--out DIR] [--knob K ...]`
+//! `cargo run --release --example accuracy -- [case ...] [--out DIR] [--knob K ...]
+//!  [--set KEY=VALUE ...]`
+//!
+//! `--set` changes the baseline of every variant (a dotted key and a TOML
+//! value, e.g. `--set solver.equation='"maxwell"'`).
 //!
 //! Cases: `weak` (red, 15 % PVC, 100 nm spheres), `typical` (red, 30 %,
 //! 200 nm), `hard` (blue, 50 %, 250 nm, dynamics packing); default all.
@@ -297,11 +301,20 @@ fn main() -> anyhow::Result<()> {
     let mut out = PathBuf::from("runs/accuracy");
     let mut cases: Vec<&str> = Vec::new();
     let mut only: Vec<String> = Vec::new();
+    let mut overrides: Vec<(String, Value)> = Vec::new();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--out" => out = PathBuf::from(it.next().expect("--out DIR")),
             "--knob" => only.push(it.next().expect("--knob KEY").clone()),
+            "--set" => {
+                let kv = it.next().expect("--set KEY=VALUE");
+                let (k, v) = kv.split_once('=').expect("--set KEY=VALUE");
+                let v: Value = toml::from_str::<toml::Table>(&format!("v = {v}"))
+                    .map_err(|e| anyhow::anyhow!("--set {kv}: {e}"))?["v"]
+                    .clone();
+                overrides.push((k.to_string(), v));
+            }
             c => cases.push(c),
         }
     }
@@ -331,12 +344,19 @@ fn main() -> anyhow::Result<()> {
             if !only.is_empty() && !only.iter().any(|k| k == key) {
                 continue;
             }
-            let mut scene = base(case, &dir);
+            let based = || {
+                let mut scene = base(case, &dir);
+                for (k, v) in &overrides {
+                    set(&mut scene, k, v.clone());
+                }
+                scene
+            };
+            let mut scene = based();
             let reference = values.last().unwrap().clone();
             set(&mut scene, key, reference.clone());
             let r = run(&exe, &scene, &dir, &mut cache);
             for v in &values {
-                let mut scene = base(case, &dir);
+                let mut scene = based();
                 set(&mut scene, key, v.clone());
                 let m = run(&exe, &scene, &dir, &mut cache);
                 let e = compare(&m.result, &r.result, &obs);

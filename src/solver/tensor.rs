@@ -68,14 +68,37 @@ pub fn add_contrast<S: Storage + Sync>(
     field: &mut Array3<C64>,
 ) {
     let nz = a.nz();
-    let nx = a.plane.1;
-    per_slice(field, nz, |iz, mut f| {
-        for t in a.slice(iz) {
-            let [iy, ix] = at(nx, t.index);
-            let v = [0, 1, 2].map(|c| x[[c * nz + iz, iy, ix]].load());
-            let w = k2 * t.delta * project(t.axis, v);
-            for (fc, a) in f.iter_mut().zip(t.axis) {
-                fc[[iy, ix]] += w * a;
+    let (ny, nx) = a.plane;
+    let plane = ny * nx;
+    per_slice(field, nz, |iz, f| {
+        let [fx, fy, fz] = f;
+        // Contiguous slices where the layouts allow (always, for the
+        // system's own arrays): no index arithmetic per component.
+        let rows = [0, 1, 2].map(|c| {
+            x.as_slice()
+                .map(|s| &s[(c * nz + iz) * plane..(c * nz + iz + 1) * plane])
+        });
+        match (rows, fx.as_slice_mut(), fy.as_slice_mut(), fz.as_slice_mut()) {
+            ([Some(rx), Some(ry), Some(rz)], Some(fx), Some(fy), Some(fz)) => {
+                for t in a.slice(iz) {
+                    let i = t.index as usize;
+                    let v = [rx[i].load(), ry[i].load(), rz[i].load()];
+                    let w = k2 * t.delta * project(t.axis, v);
+                    fx[i] += w * t.axis[0];
+                    fy[i] += w * t.axis[1];
+                    fz[i] += w * t.axis[2];
+                }
+            }
+            _ => {
+                let mut f = [fx, fy, fz];
+                for t in a.slice(iz) {
+                    let [iy, ix] = at(nx, t.index);
+                    let v = [0, 1, 2].map(|c| x[[c * nz + iz, iy, ix]].load());
+                    let w = k2 * t.delta * project(t.axis, v);
+                    for (fc, a) in f.iter_mut().zip(t.axis) {
+                        fc[[iy, ix]] += w * a;
+                    }
+                }
             }
         }
     });

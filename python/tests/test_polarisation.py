@@ -254,3 +254,14 @@ def test_random_phase_natural_light(ensemble):
         assert np.all(np.abs(cross) <= np.sqrt(xs * xp) + 1e-6), name
         largest = max(largest, float(np.abs(cross).max()))
     assert largest > 1e-6  # the phase is really there to average out
+
+
+def test_maxwell_notes_count_the_anisotropic_cut_voxels(maxwell):
+    """A Maxwell solve of grains says in its note how many voxels a grain
+    surface cuts and took as anisotropic (grid.voxel_permittivity = "auto");
+    the same grains in Helmholtz have no tensor part."""
+    import re
+    for note in maxwell["unpolarised"].solves["note"].values:
+        m = re.search(r"tensor ε: (\d+) cut voxels anisotropic, (\d+) crystal-grain voxels", str(note))
+        assert m, note
+        assert int(m.group(1)) > 0 and int(m.group(2)) == 0

@@ -321,7 +321,11 @@ fn main() -> anyhow::Result<()> {
                 let path = PathBuf::from(it.next().expect("--against FILE.h5"));
                 against = read_appearance(&path)
                     .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-                anyhow::ensure!(against.is_some(), "{}: no appearance stored", path.display());
+                anyhow::ensure!(
+                    against.is_some(),
+                    "{}: no appearance stored",
+                    path.display()
+                );
             }
             "--set" => {
                 let kv = it.next().expect("--set KEY=VALUE");

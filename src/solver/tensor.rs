@@ -78,7 +78,12 @@ pub fn add_contrast<S: Storage + Sync>(
             x.as_slice()
                 .map(|s| &s[(c * nz + iz) * plane..(c * nz + iz + 1) * plane])
         });
-        match (rows, fx.as_slice_mut(), fy.as_slice_mut(), fz.as_slice_mut()) {
+        match (
+            rows,
+            fx.as_slice_mut(),
+            fy.as_slice_mut(),
+            fz.as_slice_mut(),
+        ) {
             ([Some(rx), Some(ry), Some(rz)], Some(fx), Some(fy), Some(fz)) => {
                 for t in a.slice(iz) {
                     let i = t.index as usize;

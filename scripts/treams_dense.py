@@ -127,30 +127,23 @@ def reference(case, theta, pol):
                 f"({r['cpu_seconds']:.1f} CPU s)")
         return runs[(lmax, bmax)]
 
-    # lmax at a generous bmax, until a step changes < STEP_TOL.
-    lsteps = []
-    prev = None
-    for lmax in LMAX_SCAN:
-        cur = run(lmax, BMAX_HI)
-        if prev is not None:
-            lsteps.append({"from": prev[0], "to": lmax, "max_change": tr.max_diff(cur, prev[1])})
-            say(f"  lmax {prev[0]} -> {lmax}: {lsteps[-1]['max_change']:.1e}")
-            if lsteps[-1]["max_change"] < STEP_TOL:
-                break
-        prev = (lmax, cur)
-    lmax_ref = lmax  # the last of the scan
-    # bmax at that lmax, until a step changes < STEP_TOL.
-    bsteps = []
-    prevb = None
-    for bmax in BMAX_SCAN:
-        cur = run(lmax_ref, bmax)
-        if prevb is not None:
-            bsteps.append({"from": prevb[0], "to": bmax, "max_change": tr.max_diff(cur, prevb[1])})
-            say(f"  bmax {prevb[0]:g} -> {bmax:g}: {bsteps[-1]['max_change']:.1e}")
-            if bsteps[-1]["max_change"] < STEP_TOL:
-                break
-        prevb = (bmax, cur)
-    bmax_ref = bmax
+    def converge(values, solve, label):
+        """Solve at each value in turn until a step changes < STEP_TOL; the
+        last value solved and the steps."""
+        steps, prev = [], None
+        for v in values:
+            cur = solve(v)
+            if prev is not None:
+                steps.append({"from": prev[0], "to": v, "max_change": tr.max_diff(cur, prev[1])})
+                say(f"  {label} {prev[0]:g} -> {v:g}: {steps[-1]['max_change']:.1e}")
+                if steps[-1]["max_change"] < STEP_TOL:
+                    break
+            prev = (v, cur)
+        return v, steps
+
+    # lmax at a generous bmax, then bmax at that lmax.
+    lmax_ref, lsteps = converge(LMAX_SCAN, lambda lmax: run(lmax, BMAX_HI), "lmax")
+    bmax_ref, bsteps = converge(BMAX_SCAN, lambda bmax: run(lmax_ref, bmax), "bmax")
     ref = runs[(lmax_ref, bmax_ref)]
     for lmax, bmax in CHEAP_GRID:
         run(lmax, bmax)

@@ -93,24 +93,8 @@ pub fn tmm(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
 /// transmittance (vacuum on both sides).
 #[allow(dead_code)]
 pub fn tmm_p(layers: &[(C64, f64)], wl: f64, polar: f64) -> (f64, f64) {
-    let k0 = 2.0 * PI / wl;
-    let kx = k0 * polar.to_radians().sin();
-    let kz = |eps: C64| kz(eps * k0 * k0 - kx * kx);
-    let b = kz(C64::new(1.0, 0.0));
-    let (mut u, mut w) = (C64::new(1.0, 0.0), b);
-    for &(eps, d) in layers.iter().rev() {
-        let g = kz(eps);
-        let (c, s) = ((g * d).cos(), (g * d).sin());
-        let (u2, w2) = (
-            c * u - C64::i() * s * eps * w / g,
-            -C64::i() * g * s * u / eps + c * w,
-        );
-        u = u2;
-        w = w2;
-    }
-    let a = (u + w / b) / 2.0;
-    let r = (u - w / b) / 2.0;
-    ((r / a).norm_sqr(), (1.0 / a).norm_sqr())
+    let uniaxial: Vec<(C64, C64, f64)> = layers.iter().map(|&(e, d)| (e, e, d)).collect();
+    tmm_p_uniaxial(&uniaxial, wl, polar)
 }
 
 /// [`tmm_p`] for uniaxial layers `(ε_xx, ε_zz, thickness)` whose optic

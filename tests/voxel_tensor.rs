@@ -464,6 +464,28 @@ fn a_rutile_run_takes_a_tensor_per_grain_in_maxwell_only() {
             "orientation average"
         };
         assert!(plan.contains(want), "{equation}: {plan}");
+        // The memory model counts the cut voxels' normals and terms, and
+        // the crystal grains' shares and terms, in Maxwell only.
+        use inksim::pipeline::memory;
+        let crystal = memory::crystal_share(&scene);
+        assert_eq!(crystal > 0.1, tensor, "crystal share {crystal}");
+        let averaged = base
+            .clone()
+            .equation(equation)
+            .set("grid.voxel_permittivity", "average")
+            .scene(dir.path());
+        let cut = if tensor {
+            memory::CUT_VOXEL_BYTES * memory::cut_share(&scene)
+        } else {
+            0.0
+        };
+        let voxels = (16 * 16 * 12) as f64;
+        let diff = memory::estimate_bytes(&scene) - memory::estimate_bytes(&averaged);
+        assert!(
+            (diff - voxels * cut).abs() < 1e-6,
+            "{diff} vs {}",
+            voxels * cut
+        );
         let rep = inksim::pipeline::run(&scene).unwrap();
         for e in &rep.entries {
             assert!(e.efficiencies.energy_balance.abs() < 1e-4);

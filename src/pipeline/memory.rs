@@ -10,7 +10,8 @@
 //! flipped copy for the solves from below, and 8 B per species for the
 //! raster's volume fractions. With anisotropic cut voxels (Maxwell) the
 //! voxels a grain surface cuts hold [`CUT_VOXEL_BYTES`] more, their share
-//! estimated by [`cut_share`]. The grid is the one the run solves on
+//! estimated by [`cut_share`]; a uniaxial crystal's grains in Maxwell hold
+//! [`CRYSTAL_VOXEL_BYTES`] in every voxel they touch. The grid is the one the run solves on
 //! (including the cells a relief adds on top).
 //!
 //! The limit is the smaller of `--max-memory` and the machine's available
@@ -22,6 +23,7 @@
 //! process.
 
 use crate::config::{Equation, Method, Precision, Scene};
+use crate::raster::anisotropy::{GrainShare, Normal, Term};
 
 use super::grains::grid_of;
 use super::PipelineError;
@@ -44,7 +46,14 @@ pub const WARM_START_BYTES: f64 = 16.0;
 /// Bytes a cut voxel holds with anisotropic voxels: its surface normal
 /// (32 B) and the tensor term of each wavelength's grid and its flipped
 /// copy (48 B each).
-pub const CUT_VOXEL_BYTES: f64 = 128.0;
+pub const CUT_VOXEL_BYTES: f64 =
+    (std::mem::size_of::<Normal>() + 2 * std::mem::size_of::<Term>()) as f64;
+
+/// Bytes a voxel a crystal grain touches holds in Maxwell: the grain's share
+/// with its axis (40 B) and its tensor term in the grid and the flipped copy
+/// (48 B each).
+pub const CRYSTAL_VOXEL_BYTES: f64 =
+    (std::mem::size_of::<GrainShare>() + 2 * std::mem::size_of::<Term>()) as f64;
 
 /// The estimated share of voxels a grain surface cuts: `Σ 15 f_s c / d_s`
 /// (at most 1) over the species, with `f_s` the volume fraction, `d_s` the
@@ -52,16 +61,39 @@ pub const CUT_VOXEL_BYTES: f64 = 128.0;
 /// cut about `1–2.5 A/c²` cubic voxels (tests/voxel_tensor.rs), and
 /// spheres have `A/V = 6/d`.
 pub fn cut_share(scene: &Scene) -> f64 {
+    scene
+        .species
+        .iter()
+        .map(|s| species_cut_share(scene, s))
+        .sum::<f64>()
+        .min(1.0)
+}
+
+/// One species' term of [`cut_share`].
+fn species_cut_share(scene: &Scene, s: &crate::config::Species) -> f64 {
+    if s.shape == crate::config::GrainShape::Molecular || s.diameter_nm <= 0.0 {
+        return 0.0;
+    }
     let [nx, ny, nz] = solve_grid(scene);
     let cell = (scene.layer.fragment_x_nm / nx as f64
         + scene.layer.fragment_y_nm / ny as f64
         + scene.layer.thickness_nm / nz as f64)
         / 3.0;
+    15.0 * s.volume_fraction * cell / s.diameter_nm
+}
+
+/// The estimated share of voxels the grains of uniaxial crystal species
+/// touch in a Maxwell run (each species' volume fraction plus its cut
+/// share, at most 1); 0 in Helmholtz.
+pub fn crystal_share(scene: &Scene) -> f64 {
+    if scene.solver.equation != Equation::Maxwell {
+        return 0.0;
+    }
     scene
         .species
         .iter()
-        .filter(|s| s.shape != crate::config::GrainShape::Molecular && s.diameter_nm > 0.0)
-        .map(|s| 15.0 * s.volume_fraction * cell / s.diameter_nm)
+        .filter(|s| s.material.axes().is_some())
+        .map(|s| s.volume_fraction + species_cut_share(scene, s))
         .sum::<f64>()
         .min(1.0)
 }
@@ -97,17 +129,14 @@ pub fn estimate_bytes(scene: &Scene) -> f64 {
 }
 
 /// The cut voxels' share of [`CUT_VOXEL_BYTES`] per voxel (0 without
-/// anisotropic voxels).
+/// anisotropic voxels) and the crystal grains' of [`CRYSTAL_VOXEL_BYTES`].
 fn anisotropic_bytes(scene: &Scene) -> f64 {
-    if scene
+    let surfaces = scene
         .grid
         .voxel_permittivity
-        .anisotropic(scene.solver.equation)
-    {
-        CUT_VOXEL_BYTES * cut_share(scene)
-    } else {
-        0.0
-    }
+        .anisotropic(scene.solver.equation);
+    let cut = if surfaces { cut_share(scene) } else { 0.0 };
+    CUT_VOXEL_BYTES * cut + CRYSTAL_VOXEL_BYTES * crystal_share(scene)
 }
 
 /// A run whose memory estimate exceeds the limit: what to say about it.

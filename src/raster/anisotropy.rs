@@ -34,7 +34,6 @@
 //! voxel whose grain share rounds to 0 or 1, and the surface of an explicit
 //! structure (no normals): those keep the arithmetic mean, isotropic.
 
-use ndarray::Array2;
 use num_complex::Complex64;
 
 /// Grain shares within this of 0 or 1 make a voxel uncut.
@@ -181,21 +180,6 @@ impl Anisotropy {
             t.delta /= s;
         }
     }
-
-    /// A field of the slice's shape with each voxel's `Σ |δ|` (an upper
-    /// bound of the tensor part's norm), for tests and diagnostics.
-    pub fn norm_bound(&self, iz: usize) -> Array2<f64> {
-        let (ny, nx) = self.plane;
-        let mut out = Array2::zeros((ny, nx));
-        for t in self.slice(iz) {
-            let i = t.index as usize;
-            out[[i / nx, i % nx]] += t.delta.norm();
-        }
-        out
-    }
-
-    /// Bytes held per term (for the memory model).
-    pub const TERM_BYTES: usize = std::mem::size_of::<Term>();
 }
 
 /// The normal-direction permittivity of a cut voxel: the harmonic mean

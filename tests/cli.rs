@@ -345,7 +345,7 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert!(!out.exists(), "a refused run leaves nothing behind");
     // Maxwell: 3.2× the method's own 165 B per voxel (f64 BiCGStab) and the
     // 16 B of the warm start, plus the anisotropic cut voxels' 128 B times
-    // their estimated share 15 · 0.15 · 7.33 nm / 150 nm = 0.11, named
+    // their estimated share 9 · 0.15 · 7.33 nm / 150 nm = 0.066, named
     // with the equation and the scalar equation as a way out.
     let maxwell = huge_scene().equation("maxwell").write(dir.path());
     let (ok, _, err) = inksim(&["check", maxwell.to_str().unwrap(), "--max-memory", "1G"]);
@@ -353,7 +353,7 @@ fn a_scene_beyond_the_memory_limit_fails_check_and_run_before_any_work() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     for needle in [
         "f64 fields, maxwell",
-        "212.5 GB",
+        "210.6 GB",
         "precision = \"f32\"",
         "equation = \"helmholtz\"",
     ] {

@@ -55,11 +55,12 @@ pub const CUT_VOXEL_BYTES: f64 =
 pub const CRYSTAL_VOXEL_BYTES: f64 =
     (std::mem::size_of::<GrainShare>() + 2 * std::mem::size_of::<Term>()) as f64;
 
-/// The estimated share of voxels a grain surface cuts: `Σ 15 f_s c / d_s`
+/// The estimated share of voxels a grain surface cuts: `Σ 9 f_s c / d_s`
 /// (at most 1) over the species, with `f_s` the volume fraction, `d_s` the
-/// diameter and `c` the mean of the cell's three edges. Grains of area `A`
-/// cut about `1–2.5 A/c²` cubic voxels (tests/voxel_tensor.rs), and
-/// spheres have `A/V = 6/d`.
+/// diameter and `c` the mean of the cell's three edges. A surface of area
+/// `A` cuts about `A Σ_i ⟨|n_i|⟩ / (cell face ⊥ i)` voxels, `⟨|n_i|⟩ = 1/2`
+/// on a sphere, and spheres have `A/V = 6/d`. The demo scene (20 % of
+/// 200 nm grains, 25 × 25 × 10 nm cells): estimated 18 %, counted 13.4 %.
 pub fn cut_share(scene: &Scene) -> f64 {
     scene
         .species
@@ -79,7 +80,7 @@ fn species_cut_share(scene: &Scene, s: &crate::config::Species) -> f64 {
         + scene.layer.fragment_y_nm / ny as f64
         + scene.layer.thickness_nm / nz as f64)
         / 3.0;
-    15.0 * s.volume_fraction * cell / s.diameter_nm
+    9.0 * s.volume_fraction * cell / s.diameter_nm
 }
 
 /// The estimated share of voxels the grains of uniaxial crystal species

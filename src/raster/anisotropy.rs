@@ -68,15 +68,6 @@ pub struct SurfaceNormals {
 }
 
 impl SurfaceNormals {
-    /// Number of voxels with a normal.
-    pub fn len(&self) -> usize {
-        self.slices.iter().map(Vec::len).sum()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Sum the weighted normals that one slice's particles pushed (any
     /// order, repeats allowed) per voxel, normalise them and sort by index;
     /// voxels whose sum vanishes are dropped.
@@ -148,6 +139,12 @@ impl Anisotropy {
 
     pub fn is_empty(&self) -> bool {
         self.terms.is_empty()
+    }
+
+    /// The terms of slice `iz` grouped by voxel (one slice of terms per
+    /// voxel that has any).
+    pub fn voxel_terms(&self, iz: usize) -> impl Iterator<Item = &[Term]> {
+        self.slice(iz).chunk_by(|a, b| a.index == b.index)
     }
 
     /// Clear, keeping the allocation, for `nz` slices.

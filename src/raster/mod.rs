@@ -44,9 +44,11 @@ pub mod surface;
 
 pub use anisotropy::{Anisotropy, GrainShare, Normal, SurfaceNormals};
 
-use crate::geometry::{Geometry, Sphere};
+use crate::geometry::{axis_from_uniforms, particle_axis, Geometry, Orientation, Particle, Sphere};
 use ndarray::{Array2, Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64;
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::SplitMix64;
 use rayon::prelude::*;
 
 /// Largest supported supersampling factor per axis (one x line of sub-samples
@@ -199,37 +201,21 @@ struct Prepared {
     axis: [f64; 3],
 }
 
-/// A particle's crystal axis: along a cluster's long axis (first to last
-/// sphere, unwrapped; needles and rods grow along their c axis), for a
-/// single sphere a direction uniform on the sphere drawn from a hash of the
-/// particle's index and centre (fixed by the geometry, the same for any
-/// thread count).
-fn crystal_axis(index: usize, spheres: &[Sphere]) -> [f64; 3] {
-    if let (Some(a), Some(b)) = (spheres.first(), spheres.last()) {
-        let d = [0, 1, 2].map(|k| b.center[k] - a.center[k]);
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        if spheres.len() > 1 && len > 0.0 {
-            return d.map(|v| v / len);
-        }
-    }
-    let mut h = (index as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
-    for s in spheres.iter().take(1) {
-        for c in s.center {
-            h = (h ^ c.to_bits()).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            h ^= h >> 31;
-        }
-    }
-    let mut next = || {
-        h = h.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = h;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let cos = 2.0 * next() - 1.0;
-    let phi = 2.0 * std::f64::consts::PI * next();
-    let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    [sin * phi.cos(), sin * phi.sin(), cos]
+/// A particle's crystal axis: along a cluster's long axis
+/// ([`particle_axis`]: first to last sphere; needles and rods grow along
+/// their c axis), for a single sphere a direction uniform on the sphere
+/// ([`axis_from_uniforms`]) drawn from a seed of the particle's index and
+/// centre (fixed by the geometry, the same for any thread count).
+fn crystal_axis(geometry: &Geometry, index: usize, p: &Particle) -> [f64; 3] {
+    particle_axis(geometry, p).unwrap_or_else(|| {
+        let seed = p.spheres.first().map_or(0, |s| {
+            s.center
+                .iter()
+                .fold(index as u64, |h, c| h.rotate_left(21) ^ c.to_bits())
+        });
+        let mut rng = SplitMix64::seed_from_u64(seed);
+        axis_from_uniforms(Orientation::Random, rng.gen(), rng.gen())
+    })
 }
 
 fn prepare(geometry: &Geometry, size: [f64; 3]) -> (Vec<Prepared>, Vec<Sphere>) {
@@ -271,7 +257,7 @@ fn prepare(geometry: &Geometry, size: [f64; 3]) -> (Vec<Prepared>, Vec<Sphere>) 
             len: p.spheres.len(),
             lo,
             hi,
-            axis: crystal_axis(preps.len(), &spheres[first..]),
+            axis: crystal_axis(geometry, preps.len(), p),
         });
     }
     (preps, spheres)

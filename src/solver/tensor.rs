@@ -70,41 +70,21 @@ pub fn add_contrast<S: Storage + Sync>(
     let nz = a.nz();
     let (ny, nx) = a.plane;
     let plane = ny * nx;
+    // The system's arrays are in standard layout (made by `zeros` or
+    // `default`): borrowed as they are, rows as contiguous slices.
+    let x = x.as_standard_layout();
+    let xs = x.as_slice().expect("standard layout");
     per_slice(field, nz, |iz, f| {
-        let [fx, fy, fz] = f;
-        // Contiguous slices where the layouts allow (always, for the
-        // system's own arrays): no index arithmetic per component.
-        let rows = [0, 1, 2].map(|c| {
-            x.as_slice()
-                .map(|s| &s[(c * nz + iz) * plane..(c * nz + iz + 1) * plane])
-        });
-        match (
-            rows,
-            fx.as_slice_mut(),
-            fy.as_slice_mut(),
-            fz.as_slice_mut(),
-        ) {
-            ([Some(rx), Some(ry), Some(rz)], Some(fx), Some(fy), Some(fz)) => {
-                for t in a.slice(iz) {
-                    let i = t.index as usize;
-                    let v = [rx[i].load(), ry[i].load(), rz[i].load()];
-                    let w = k2 * t.delta * project(t.axis, v);
-                    fx[i] += w * t.axis[0];
-                    fy[i] += w * t.axis[1];
-                    fz[i] += w * t.axis[2];
-                }
-            }
-            _ => {
-                let mut f = [fx, fy, fz];
-                for t in a.slice(iz) {
-                    let [iy, ix] = at(nx, t.index);
-                    let v = [0, 1, 2].map(|c| x[[c * nz + iz, iy, ix]].load());
-                    let w = k2 * t.delta * project(t.axis, v);
-                    for (fc, a) in f.iter_mut().zip(t.axis) {
-                        fc[[iy, ix]] += w * a;
-                    }
-                }
-            }
+        let [fx, fy, fz] = f.map(|r| r.as_slice_mut().expect("contiguous row"));
+        let row = |c: usize| &xs[(c * nz + iz) * plane..(c * nz + iz + 1) * plane];
+        let (rx, ry, rz) = (row(0), row(1), row(2));
+        for t in a.slice(iz) {
+            let i = t.index as usize;
+            let v = [rx[i].load(), ry[i].load(), rz[i].load()];
+            let w = k2 * t.delta * project(t.axis, v);
+            fx[i] += w * t.axis[0];
+            fy[i] += w * t.axis[1];
+            fz[i] += w * t.axis[2];
         }
     });
 }
@@ -124,22 +104,17 @@ pub fn add_precondition<S: Storage + Send + Sync>(
     let nx = a.plane.1;
     let i_es = C64::i() / es;
     per_slice(x, nz, |iz, f| {
-        let slice = a.slice(iz);
-        let mut k = 0;
-        while k < slice.len() {
+        for terms in a.voxel_terms(iz) {
             // One voxel's terms, all from its values before the update.
-            let index = slice[k].index;
-            let [iy, ix] = at(nx, index);
+            let [iy, ix] = at(nx, terms[0].index);
             let gamma = 1.0 + i_es * (eps[[iz, iy, ix]] - er);
             let v0 = [0, 1, 2].map(|c| f[c][[iy, ix]].load() / gamma);
             let mut add = [C64::new(0.0, 0.0); 3];
-            while k < slice.len() && slice[k].index == index {
-                let t = &slice[k];
+            for t in terms {
                 let w = i_es * t.delta * project(t.axis, v0);
                 for (ac, a) in add.iter_mut().zip(t.axis) {
                     *ac += w * a;
                 }
-                k += 1;
             }
             for c in 0..3 {
                 let cur = f[c][[iy, ix]].load();
@@ -179,21 +154,11 @@ pub fn voxels<'a>(
 ) -> impl Iterator<Item = (C64, C64, f64)> + 'a {
     let nx = a.plane.1;
     (0..a.nz()).flat_map(move |iz| {
-        let slice = a.slice(iz);
-        let mut k = 0;
-        std::iter::from_fn(move || {
-            if k >= slice.len() {
-                return None;
-            }
-            let index = slice[k].index;
-            let [iy, ix] = at(nx, index);
-            let (mut sum, mut bound) = (C64::new(0.0, 0.0), 0.0);
-            while k < slice.len() && slice[k].index == index {
-                sum += slice[k].delta;
-                bound += slice[k].delta.norm();
-                k += 1;
-            }
-            Some((eps[[iz, iy, ix]], sum, bound))
+        a.voxel_terms(iz).map(move |terms| {
+            let [iy, ix] = at(nx, terms[0].index);
+            let sum = terms.iter().map(|t| t.delta).sum::<C64>();
+            let bound = terms.iter().map(|t| t.delta.norm()).sum::<f64>();
+            (eps[[iz, iy, ix]], sum, bound)
         })
     })
 }

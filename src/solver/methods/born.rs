@@ -16,12 +16,16 @@ use crate::solver::storage::{norm_sqr, with_storage, Storage};
 use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
+use rand::{Rng, SeedableRng};
+use rand_xoshiro::SplitMix64;
 
 /// Steps spent on the a-priori contraction estimate from the background
 /// field.
 pub const ESTIMATE_STEPS: usize = 4;
 /// Steps of the power iteration on a pseudo-random field beside it.
 pub const POWER_STEPS: usize = 6;
+/// Seed of the power iteration's start field.
+const POWER_SEED: u64 = 0x0B0E_5EED;
 /// Operator applications of the whole estimate.
 pub const ESTIMATE_APPLICATIONS: usize = ESTIMATE_STEPS + POWER_STEPS;
 /// Estimated contraction above which Born is not attempted by `auto`.
@@ -86,8 +90,8 @@ impl Born {
     }
 
     /// `‖G V d‖ / ‖d‖` after [`POWER_STEPS`] steps of `d ← G V d / ‖G V d‖`
-    /// from a pseudo-random field (a fixed hash of the index: the same for
-    /// any thread count), a lower estimate of the spectral radius that
+    /// from a pseudo-random field (filled in order from a fixed seed: the
+    /// same for any thread count), a lower estimate of the spectral radius that
     /// every mode enters from the start.
     fn power_ratio<S: Storage>(&self, sys: &mut System, scr: &mut Scratch) -> f64 {
         let dim = sys.unknown_dim();
@@ -95,13 +99,10 @@ impl Born {
         let mut out = Array3::<S>::default(dim);
         let mut ubg = Array3::<S>::default(dim);
         sys.set_background(&mut ubg);
-        for (i, v) in d.iter_mut().enumerate() {
-            let h = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-            let (a, b) = ((h >> 11) as f64, ((h >> 3) & 0xFF_FFFF) as f64);
-            *v = S::store(num_complex::Complex64::new(
-                a / (1u64 << 53) as f64 - 0.5,
-                b / (1u64 << 24) as f64 - 0.5,
-            ));
+        let mut rng = SplitMix64::seed_from_u64(POWER_SEED);
+        for v in d.iter_mut() {
+            let (re, im): (f64, f64) = (rng.gen(), rng.gen());
+            *v = S::store(num_complex::Complex64::new(re - 0.5, im - 0.5));
         }
         let mut ratio = f64::NAN;
         for _ in 0..POWER_STEPS {

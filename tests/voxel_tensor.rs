@@ -25,6 +25,18 @@ const H: f64 = 600.0;
 const Z1: f64 = 137.0;
 const Z2: f64 = 411.0;
 
+/// A fragment of `size` holding one sphere.
+fn one_sphere(size: [f64; 3], center: [f64; 3], radius: f64) -> Geometry {
+    Geometry {
+        size_nm: size,
+        particles: vec![Particle {
+            species: 0,
+            spheres: vec![Sphere { center, radius }],
+        }],
+        stats: Default::default(),
+    }
+}
+
 /// R and T of the laminate on `nz` cells, with or without its tensor.
 fn laminate_rt(nz: usize, eps_s: C64, polar: f64, pol: Linear, tensor: bool) -> (f64, f64) {
     let (eps, t) = laminate(nz, (Z1, Z2, H), eps_s);
@@ -104,17 +116,7 @@ fn a_term_across_the_faces_leaves_s_alone() {
 fn a_sphere_has_radial_normals_and_harmonic_terms() {
     let (l, h, r) = (400.0, 400.0, 130.0);
     let centre = [190.0, 207.0, 203.0];
-    let geom = Geometry {
-        size_nm: [l, l, h],
-        particles: vec![Particle {
-            species: 0,
-            spheres: vec![Sphere {
-                center: centre,
-                radius: r,
-            }],
-        }],
-        stats: Default::default(),
-    };
+    let geom = one_sphere([l, l, h], centre, r);
     let n = 40;
     let grid = Grid::new(n, n, n, [l, l, h]).unwrap();
     let raster = rasterize(&geom, &grid, 4);
@@ -172,17 +174,7 @@ fn a_sphere_has_radial_normals_and_harmonic_terms() {
 /// rasterised: its ε grid and its tensor.
 fn sphere_layer(centre: [f64; 3], n: usize, eps_s: C64) -> (ndarray::Array3<C64>, Anisotropy) {
     let (l, h) = (400.0, 400.0);
-    let geom = Geometry {
-        size_nm: [l, l, h],
-        particles: vec![Particle {
-            species: 0,
-            spheres: vec![Sphere {
-                center: centre,
-                radius: 120.0,
-            }],
-        }],
-        stats: Default::default(),
-    };
+    let geom = one_sphere([l, l, h], centre, 120.0);
     let raster = rasterize(&geom, &Grid::new(n, n, n, [l, l, h]).unwrap(), 4);
     let eb = C64::new(EPS_B, 0.0);
     let mut eps = ndarray::Array3::zeros((n, n, n));

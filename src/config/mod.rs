@@ -601,6 +601,17 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Per species, whether its grains are solved as a tensor each: a
+    /// uniaxial crystal (ordinary and extraordinary tables) in Maxwell's
+    /// equations; otherwise its orientation average (METHOD §8).
+    pub fn crystal_tensors(&self) -> Vec<bool> {
+        let maxwell = self.solver.equation == Equation::Maxwell;
+        self.species
+            .iter()
+            .map(|s| maxwell && s.material.axes().is_some())
+            .collect()
+    }
+
     /// Total pigment volume concentration requested.
     pub fn total_pvc(&self) -> f64 {
         self.species.iter().map(|s| s.volume_fraction).sum()

@@ -21,17 +21,6 @@ use super::solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
 use super::surface::apply_surface;
 use super::{PipelineError, SUPERSAMPLE};
 
-/// The species whose grains carry a crystal axis: uniaxial crystals in
-/// Maxwell's equations (a tensor per grain; METHOD §8).
-fn crystal_species(scene: &crate::config::Scene) -> Vec<bool> {
-    let maxwell = scene.solver.equation == crate::config::Equation::Maxwell;
-    scene
-        .species
-        .iter()
-        .map(|s| maxwell && s.material.axes().is_some())
-        .collect()
-}
-
 /// A solved layer.
 pub struct SolvedLayer {
     /// Every solve, in run order.
@@ -159,7 +148,7 @@ fn grains(
         ));
         let raster = apply_surface(
             scene,
-            raster::rasterize_keeping_axes(&geometry, &grid, SUPERSAMPLE, &crystal_species(scene)),
+            raster::rasterize_keeping_axes(&geometry, &grid, SUPERSAMPLE, &scene.crystal_tensors()),
             seed,
         );
         if r == 0 {

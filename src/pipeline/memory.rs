@@ -62,39 +62,40 @@ pub const CRYSTAL_VOXEL_BYTES: f64 =
 /// on a sphere, and spheres have `A/V = 6/d`. The demo scene (20 % of
 /// 200 nm grains, 25 × 25 × 10 nm cells): estimated 18 %, counted 13.4 %.
 pub fn cut_share(scene: &Scene) -> f64 {
-    scene
-        .species
-        .iter()
-        .map(|s| species_cut_share(scene, s))
-        .sum::<f64>()
-        .min(1.0)
+    species_cut_shares(scene).iter().sum::<f64>().min(1.0)
 }
 
-/// One species' term of [`cut_share`].
-fn species_cut_share(scene: &Scene, s: &crate::config::Species) -> f64 {
-    if s.shape == crate::config::GrainShape::Molecular || s.diameter_nm <= 0.0 {
-        return 0.0;
-    }
+/// Each species' term of [`cut_share`] (0 for a molecular one).
+fn species_cut_shares(scene: &Scene) -> Vec<f64> {
     let [nx, ny, nz] = solve_grid(scene);
     let cell = (scene.layer.fragment_x_nm / nx as f64
         + scene.layer.fragment_y_nm / ny as f64
         + scene.layer.thickness_nm / nz as f64)
         / 3.0;
-    9.0 * s.volume_fraction * cell / s.diameter_nm
-}
-
-/// The estimated share of voxels the grains of uniaxial crystal species
-/// touch in a Maxwell run (each species' volume fraction plus its cut
-/// share, at most 1); 0 in Helmholtz.
-pub fn crystal_share(scene: &Scene) -> f64 {
-    if scene.solver.equation != Equation::Maxwell {
-        return 0.0;
-    }
     scene
         .species
         .iter()
-        .filter(|s| s.material.axes().is_some())
-        .map(|s| s.volume_fraction + species_cut_share(scene, s))
+        .map(|s| {
+            if s.shape == crate::config::GrainShape::Molecular || s.diameter_nm <= 0.0 {
+                0.0
+            } else {
+                9.0 * s.volume_fraction * cell / s.diameter_nm
+            }
+        })
+        .collect()
+}
+
+/// The estimated share of voxels the grains of tensor crystals
+/// ([`Scene::crystal_tensors`]: uniaxial crystals in Maxwell) touch: each
+/// such species' volume fraction plus its cut share, at most 1.
+pub fn crystal_share(scene: &Scene) -> f64 {
+    scene
+        .species
+        .iter()
+        .zip(species_cut_shares(scene))
+        .zip(scene.crystal_tensors())
+        .filter(|(_, tensor)| *tensor)
+        .map(|((s, cut), _)| s.volume_fraction + cut)
         .sum::<f64>()
         .min(1.0)
 }

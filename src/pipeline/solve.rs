@@ -98,7 +98,6 @@ pub fn solve_layer(
         .grid
         .voxel_permittivity
         .anisotropic(scene.solver.equation);
-    let maxwell = scene.solver.equation == crate::config::Equation::Maxwell;
     let mut tensor = Anisotropy::empty(g.nz, (g.ny, g.nx));
     let mut tensor_below = Anisotropy::empty(g.nz, (g.ny, g.nx));
     // (surface terms, crystal terms) of the wavelength's tensor.
@@ -109,7 +108,7 @@ pub fn solve_layer(
             LayerEps::Raster(raster) => {
                 let eps_species = fraction_eps(scene, lambda)?;
                 raster.epsilon_into(C64::new(eps_b, 0.0), &eps_species, &mut eps);
-                let crystals = crystal_eps(scene, lambda, maxwell);
+                let crystals = crystal_eps(scene, lambda);
                 if surfaces || crystals.iter().any(Option::is_some) {
                     tensor_counts = raster.anisotropy_into(
                         C64::new(eps_b, 0.0),
@@ -209,19 +208,14 @@ pub fn solve_layer(
     Ok(entries)
 }
 
-/// Each species' `(ε_o, ε_e)` where it is a uniaxial crystal and the scene
-/// is solved in Maxwell's equations (a tensor per grain, METHOD §8), else
-/// None (its orientation average).
-fn crystal_eps(scene: &Scene, lambda: f64, maxwell: bool) -> Vec<Option<(C64, C64)>> {
+/// Each species' `(ε_o, ε_e)` where its grains are a tensor each
+/// ([`Scene::crystal_tensors`]), else None (its orientation average).
+fn crystal_eps(scene: &Scene, lambda: f64) -> Vec<Option<(C64, C64)>> {
     scene
         .species
         .iter()
-        .map(|s| {
-            s.material.axes()?;
-            maxwell
-                .then(|| s.material.epsilon_axes_at(lambda))
-                .flatten()
-        })
+        .zip(scene.crystal_tensors())
+        .map(|(s, tensor)| tensor.then(|| s.material.epsilon_axes_at(lambda)).flatten())
         .collect()
 }
 

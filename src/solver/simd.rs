@@ -141,6 +141,41 @@ fn prefetch(data: &[C64]) {
     let _ = data;
 }
 
+/// `fn name(args) -> R` that runs `body(args)` compiled for AVX-512 or
+/// AVX2 where the CPU has them: `body` is `#[inline(always)]`, so it is
+/// compiled into each `#[target_feature]` variant with its wider
+/// registers (a closure handed to [`dispatch`] is inlined only when LLVM
+/// finds it small enough). Each variant does the same operations as the
+/// portable one, so the bits do not depend on the CPU.
+macro_rules! widest {
+    ($(#[$doc:meta])* $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty = $body:path;) => {
+        $(#[$doc])*
+        $vis fn $name($($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx512f")]
+                fn avx512($($arg: $ty),*) -> $ret {
+                    $body($($arg),*)
+                }
+                #[target_feature(enable = "avx2")]
+                fn avx2($($arg: $ty),*) -> $ret {
+                    $body($($arg),*)
+                }
+                if std::arch::is_x86_feature_detected!("avx512f") {
+                    // SAFETY: the CPU has AVX-512F (checked just above).
+                    return unsafe { avx512($($arg),*) };
+                }
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU has AVX2 (checked just above).
+                    return unsafe { avx2($($arg),*) };
+                }
+            }
+            $body($($arg),*)
+        }
+    };
+}
+pub(crate) use widest;
+
 /// Run `f`, compiled for AVX-512 or AVX2 where the CPU has them (the
 /// kernels are `#[inline(always)]`, so they are compiled into these
 /// wrappers with the wider registers).

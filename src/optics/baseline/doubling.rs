@@ -344,7 +344,7 @@ pub fn thin_flux(kernel: &FluxKernel, dz: f64) -> Result<Homogeneous, BaselineEr
 
 /// Two copies of a homogeneous slab on top of each other, with
 /// `G = (I − R R)⁻¹ = I + G̃`: `R₂ = R + T R G T`,
-/// `T₂ = T G T = E² + [E S + S E + S S + T G̃ T]` (`T = E + S`).
+/// `T₂ = T G T = E² + [E S + S E + S (S + G̃T) + E G̃T]` (`T = E + S`).
 pub fn double(s: &Homogeneous) -> Result<Homogeneous, BaselineError> {
     let n = s.direct.len();
     let rr = s.r.mul(&s.r);
@@ -359,10 +359,12 @@ pub fn double(s: &Homogeneous) -> Result<Homogeneous, BaselineError> {
     let gt_tilde = g_tilde.mul(&t);
     let gt = t.add(&gt_tilde);
     let r = s.r.add(&t.mul(&s.r).mul(&gt));
-    let mut scattered = s.scattered.mul(&s.scattered).add(&t.mul(&gt_tilde));
+    // S S + T G̃T = S (S + G̃T) + E G̃T, one product fewer.
+    let mut scattered = s.scattered.mul(&s.scattered.add(&gt_tilde));
     for i in 0..n {
         for j in 0..n {
-            scattered[(i, j)] += (s.direct[i] + s.direct[j]) * s.scattered[(i, j)];
+            scattered[(i, j)] +=
+                (s.direct[i] + s.direct[j]) * s.scattered[(i, j)] + s.direct[i] * gt_tilde[(i, j)];
         }
     }
     let depth = 2.0 * s.depth;

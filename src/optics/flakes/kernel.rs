@@ -320,13 +320,27 @@ pub fn flake_kernels(
         .collect()
 }
 
-/// The spread flakes' kernels by integrating the reflected radiance over
-/// the view directions: per unit path the flux scattered into `dω_o` is
-/// `(a/4) D(h) R_f(|ω·h|) dω_o` (`h` the half vector, `dω_o = 4 |ω·h| dω_h`),
-/// integrated over each node's cell in `μ_o` (Gauss–Legendre on every
-/// cell, finer than σ) and against `cos mφ` in azimuth (midpoint rule on
-/// `[0, π]`, finer than σ).
-fn integrate_lobes(
+crate::solver::simd::widest! {
+    /// The spread flakes' kernels by integrating the reflected radiance over
+    /// the view directions: per unit path the flux scattered into `dω_o` is
+    /// `(a/4) D(h) R_f(|ω·h|) dω_o` (`h` the half vector, `dω_o = 4 |ω·h| dω_h`),
+    /// integrated over each node's cell in `μ_o` (Gauss–Legendre on every
+    /// cell, finer than σ) and against `cos mφ` in azimuth (midpoint rule on
+    /// `[0, π]`, finer than σ).
+    fn integrate_lobes(
+        ords: &Ordinates,
+        flakes: &FlakeMedium,
+        modes: usize,
+        same: &mut [Matrix],
+        opp: &mut [Matrix],
+    ) -> () = integrate_lobes_body;
+}
+
+/// Azimuths per chunk of [`integrate_lobes`]'s vector lanes.
+const CHUNK: usize = 8;
+
+#[inline(always)]
+fn integrate_lobes_body(
     ords: &Ordinates,
     flakes: &FlakeMedium,
     modes: usize,
@@ -338,12 +352,14 @@ fn integrate_lobes(
     let a = flakes.area_per_nm;
     let azimuths = ((8.0 * PI / sigma).ceil() as usize).clamp(128, 2048);
     let dphi = PI / azimuths as f64;
-    let phis: Vec<(f64, f64)> = (0..azimuths)
+    // The azimuths' cosines and sines, padded to whole chunks.
+    let padded = azimuths.div_ceil(CHUNK) * CHUNK;
+    let (cos_phi, sin_phi): (Vec<f64>, Vec<f64>) = (0..padded)
         .map(|q| {
             let phi = (q as f64 + 0.5) * dphi;
             (phi.cos(), phi.sin())
         })
-        .collect();
+        .unzip();
     let cos_table: Vec<f64> = (0..azimuths)
         .flat_map(|q| {
             let phi = (q as f64 + 0.5) * dphi;
@@ -397,22 +413,43 @@ fn integrate_lobes(
                 for (side, sign) in [1.0, -1.0].into_iter().enumerate() {
                     let vz = wj[2] - sign * mu_o;
                     let mut end = 0;
-                    for (q, &(c, s)) in phis.iter().enumerate() {
-                        let v = [wj[0] - sin_o * c, -sin_o * s, vz];
-                        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                        if len < 1e-12 {
-                            profile[q] = 0.0;
+                    // A chunk of azimuths at a time: the half vector's
+                    // cosine and the local angle's (the square root and
+                    // the divisions) across the chunk's lanes, then the
+                    // tables per azimuth up to the first beyond the
+                    // density's extent.
+                    'chunks: for (chunk, (cs, ss)) in cos_phi
+                        .chunks_exact(CHUNK)
+                        .zip(sin_phi.chunks_exact(CHUNK))
+                        .enumerate()
+                    {
+                        let mut cos_h = [0.0; CHUNK];
+                        let mut local = [0.0; CHUNK];
+                        let mut length = [0.0; CHUNK];
+                        for t in 0..CHUNK {
+                            let (vx, vy) = (wj[0] - sin_o * cs[t], -sin_o * ss[t]);
+                            let len = (vx * vx + vy * vy + vz * vz).sqrt();
+                            length[t] = len;
+                            cos_h[t] = vz.abs() / len;
+                            local[t] = (wj[0] * vx + wj[2] * vz).abs() / len;
+                        }
+                        for t in 0..CHUNK {
+                            let q = chunk * CHUNK + t;
+                            if q == azimuths {
+                                break 'chunks;
+                            }
+                            if length[t] < 1e-12 {
+                                profile[q] = 0.0;
+                                end = q + 1;
+                                continue;
+                            }
+                            if cos_h[t] < table.lo {
+                                break 'chunks;
+                            }
+                            let d = table.at_cos(cos_h[t]).max(0.0);
+                            profile[q] = scale * d * flakes.table.at(local[t]).r;
                             end = q + 1;
-                            continue;
                         }
-                        let cos_h = vz.abs() / len;
-                        if cos_h < table.lo {
-                            break;
-                        }
-                        let d = table.at_cos(cos_h).max(0.0);
-                        let local = (wj[0] * v[0] + wj[2] * v[2]).abs() / len;
-                        profile[q] = scale * d * flakes.table.at(local).r;
-                        end = q + 1;
                     }
                     let target = &mut cell_profile[side];
                     // Clear what this cell has not written yet.

@@ -281,3 +281,46 @@ fn the_pigment_terms_match_the_azimuthal_integral() {
     );
     assert!(worst < 1e-12 * scale, "{worst} of {scale}");
 }
+
+/// The reflection at any air angles (`flakes::air`): at the nodes the
+/// model's own values (the scattered factor at any azimuth, the mirror part,
+/// the scattered albedo); between two nodes the straight line between
+/// their values; beyond the outermost node the outermost's value.
+#[test]
+fn the_reflection_between_nodes_is_the_line_between_their_values() {
+    use inksim::optics::flakes::air::AirNodes;
+    let p = three_layer_paint(true, 12.0, 0.8);
+    let air = AirNodes::new(&p);
+    let a = &air.angles_deg;
+    assert!(a.len() > 10 && a.windows(2).all(|w| w[0] < w[1]), "{a:?}");
+    for &i in &[45.0, 15.0] {
+        for &v in &[0.0, 15.0, 60.0] {
+            for az in [0.0, 30.0, 90.0, 180.0] {
+                let want = p.factor(i, v, az).unwrap();
+                let got = air.factor(&p, i, v, az);
+                assert!(
+                    (got - want).abs() <= 1e-12 * want.abs().max(1e-3),
+                    "{i} {v} {az}: {got} vs {want}"
+                );
+            }
+        }
+    }
+    for (&deg, &j) in a.iter().zip(&air.nodes) {
+        assert!((air.mirror(&p, deg) - p.mirror[j]).abs() < 1e-15);
+        let scattered = p.albedo(j) - p.mirror[j];
+        assert!((air.scattered_albedo(&p, deg) - scattered).abs() < 1e-15);
+    }
+    // Halfway between two neighbouring nodes: the mean of their values.
+    let k = a.len() / 2;
+    let mid = 0.5 * (a[k] + a[k + 1]);
+    let (f0, f1) = (
+        air.factor(&p, 45.0, a[k], 20.0),
+        air.factor(&p, 45.0, a[k + 1], 20.0),
+    );
+    let fm = air.factor(&p, 45.0, mid, 20.0);
+    assert!((fm - 0.5 * (f0 + f1)).abs() < 1e-12, "{fm} vs {f0}, {f1}");
+    // Beyond the outermost node: held.
+    let last = *a.last().unwrap();
+    assert!(last < 90.0 && last > 80.0, "{last}");
+    assert_eq!(air.mirror(&p, 89.9), air.mirror(&p, last));
+}

@@ -113,6 +113,7 @@ fn an_aluminium_paint_flops() {
         normals: NormalQuadrature {
             tilts: 48,
             azimuths: 256,
+            lobe_sampling: 2.0,
         },
         ordinates: OrdinateParams {
             escape_nodes: 32,

@@ -18,6 +18,7 @@ use crate::optics::baseline::doubling::Medium;
 use crate::optics::baseline::ordinates::OrdinateParams;
 use crate::optics::baseline::{transfer, BaselineInput, BaselineSpecies};
 use crate::optics::colour::Observer;
+use crate::optics::flakes::air::AirNodes;
 use crate::optics::flakes::kernel::FlakeMedium;
 use crate::optics::flakes::multiangle;
 use crate::optics::flakes::normals::Orientation;
@@ -254,20 +255,6 @@ pub fn reflect_at(
     )?)
 }
 
-/// The air polar angles of the escaping nodes, in node order, and the
-/// nodes.
-fn air_nodes(r: &PaintReflection) -> (Vec<f64>, Vec<usize>) {
-    let mut pairs: Vec<(f64, usize)> = r
-        .ords
-        .mu_air
-        .iter()
-        .enumerate()
-        .filter_map(|(i, m)| m.map(|m| (m.clamp(-1.0, 1.0).acos().to_degrees(), i)))
-        .collect();
-    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    pairs.into_iter().unzip()
-}
-
 /// The in-plane BRDF (1/sr), mirror reflectance and albedo on the air
 /// directions.
 struct InPlane {
@@ -279,7 +266,11 @@ struct InPlane {
 }
 
 fn in_plane(reflections: &[PaintReflection]) -> Result<InPlane, PipelineError> {
-    let (directions_deg, nodes) = air_nodes(&reflections[0]);
+    let AirNodes {
+        angles_deg: directions_deg,
+        nodes,
+        ..
+    } = AirNodes::new(&reflections[0]);
     // `0 − d`, not `−d`: the normal reads 0, not −0.
     let mut view_deg: Vec<f64> = directions_deg.iter().rev().map(|&d| 0.0 - d).collect();
     view_deg.extend(directions_deg.iter().filter(|&&d| d > 0.0));

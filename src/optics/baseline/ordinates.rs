@@ -23,8 +23,34 @@
 use super::BaselineError;
 
 /// Gauss–Legendre nodes and weights on `[−1, 1]` (`n ≥ 1`), by Newton's
-/// iteration on `P_n` from the usual cosine guesses.
+/// iteration on `P_n` from the usual cosine guesses ([`RULE_CACHE_LIMIT`]
+/// rules and smaller kept once computed: the flake kernels and the
+/// interference flakes' thickness averages ask for the same rules at every
+/// wavelength, and a rule of `n` points costs `O(n²)`).
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    type Rules = Mutex<HashMap<usize, (Vec<f64>, Vec<f64>)>>;
+    static RULES: OnceLock<Rules> = OnceLock::new();
+    if n > RULE_CACHE_LIMIT {
+        return compute_gauss_legendre(n);
+    }
+    let rules = RULES.get_or_init(Default::default);
+    if let Some(r) = rules.lock().unwrap_or_else(|e| e.into_inner()).get(&n) {
+        return r.clone();
+    }
+    let r = compute_gauss_legendre(n);
+    rules
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(n, r.clone());
+    r
+}
+
+/// The largest rule [`gauss_legendre`] keeps.
+pub const RULE_CACHE_LIMIT: usize = 1024;
+
+fn compute_gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n {

@@ -65,8 +65,14 @@ pub struct FlakeMedium {
 /// Resolution of the quadrature over normals.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NormalQuadrature {
+    /// Tilts and azimuths of the normals' quadrature (the aligned flakes'
+    /// absorption).
     pub tilts: usize,
     pub azimuths: usize,
+    /// The spread lobes' sampling against the default's (1: eight azimuths
+    /// and two polar points per σ, at least 128 azimuths on `[0, π]`;
+    /// 0.5 half of each).
+    pub lobe_sampling: f64,
 }
 
 impl Default for NormalQuadrature {
@@ -74,6 +80,7 @@ impl Default for NormalQuadrature {
         NormalQuadrature {
             tilts: 24,
             azimuths: 96,
+            lobe_sampling: 1.0,
         }
     }
 }
@@ -228,7 +235,8 @@ pub fn flake_kernels(
     let mut cos_m = vec![0.0; modes];
     let aligned = flakes.orientation.sigma_rad <= 0.0;
     if !aligned {
-        integrate_lobes(ords, flakes, modes, &mut same, &mut opp);
+        let sampling = quadrature.lobe_sampling.clamp(0.1, 4.0);
+        integrate_lobes(ords, flakes, modes, sampling, &mut same, &mut opp);
     }
     for j in 0..n {
         let mu_j = ords.mu[j];
@@ -331,6 +339,7 @@ crate::solver::simd::widest! {
         ords: &Ordinates,
         flakes: &FlakeMedium,
         modes: usize,
+        sampling: f64,
         same: &mut [Matrix],
         opp: &mut [Matrix],
     ) -> () = integrate_lobes_body;
@@ -344,13 +353,15 @@ fn integrate_lobes_body(
     ords: &Ordinates,
     flakes: &FlakeMedium,
     modes: usize,
+    sampling: f64,
     same: &mut [Matrix],
     opp: &mut [Matrix],
 ) {
     let n = ords.len();
     let sigma = flakes.orientation.sigma_rad;
     let a = flakes.area_per_nm;
-    let azimuths = ((8.0 * PI / sigma).ceil() as usize).clamp(128, 2048);
+    let least = (128.0 * sampling).ceil() as usize;
+    let azimuths = ((8.0 * sampling * PI / sigma).ceil() as usize).clamp(least, 2048);
     let dphi = PI / azimuths as f64;
     // The azimuths' cosines and sines, padded to whole chunks.
     let padded = azimuths.div_ceil(CHUNK) * CHUNK;
@@ -403,7 +414,7 @@ fn integrate_lobes_body(
         let scale = 0.25 * a / mu_j;
         for (k, &(lo, hi)) in cells.iter().enumerate() {
             let span = (lo.clamp(0.0, 1.0).acos() - hi.clamp(0.0, 1.0).acos()).abs();
-            let points = ((2.0 * span / sigma).ceil() as usize).clamp(3, 24);
+            let points = ((2.0 * sampling * span / sigma).ceil() as usize).clamp(3, 24);
             let (x, w) = &rules[points];
             let mut reach = [0usize; 2];
             for (x, w) in x.iter().zip(w) {

@@ -12,6 +12,8 @@
 //!   adding–doubling directions (flakes and ordinary pigments);
 //! - [`paint`]: the fast model, layers added on a ground under the paint's
 //!   surface, and its BRDF;
+//! - [`air`]: the fast model's reflection at any air angles, linear between
+//!   the nodes (for renderers and regular tables);
 //! - [`montecarlo`]: the full model that checks it, ray tracing with
 //!   explicit disc flakes;
 //! - [`multiangle`]: the multi-angle geometries, their colours and the flop
@@ -19,6 +21,7 @@
 //! - [`sparkle`]: Poisson glints per resolution cell and graininess;
 //! - [`sparkle_texture`]: a patch of resolution cells with its glints drawn.
 
+pub mod air;
 pub mod kernel;
 pub mod montecarlo;
 pub mod multiangle;

@@ -21,6 +21,14 @@ use common::cli::inksim_in;
 use common::json::Json;
 use common::scene::{PigmentToml, SceneToml};
 
+/// Held by each test that times the server or runs Chromium for its whole
+/// run: the tests of this file run in parallel threads, and a software-
+/// rendering browser beside a timed recompute would time the browser.
+fn exclusive() -> std::sync::MutexGuard<'static, ()> {
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    LOCK.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// A small result of `pigment` in `dir` (`dir/<pigment>.h5`).
 fn result(dir: &Path, pigment: &str) -> PathBuf {
     let sub = dir.join(pigment);
@@ -215,6 +223,7 @@ fn view_refuses_remote_binds_and_bad_results_with_one_line() {
 
 #[test]
 fn the_page_draws_the_results_colour_and_answers_its_controls() {
+    let _only = exclusive();
     let Some(chrome) = chromium() else {
         eprintln!(
             "SKIPPED the_page_draws_the_results_colour_and_answers_its_controls: no chromium, \
@@ -308,30 +317,58 @@ fn get(url: &str) -> (String, f64) {
     (body, ms)
 }
 
+/// The live model's parameters, checked to include `keys`; then one GET of
+/// `/api/live/compute?<query>` per query: the slowest (ms, server work and
+/// HTTP round trip together) and each answer's `result`.
+fn live_sweep(url: &str, keys: &[&str], queries: &[String]) -> (f64, Vec<Json>) {
+    let (params, _) = get(&format!("{url}/api/live"));
+    for k in keys {
+        assert!(
+            params.contains(&format!("\"key\":\"{k}\"")),
+            "{k}: {params}"
+        );
+    }
+    let mut worst: f64 = 0.0;
+    let mut out = vec![];
+    for q in queries {
+        let (body, ms) = get(&format!("{url}/api/live/compute?{q}"));
+        worst = worst.max(ms);
+        out.push(Json::parse(&body).get("result").clone());
+    }
+    (worst, out)
+}
+
+/// The page's live probe (its first live control moved) under a 45° lamp,
+/// no sky, 0 EV; None, saying so, where no Chromium is installed.
+fn probe_live(d: &Path, url: &str) -> Option<Json> {
+    let Some(chrome) = chromium() else {
+        eprintln!("SKIPPED the page part: no chromium on PATH");
+        return None;
+    };
+    Some(probe(
+        &chrome,
+        d,
+        &format!("{url}/?probe=live&theta=45&phi=0&sky=0&ev=0"),
+    ))
+}
+
 #[test]
 fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
+    let _only = exclusive();
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = SceneToml::grains().paper(0.9).output(d, "live").write(d);
     let served = serve(&[&scene]);
     let url = &served.1;
-    let (params, _) = get(&format!("{url}/api/live"));
-    assert!(
-        params.contains("\"key\":\"pvc0\"") && params.contains("thickness_nm"),
-        "{params}"
-    );
     // Every change a user makes is one request: time a sweep of the
     // pigment's volume fraction, server work and HTTP round trip together.
-    let mut worst: f64 = 0.0;
+    let queries: Vec<String> = (1..=10)
+        .map(|k| format!("pvc0={}&thickness_nm=2000", 0.03 * k as f64))
+        .collect();
+    let (worst, results) = live_sweep(url, &["pvc0", "thickness_nm"], &queries);
     let mut l_star = vec![];
-    for k in 1..=10 {
-        let pvc = 0.03 * k as f64;
-        let (body, ms) = get(&format!(
-            "{url}/api/live/compute?pvc0={pvc}&thickness_nm=2000"
-        ));
-        worst = worst.max(ms);
-        let j = Json::parse(&body);
-        let c = &j.get("result").arr("colours")[0];
+    for r in &results {
+        let c = &r.arr("colours")[0];
         assert_eq!(c.str("geometry"), "45/0");
         l_star.push(c.arr("lab")[0].as_num());
     }
@@ -340,15 +377,9 @@ fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
     // More pigment, darker: the model answers the control.
     assert!(l_star.windows(2).all(|w| w[1] < w[0]), "{l_star:?}");
 
-    let Some(chrome) = chromium() else {
-        eprintln!("SKIPPED the page part: no chromium on PATH");
+    let Some(p) = probe_live(d, url) else {
         return;
     };
-    let p = probe(
-        &chrome,
-        d,
-        &format!("{url}/?probe=live&theta=45&phi=0&sky=0&ev=0"),
-    );
     let after = p.get("after");
     let (before_px, after_px) = (rgb(&p.arr("centres")[0]), rgb(&after.arr("centres")[0]));
     assert_ne!(
@@ -361,4 +392,72 @@ fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
         "the numbers did not follow"
     );
     assert!(p.str("readout").contains("ΔE00"), "{}", p.str("readout"));
+}
+
+/// An effect paint (configs/metallic.toml) recomputed live: every change of
+/// the flakes' spread within 200 ms (server and HTTP together), the
+/// near-specular lightness falling as the spread widens; the page draws the
+/// object's centre under a 45° lamp in the paint's 45as45 (45°/0°) colour
+/// and follows its first control (the flakes' volume fraction).
+#[test]
+fn an_effect_paint_is_recomputed_live_within_200_ms_and_drawn_in_its_colour() {
+    let _only = exclusive();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/metallic.toml");
+    let served = serve(&[&config]);
+    let url = &served.1;
+    let queries: Vec<String> = (0..10)
+        .map(|k| format!("layer1_spread_deg={}", 4.0 + 2.0 * k as f64))
+        .collect();
+    let (worst, results) = live_sweep(url, &["layer1_flakes", "layer1_spread_deg"], &queries);
+    let mut near_specular = vec![];
+    for r in &results {
+        let colours = r.arr("colours");
+        assert_eq!(colours[0].str("geometry"), "45as45");
+        let c = colours
+            .iter()
+            .find(|c| c.str("geometry") == "45as-15")
+            .unwrap();
+        near_specular.push(c.arr("lab")[0].as_num());
+    }
+    eprintln!(
+        "effect paint live, 10 changes: slowest {worst:.1} ms (limit 200); L*(45as-15) {near_specular:.1?}"
+    );
+    assert!(worst < 200.0, "{worst} ms");
+    assert!(
+        near_specular.windows(2).all(|w| w[1] < w[0]),
+        "{near_specular:?}"
+    );
+    let (start, _) = get(&format!("{url}/api/live/compute"));
+    let start = Json::parse(&start);
+    let result = start.get("result");
+    assert!(
+        result.str("model").contains("ΔE00"),
+        "{}",
+        result.str("model")
+    );
+    let first = &result.arr("colours")[0];
+    let mapped: Vec<f64> = first.arr("mapped_lab").iter().map(|v| v.as_num()).collect();
+    let want = [mapped[0], mapped[1], mapped[2]];
+
+    let Some(p) = probe_live(d, url) else {
+        return;
+    };
+    let obs = Observer::standard(Illuminant::D65, StandardObserver::TenDegree);
+    let centre = rgb(&p.arr("centres")[0]);
+    let de = delta_e2000(lab_of_pixel(&obs, centre), want);
+    eprintln!("effect paint: page centre {centre:?} vs its 45as45 colour {want:.1?}: ΔE00 {de:.2}");
+    assert!(de < 2.0, "centre {centre:?}: ΔE00 {de:.2} to {want:?}");
+    let after = p.get("after");
+    assert_ne!(
+        centre,
+        rgb(&after.arr("centres")[0]),
+        "the picture did not follow the control"
+    );
+    assert_ne!(
+        p.str("colours"),
+        after.str("colours"),
+        "the numbers did not follow"
+    );
 }

@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Result};
 use inksim::view::live::{LiveModel, RadiativeTransfer};
+use inksim::view::paint::LivePaint;
 use inksim::view::{result, server, source};
 use std::net::IpAddr;
 use std::path::PathBuf;
@@ -31,7 +32,12 @@ pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> 
                     input.display()
                 );
             }
-            live = Some(Box::new(RadiativeTransfer::new(&config.scene()?)?));
+            live = Some(if config.is_paint() {
+                let scene = inksim::config::parse_paint(input, &config.text)?;
+                Box::new(LivePaint::new(scene)?)
+            } else {
+                Box::new(RadiativeTransfer::new(&config.scene()?)?)
+            });
             continue;
         }
         for path in source::result_files(input)? {

@@ -15,12 +15,15 @@
 //! - [`source`]: which results a command line names (files, a study's folder);
 //! - [`live`]: the recompute hook ([`live::LiveModel`]) and the scenes' radiative-transfer
 //!   baselines recomputed as a control moves;
+//! - [`paint`]: an effect paint's fast model recomputed live, its whole BRDF
+//!   on the page's grid;
 //! - [`server`]: the HTTP server and its routes; [`page`]: the embedded page.
 //!
 //! Imports from every earlier stage; nothing imports from it.
 
 pub mod live;
 pub mod page;
+pub mod paint;
 pub mod result;
 pub mod server;
 pub mod source;

@@ -24,6 +24,7 @@
 //!   colour the table is the solved wavelengths' RGB as it is, and
 //!   [`PageBrdf::anchor`] says so.
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::optics::colour::{gamut, Observer};
@@ -34,6 +35,10 @@ use crate::output::render::preview::{GAIN_MAX, GAIN_MIN};
 pub const THETA_STEP_DEG: f64 = 5.0;
 /// Spacing of the azimuth difference Δφ (deg).
 pub const PHI_STEP_DEG: f64 = 10.0;
+
+/// The diffuse BRDF at `(θi, θo)` (deg) for each `Δφ` of a slice (deg):
+/// one row of [`PageBrdf::tabulate`]'s table.
+pub type BrdfRow<'a> = dyn Fn(f64, f64, &[f64]) -> Vec<[f64; 3]> + Sync + 'a;
 
 /// The table shipped to the page (module docs); JSON field names as here.
 #[derive(Debug, Clone, Serialize)]
@@ -113,8 +118,6 @@ impl PageBrdf {
     /// The table of `brdf`; `anchor_45_0` is the result's measured 45°/0°
     /// colour (CIELAB) and the observer it is under, when it has one.
     pub fn new(brdf: &RgbBrdf, anchor_45_0: Option<([f64; 3], &Observer)>) -> PageBrdf {
-        let thetas = nodes(THETA_STEP_DEG, 90.0);
-        let phis = nodes(PHI_STEP_DEG, 180.0);
         let (gain, anchor) = match anchor_45_0 {
             Some((lab, obs)) => {
                 let g = gains_to(brdf, obs, lab);
@@ -134,16 +137,41 @@ impl PageBrdf {
                     .to_string(),
             ),
         };
-        let mut table = Vec::with_capacity(thetas.len() * thetas.len() * phis.len() * 3);
-        for &ti in &thetas {
-            let wi = polar(ti, 0.0);
-            for &to in &thetas {
-                for &p in &phis {
-                    let f = brdf.eval(wi, polar(to, p));
-                    table.extend((0..3).map(|ch| (f[ch] * gain[ch]) as f32));
-                }
-            }
-        }
+        PageBrdf::tabulate(
+            &|ti, to, phis| {
+                let wi = polar(ti, 0.0);
+                phis.iter().map(|&p| brdf.eval(wi, polar(to, p))).collect()
+            },
+            &|t| brdf.sky(t),
+            &|t| brdf.specular(t),
+            gain,
+            anchor,
+        )
+    }
+
+    /// The table on the grid of the module docs: `row(θi, θo, Δφs)` the
+    /// diffuse BRDF (1/sr, linear sRGB) at each `Δφ` (deg), `sky(θo)` and
+    /// `specular(θo)` as [`PageBrdf`]'s fields, each multiplied by `gain`.
+    pub fn tabulate(
+        row: &BrdfRow<'_>,
+        sky: &dyn Fn(f64) -> [f64; 3],
+        specular: &dyn Fn(f64) -> [f64; 3],
+        gain: [f64; 3],
+        anchor: String,
+    ) -> PageBrdf {
+        let thetas = nodes(THETA_STEP_DEG, 90.0);
+        let phis = nodes(PHI_STEP_DEG, 180.0);
+        let table: Vec<f32> = thetas
+            .par_iter()
+            .flat_map_iter(|&ti| {
+                let phis = &phis;
+                thetas.iter().flat_map(move |&to| {
+                    row(ti, to, phis)
+                        .into_iter()
+                        .flat_map(move |f| (0..3).map(move |ch| (f[ch] * gain[ch]) as f32))
+                })
+            })
+            .collect();
         let per_theta = |f: &dyn Fn(f64) -> [f64; 3]| -> Vec<f32> {
             thetas
                 .iter()
@@ -157,8 +185,8 @@ impl PageBrdf {
             n_theta: thetas.len(),
             n_phi: phis.len(),
             brdf: table,
-            sky: per_theta(&|t| brdf.sky(t)),
-            specular: per_theta(&|t| brdf.specular(t)),
+            sky: per_theta(sky),
+            specular: per_theta(specular),
             gain,
             anchor,
         }

@@ -338,9 +338,10 @@ fn live_sweep(url: &str, keys: &[&str], queries: &[String]) -> (f64, Vec<Json>) 
     (worst, out)
 }
 
-/// The page's live probe (its first live control moved) under a 45° lamp,
-/// no sky, 0 EV; None, saying so, where no Chromium is installed.
-fn probe_live(d: &Path, url: &str) -> Option<Json> {
+/// The page's probe `kind` (e.g. `live`: its first live control moved) under
+/// a 45° lamp, no sky, 0 EV; None, saying so, where no Chromium is
+/// installed.
+fn probe_live(d: &Path, url: &str, kind: &str) -> Option<Json> {
     let Some(chrome) = chromium() else {
         eprintln!("SKIPPED the page part: no chromium on PATH");
         return None;
@@ -348,7 +349,7 @@ fn probe_live(d: &Path, url: &str) -> Option<Json> {
     Some(probe(
         &chrome,
         d,
-        &format!("{url}/?probe=live&theta=45&phi=0&sky=0&ev=0"),
+        &format!("{url}/?probe={kind}&theta=45&phi=0&sky=0&ev=0"),
     ))
 }
 
@@ -377,7 +378,7 @@ fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
     // More pigment, darker: the model answers the control.
     assert!(l_star.windows(2).all(|w| w[1] < w[0]), "{l_star:?}");
 
-    let Some(p) = probe_live(d, url) else {
+    let Some(p) = probe_live(d, url, "live") else {
         return;
     };
     let after = p.get("after");
@@ -441,7 +442,8 @@ fn an_effect_paint_is_recomputed_live_within_200_ms_and_drawn_in_its_colour() {
     let mapped: Vec<f64> = first.arr("mapped_lab").iter().map(|v| v.as_num()).collect();
     let want = [mapped[0], mapped[1], mapped[2]];
 
-    let Some(p) = probe_live(d, url) else {
+    // The colour without the glints (a glint may sit on the centre).
+    let Some(p) = probe_live(d, url, "live&glints=0") else {
         return;
     };
     let obs = Observer::standard(Illuminant::D65, StandardObserver::TenDegree);
@@ -459,5 +461,24 @@ fn an_effect_paint_is_recomputed_live_within_200_ms_and_drawn_in_its_colour() {
         p.str("colours"),
         after.str("colours"),
         "the numbers did not follow"
+    );
+
+    // The glints: there, as many near the centre as the sparkle model's
+    // Poisson mean says (P(≥ 1) = 1 − e^(−N P) at a 45° lamp and a normal
+    // view), and elsewhere when the lamp moves by 10°.
+    let s = probe_live(d, url, "sparkle").unwrap();
+    let g = s.get("sparkle");
+    let (glints, moved, both) = (g.num("glints"), g.num("moved"), g.num("both"));
+    let share = g.num("centre_glints") / g.num("centre_pixels");
+    let want = 1.0 - (-g.num("model_mean_45")).exp();
+    eprintln!(
+        "glints: {glints} pixels ({moved} after the lamp moved 10°, {both} in both); near the \
+         centre {share:.3} of the cells against the model's {want:.3}"
+    );
+    assert!(glints > 0.01 * s.num("object_pixels"), "{glints}");
+    assert!((share / want - 1.0).abs() < 0.25, "{share} vs {want}");
+    assert!(
+        both < 0.5 * glints.min(moved),
+        "{both} of {glints}, {moved}"
     );
 }

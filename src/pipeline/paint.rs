@@ -30,8 +30,8 @@ use crate::output::h5::{self, AngleRecord, Identity, PaintResultSet, SparkleTabl
 use crate::output::progress::Progress;
 use crate::output::render::multiangle::{flop_png, patches_png, PatchCaption};
 
-pub use super::paint_optics::lacquer_index;
-use super::paint_optics::{index, reflector};
+use super::paint_optics::index;
+pub use super::paint_optics::{lacquer_index, reflector};
 use super::{check_output_dir, paint_sparkle, PipelineError};
 
 /// What a paint run wrote and found.

@@ -32,7 +32,7 @@ fn film(f: &FilmSpec, wavelength_nm: f64) -> Result<Film, PipelineError> {
 }
 
 /// A flake's optics at a wavelength.
-pub(super) fn reflector(r: &ReflectorSpec, wavelength_nm: f64) -> Result<Reflector, PipelineError> {
+pub fn reflector(r: &ReflectorSpec, wavelength_nm: f64) -> Result<Reflector, PipelineError> {
     Ok(match r {
         ReflectorSpec::Metal { film: f } => Reflector::Metal(film(f, wavelength_nm)?),
         ReflectorSpec::Spectrum { reflectance, .. } => {

@@ -194,6 +194,7 @@ impl LiveModel for RadiativeTransfer {
             labels: vec![],
             rgb_to_xyz: rgb_to_xyz(obs),
             white_xyz: obs.white_xyz(),
+            sparkle: None,
         })
     }
 }

@@ -27,7 +27,7 @@
 use rayon::prelude::*;
 
 use super::live::{LiveModel, Param};
-use super::result::{page_colours, rgb_to_xyz, PageResult};
+use super::result::{page_colours, rgb_to_xyz, PageResult, PageSparkle};
 use super::table::PageBrdf;
 use super::ViewError;
 use crate::config::paint::{PaintScene, ReflectorSpec};
@@ -36,9 +36,15 @@ use crate::optics::colour::{self, delta_e2000, Observer};
 use crate::optics::flakes::air::AirNodes;
 use crate::optics::flakes::kernel::NormalQuadrature;
 use crate::optics::flakes::multiangle::{self, AngleColour};
+use crate::optics::flakes::normals::Orientation;
 use crate::optics::flakes::paint::{ModelParams, PaintReflection};
+use crate::optics::flakes::sparkle::{
+    cell_area_mm2, cone_probability, flakes_per_mm2, half_vector_tilt, ARCMINUTE_RAD,
+};
 use crate::output::h5::{MeasuredRecord, MeasuredSpectrum};
-use crate::pipeline::paint::{model_params, paint_air_directions, reflect_at};
+use crate::pipeline::paint::{
+    lacquer_index, model_params, paint_air_directions, reflect_at, reflector,
+};
 
 /// The live wavelengths' spacing: at least this (nm), from the paint's own.
 pub const LIVE_STEP_NM: f64 = 20.0;
@@ -337,6 +343,66 @@ fn table(reflections: &[PaintReflection], weights: &[[f64; 3]], anchor: String) 
     )
 }
 
+/// The glints of the paint's first layer with flakes, for the page
+/// ([`PageSparkle`]); None without flakes.
+fn sparkle(
+    scene: &PaintScene,
+    wavelengths_nm: &[f64],
+    weights: &[[f64; 3]],
+) -> Result<Option<PageSparkle>, ViewError> {
+    let Some((layer, f)) = scene
+        .layers
+        .iter()
+        .find_map(|l| l.flakes.as_ref().map(|f| (l, f)))
+    else {
+        return Ok(None);
+    };
+    let live = |e: crate::pipeline::PipelineError| ViewError::Live(e.to_string());
+    let cell_mm2 = cell_area_mm2(scene.sparkle.viewing_distance_mm, ARCMINUTE_RAD);
+    let per_mm2 = flakes_per_mm2(
+        f.volume_fraction,
+        layer.thickness_um,
+        f.diameter_um,
+        f.thickness_nm() / 1000.0,
+    );
+    let flake_mm2 = std::f64::consts::PI / 4.0 * f.mean_square_diameter_um2() * 1e-6;
+    let mut glint = [0.0; 3];
+    let mut n_mid = 1.5;
+    for (l, (&wl, w)) in wavelengths_nm.iter().zip(weights).enumerate() {
+        let n = lacquer_index(scene, wl).map_err(live)?;
+        if l == wavelengths_nm.len() / 2 {
+            n_mid = n;
+        }
+        let r = reflector(&f.reflector, wl)
+            .map_err(live)?
+            .powers(n, wl, 1.0)
+            .r;
+        for ch in 0..3 {
+            glint[ch] += w[ch] * r;
+        }
+    }
+    let per_cell = per_mm2 * cell_mm2;
+    let spread = Orientation {
+        sigma_rad: f.orientation_sd_deg.to_radians(),
+    };
+    let p45 = cone_probability(
+        &spread,
+        half_vector_tilt(45.0, n_mid),
+        scene.sparkle.acceptance_deg.to_radians(),
+    );
+    Ok(Some(PageSparkle {
+        flakes_per_cell: per_cell,
+        mean_glints_45: per_cell * p45,
+        sigma_deg: f.orientation_sd_deg,
+        acceptance_deg: scene.sparkle.acceptance_deg,
+        lacquer_index: n_mid,
+        coverage: (flake_mm2 / cell_mm2).min(1.0),
+        glint_rgb: glint,
+        cell_mm: cell_mm2.sqrt(),
+        viewing_distance_mm: scene.sparkle.viewing_distance_mm,
+    }))
+}
+
 impl LiveModel for LivePaint {
     fn describe(&self) -> String {
         format!(
@@ -395,11 +461,18 @@ impl LiveModel for LivePaint {
         let weights = rgb_weights(obs, wl)?;
         let flop = multiangle::flop_index_of(&angle)
             .map_or("no flop index".into(), |f| format!("flop index {f:.2}"));
+        let sparkle = sparkle(&scene, wl, &weights)?;
+        let glints = sparkle.as_ref().map_or(String::new(), |s| {
+            format!(
+                "; glints by the sparkle model, a canvas pixel one resolution cell at {:.0} mm                  ({:.0} flakes per cell, {:.2} glints per cell under a 45° lamp)",
+                s.viewing_distance_mm, s.flakes_per_cell, s.mean_glints_45
+            )
+        });
         let brdf = table(
             &reflections,
             &weights,
             format!(
-                "colour from each direction's spectrum ({} wavelengths, no gains); {flop}",
+                "colour from each direction's spectrum ({} wavelengths, no gains); {flop}{glints}",
                 wl.len()
             ),
         );
@@ -416,6 +489,7 @@ impl LiveModel for LivePaint {
             labels: vec![],
             rgb_to_xyz: rgb_to_xyz(obs),
             white_xyz: obs.white_xyz(),
+            sparkle,
         })
     }
 }

@@ -56,6 +56,34 @@ pub struct PageResult {
     pub rgb_to_xyz: [[f64; 3]; 3],
     /// XYZ of the perfect white under those conditions.
     pub white_xyz: [f64; 3],
+    /// An effect paint's glints; None for other results.
+    pub sparkle: Option<PageSparkle>,
+}
+
+/// What the page needs to draw an effect paint's glints by the sparkle
+/// model of METHOD §10 (`optics::flakes::sparkle`): each canvas pixel is one
+/// resolution cell at the viewing distance; a cell glints when one of its
+/// flakes has its normal within the acceptance cone (in the lacquer) of the
+/// half vector between the refracted lamp and view directions.
+#[derive(Debug, Clone, Serialize)]
+pub struct PageSparkle {
+    /// Flakes per resolution cell (Poisson mean).
+    pub flakes_per_cell: f64,
+    /// Spread of the flakes' normals (deg).
+    pub sigma_deg: f64,
+    /// The acceptance cone's half-angle in the lacquer (deg).
+    pub acceptance_deg: f64,
+    pub lacquer_index: f64,
+    /// A flake's share of its cell's area.
+    pub coverage: f64,
+    /// A flake's reflectance near normal incidence, linear sRGB.
+    pub glint_rgb: [f64; 3],
+    /// The model's mean glints per cell under a lamp at 45° and a normal
+    /// view (`N P`).
+    pub mean_glints_45: f64,
+    /// The resolution cell's side (mm) and the viewing distance (mm).
+    pub cell_mm: f64,
+    pub viewing_distance_mm: f64,
 }
 
 /// The matrix taking linear sRGB to XYZ under `obs` (the inverse of
@@ -139,6 +167,7 @@ pub fn page_result(
         labels: vec![],
         rgb_to_xyz: rgb_to_xyz(obs),
         white_xyz: obs.white_xyz(),
+        sparkle: None,
     })
 }
 

@@ -28,6 +28,7 @@ const state = {
   sky: 0.2,
   ev: -0.5,
   clip: false,
+  glints: true,
   geometry: "45/0",
 };
 
@@ -134,9 +135,11 @@ const VS = `#version 300 es
 in vec3 aPos; in vec3 aNrm;
 uniform mat3 uRot; uniform float uScale; uniform vec2 uOffset;
 out vec3 vN;
+out vec3 vP;
 void main() {
   vec3 p = uRot * aPos;
   vN = uRot * aNrm;
+  vP = aPos;
   gl_Position = vec4(p.xy * uScale + uOffset, -p.z * 0.5, 1.0);
 }`;
 const FS = `#version 300 es
@@ -148,7 +151,13 @@ uniform vec3 uN[2];
 uniform vec3 uLight;
 uniform float uLightE, uSky, uExposure, uSplitPx, uDiscCos;
 uniform int uClip;
+// Glints (effect paints): (flakes per cell, spread σ rad, acceptance γ rad,
+// lacquer index) and (one glint's radiance rgb, on); uCell the object's
+// length per canvas pixel (one resolution cell).
+uniform vec4 uSpark[2], uGlint[2];
+uniform float uCell;
 in vec3 vN;
+in vec3 vP;
 out vec4 outColour;
 float tc(float x, float n) { return (clamp(x, 0.0, 1.0) * (n - 1.0) + 0.5) / n; }
 vec3 shade(int k, vec3 n) {
@@ -170,12 +179,58 @@ vec3 shade(int k, vec3 n) {
   float disc = (ci > 0.0 && dot(r, l) >= uDiscCos) ? uLightE / (2.0 * P * (1.0 - uDiscCos)) : 0.0;
   return f * uLightE * max(ci, 0.0) + sky * uSky + spec * (uSky + disc);
 }
+// PCG's output function: well-mixed 32-bit values from the cell and the
+// flake's number.
+uint pcg(uint v) {
+  uint state = v * 747796405u + 2891336453u;
+  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+float rnd(uvec3 c, uint j) {
+  return (float(pcg(c.x ^ pcg(c.y ^ pcg(c.z ^ pcg(j))))) + 0.5) / 4294967296.0;
+}
+vec3 refr(vec3 d, vec3 n, float eta) {
+  float c = dot(d, n);
+  vec3 t = (d - c * n) / eta;
+  return t + n * sqrt(max(1.0 - dot(t, t), 0.0));
+}
+// The sparkle model (METHOD §10): a cell glints when one of its flakes has
+// its normal within γ of the half vector between the refracted lamp and
+// view directions. Each cell holds M flakes drawn from the spread (tilt
+// Rayleigh in σ, azimuth uniform), each standing for N/M of the cell's N
+// flakes: the cone is widened to γ √(N/M), so the mean count per cell is
+// the model's N P. The flakes are fixed to the object, so the glints move
+// as the lamp or the object turns; under the sky alone nothing glints.
+vec3 glints(int k, vec3 n, vec3 cell) {
+  vec4 s = k == 0 ? uSpark[0] : uSpark[1];
+  vec4 g = k == 0 ? uGlint[0] : uGlint[1];
+  vec3 l = normalize(uLight);
+  if (g.a <= 0.0 || dot(n, l) <= 0.0) return vec3(0.0);
+  const vec3 v = vec3(0.0, 0.0, 1.0);
+  vec3 h = normalize(refr(l, n, s.w) + refr(v, n, s.w));
+  const int M = 64;
+  // The cone as a chord, |h − m| ≤ 2 sin(γ'/2): well conditioned for small
+  // cones, where 1 − cos γ' loses the digits (and GPUs' cos is not exact).
+  float chord = 2.0 * sin(0.5 * min(s.z * sqrt(max(s.x, 0.0) / float(M)), 1.5));
+  vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+  vec3 t2 = cross(n, t1);
+  float count = 0.0;
+  for (int j = 0; j < M; j++) {
+    uvec3 c = uvec3(ivec3(cell) + ivec3(1 << 20));
+    float u1 = rnd(c, uint(2 * j)), u2 = rnd(c, uint(2 * j + 1));
+    float tilt = s.y * sqrt(-2.0 * log(u1)), az = 6.283185307 * u2;
+    vec3 m = cos(tilt) * n + sin(tilt) * (cos(az) * t1 + sin(az) * t2);
+    vec3 d = h - m;
+    if (dot(d, d) <= chord * chord) count += 1.0;
+  }
+  return count * g.rgb;
+}
 float enc(float x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055; }
 void main() {
   vec3 n = normalize(vN);
   if (n.z < 0.0) n = -n;  // a panel's back, seen from behind: coated too
   int k = gl_FragCoord.x < uSplitPx ? 0 : 1;
-  vec3 L = shade(k, n) * uExposure;
+  vec3 L = (shade(k, n) + glints(k, n, floor(vP / uCell))) * uExposure;
   bool clipped = any(greaterThan(L, vec3(1.0)));
   L = clamp(L, 0.0, 1.0);
   vec3 e = vec3(enc(L.r), enc(L.g), enc(L.b));
@@ -183,7 +238,7 @@ void main() {
   outColour = vec4(e, 1.0);
 }`;
 
-let gl, prog, loc = {}, meshes = {}, tex = [null, null], side = [null, null], dims = [[2, 2], [2, 2]];
+let gl, prog, loc = {}, meshes = {}, tex = [null, null], side = [null, null], dims = [[2, 2], [2, 2]], sparkle = [null, null];
 
 function compile(type, src) {
   const s = gl.createShader(type);
@@ -202,7 +257,8 @@ function initGl() {
   gl.linkProgram(prog);
   if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
   for (const n of ["uRot", "uScale", "uOffset", "uLight", "uLightE", "uSky", "uExposure", "uSplitPx",
-    "uDiscCos", "uClip", "uBrdf[0]", "uBrdf[1]", "uSide[0]", "uSide[1]", "uN[0]", "uN[1]"])
+    "uDiscCos", "uClip", "uBrdf[0]", "uBrdf[1]", "uSide[0]", "uSide[1]", "uN[0]", "uN[1]",
+    "uSpark[0]", "uSpark[1]", "uGlint[0]", "uGlint[1]", "uCell"])
     loc[n] = gl.getUniformLocation(prog, n);
   meshes.sphere = upload(sphereMesh(96, 48));
   meshes.panel = upload(panelMesh());
@@ -248,6 +304,7 @@ function uploadResult(k, r) {
   for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.LINEAR);
   for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
   dims[k] = [nt, np];
+  sparkle[k] = r.sparkle || null;
 }
 
 function draw() {
@@ -268,6 +325,17 @@ function draw() {
     gl.uniform1i(loc[`uSide[${k}]`], 2 * k + 1);
     const d = dims[k === 1 && hasB ? 1 : 0];
     gl.uniform3f(loc[`uN[${k}]`], d[0], d[1], 0);
+    // One glint: the flake mirrors the lamp's disc over its share of the cell.
+    const sp = sparkle[k === 1 && hasB ? 1 : 0], rad = Math.PI / 180;
+    const lamp = LIGHT_E / (2 * Math.PI * (1 - Math.cos(DISC_DEG * rad)));
+    if (sp && state.glints) {
+      gl.uniform4f(loc[`uSpark[${k}]`], sp.flakes_per_cell, sp.sigma_deg * rad, sp.acceptance_deg * rad, sp.lacquer_index);
+      const g = sp.glint_rgb.map((c) => c * sp.coverage * lamp);
+      gl.uniform4f(loc[`uGlint[${k}]`], g[0], g[1], g[2], 1);
+    } else {
+      gl.uniform4f(loc[`uSpark[${k}]`], 0, 1, 0, 1.5);
+      gl.uniform4f(loc[`uGlint[${k}]`], 0, 0, 0, 0);
+    }
   }
   // uRot is column-major in GLSL: pass the transpose of the row-major state.
   const R = state.rot;
@@ -281,10 +349,12 @@ function draw() {
   gl.uniform1i(loc.uClip, state.clip ? 1 : 0);
   if (hasB && state.mode === "side") {
     gl.uniform1f(loc.uScale, 0.42);
+    gl.uniform1f(loc.uCell, 2 / W / 0.42);
     gl.uniform1f(loc.uSplitPx, W / 2);
     for (const x of [-0.5, 0.5]) { gl.uniform2f(loc.uOffset, x, 0); gl.drawArrays(gl.TRIANGLES, 0, mesh.count); }
   } else {
     gl.uniform1f(loc.uScale, 0.8);
+    gl.uniform1f(loc.uCell, 2 / W / 0.8);
     gl.uniform2f(loc.uOffset, 0, 0);
     gl.uniform1f(loc.uSplitPx, hasB ? state.split * W : 1e9);
     gl.drawArrays(gl.TRIANGLES, 0, mesh.count);
@@ -530,6 +600,7 @@ function bindControls() {
   bindRange("sky", "sky", 2);
   bindRange("ev", "ev", 1);
   $("clip").addEventListener("change", () => { state.clip = $("clip").checked; draw(); });
+  $("glints").addEventListener("change", () => { state.glints = $("glints").checked; draw(); });
   $("split").addEventListener("input", () => { state.split = Number($("split").value); draw(); });
   for (const el of document.querySelectorAll("input[name=shape]"))
     el.addEventListener("change", () => { state.shape = el.value; draw(); });
@@ -557,6 +628,8 @@ function bindControls() {
 function fromQuery(q) {
   for (const k of ["theta", "phi", "sky", "ev", "split", "a", "b"]) if (q.has(k)) state[k] = Number(q.get(k));
   for (const k of ["mode", "shape", "geometry"]) if (q.has(k)) state[k] = q.get(k);
+  if (q.has("glints")) state.glints = q.get("glints") !== "0";
+  $("glints").checked = state.glints;
   for (const el of document.querySelectorAll("input[name=mode]")) el.checked = el.value === state.mode;
   for (const el of document.querySelectorAll("input[name=shape]")) el.checked = el.value === state.shape;
   $("split").value = state.split;
@@ -583,6 +656,35 @@ function probe(kind) {
     el.value = String(Math.max(0, state.theta - 30));
     el.dispatchEvent(new Event("input"));
     out.after = { theta: state.theta, centres: centres().map(([x, y, id]) => ({ x, y, id, rgb: pixel(x, y) })), readout: $("readout").textContent };
+  }
+  if (kind === "sparkle") {
+    // The glints alone: the picture with and without them, at the lamp's
+    // angle and 10° further; and their share of the cells near the centre
+    // (a normal within ~5° of the view) against the model's mean.
+    const W = gl.drawingBufferWidth, H = gl.drawingBufferHeight;
+    const grab = (on) => { state.glints = on; draw(); const p = new Uint8Array(W * H * 4); gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, p); return p; };
+    const lit = () => {
+      const a = grab(true), b = grab(false), set = new Set();
+      for (let i = 0; i < W * H; i++) if (Math.abs(a[4 * i] - b[4 * i]) + Math.abs(a[4 * i + 1] - b[4 * i + 1]) + Math.abs(a[4 * i + 2] - b[4 * i + 2]) > 12) set.add(i);
+      return set;
+    };
+    const g1 = lit();
+    const R = 0.8 * Math.min(W, H) / 2, r2 = (0.08 * R) ** 2;
+    let centre = 0, centreLit = 0;
+    for (let y = 0; y < H; y++) for (let x = 0; x < W; x++) {
+      if ((x + 0.5 - W / 2) ** 2 + (y + 0.5 - H / 2) ** 2 > r2) continue;
+      centre++;
+      if (g1.has(y * W + x)) centreLit++;
+    }
+    state.theta += 10;
+    const g2 = lit();
+    let both = 0;
+    for (const i of g1) if (g2.has(i)) both++;
+    const sp = sparkle[0];
+    out.sparkle = { glints: g1.size, moved: g2.size, both, centre_pixels: centre, centre_glints: centreLit, model_mean_45: sp ? sp.mean_glints_45 : null };
+    state.theta -= 10;
+    state.glints = true;
+    draw();
   }
   if (kind === "live" && live.params.length) {
     // Move the first live control as a user would; report once the picture changed.

@@ -64,6 +64,12 @@ fn start(args: &[&str]) -> (Child, String) {
     BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
+    if line.is_empty() {
+        // It stopped: say why.
+        let mut why = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut why).unwrap();
+        line = why;
+    }
     (child, line)
 }
 
@@ -481,4 +487,52 @@ fn an_effect_paint_is_recomputed_live_within_200_ms_and_drawn_in_its_colour() {
         both < 0.5 * glints.min(moved),
         "{both} of {glints}, {moved}"
     );
+}
+
+/// A study's folder: the variants' axis labels come from its summary.h5,
+/// and the page chooses A by its axis values (one select per axis).
+#[test]
+fn a_studys_variants_are_chosen_by_their_axis_values() {
+    use hdf5::types::VarLenUnicode;
+    let _only = exclusive();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let variants = d.join("variants");
+    std::fs::create_dir_all(&variants).unwrap();
+    let names = ["pigment-yellow", "pigment-blue"];
+    for (name, pigment) in names.iter().zip(["yellow", "blue"]) {
+        let r = result(d, pigment);
+        std::fs::rename(&r, variants.join(format!("{name}.h5"))).unwrap();
+    }
+    // The summary's /name and /labels/<axis>, as the merge writes them
+    // (docs/FORMAT.md).
+    let text =
+        |xs: &[&str]| -> Vec<VarLenUnicode> { xs.iter().map(|s| s.parse().unwrap()).collect() };
+    {
+        let f = hdf5::File::create(d.join("summary.h5")).unwrap();
+        f.new_dataset_builder()
+            .with_data(&text(&names))
+            .create("name")
+            .unwrap();
+        let g = f.create_group("labels").unwrap();
+        g.new_dataset_builder()
+            .with_data(&text(&["yellow", "blue"]))
+            .create("pigment")
+            .unwrap();
+    } // every handle closed: the server opens the file next
+
+    let served = serve(&[d]);
+    let url = &served.1;
+    let (list, _) = get(&format!("{url}/api/results"));
+    assert!(list.contains("[\"pigment\",\"blue\"]"), "{list}");
+    let Some(p) = probe_live(d, url, "axes") else {
+        return;
+    };
+    let a = p.get("axes");
+    eprintln!("axes probe: {a:?}");
+    assert_eq!(a.num("pickers"), 1.0);
+    // A starts at the first file (pigment-blue); the probe picks the last
+    // label of the axis, yellow.
+    assert_eq!(a.str("a"), "pigment-yellow", "{a:?}");
+    assert_eq!(a.str("note"), "");
 }

@@ -40,8 +40,15 @@ pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> 
             });
             continue;
         }
-        for path in source::result_files(input)? {
-            results.push(result::load(&path)?);
+        let files = source::result_files(input)?;
+        let labels = source::study_labels(&files)?;
+        for path in files {
+            let mut r = result::load(&path)?;
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+            if let Some(l) = stem.and_then(|s| labels.get(&s)) {
+                r.page.labels = l.clone();
+            }
+            results.push(r);
         }
     }
     let (srv, addr) = server::bind(server::Listen {

@@ -35,3 +35,30 @@ pub fn result_files(input: &Path) -> Result<Vec<PathBuf>, ViewError> {
     }
     Ok(out)
 }
+
+/// The axis labels of the variants among `files`, by file stem, from the
+/// study's `summary.h5` beside their `variants/` folder (none where there is
+/// no summary: the study has not been merged).
+pub fn study_labels(
+    files: &[PathBuf],
+) -> Result<std::collections::HashMap<String, Vec<(String, String)>>, ViewError> {
+    let mut out = std::collections::HashMap::new();
+    let mut seen = std::collections::HashSet::new();
+    for f in files {
+        let Some(variants) = f.parent() else { continue };
+        if variants.file_name().and_then(|n| n.to_str()) != Some("variants") {
+            continue;
+        }
+        let summary = variants
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("summary.h5");
+        if !summary.is_file() || !seen.insert(summary.clone()) {
+            continue;
+        }
+        for (name, labels) in crate::output::h5::read_study_labels(&summary)? {
+            out.insert(name, labels);
+        }
+    }
+    Ok(out)
+}

@@ -16,6 +16,7 @@
 //! - `brdf_read`: what drawing the layer on an object needs (the RGB
 //!   BRDF's data, the measured spectra, the tile);
 //! - `paint`: an effect paint's result file, its writer and reader;
+//! - `study_labels`: a study summary's variant axis labels, read back;
 //! - `attrs`: scalar and string attribute helpers shared by all of them;
 //! - `described`: every dataset's `units`, `description` and axis names,
 //!   written with it; `scales`: the HDF5 dimension scales behind the axes;
@@ -41,6 +42,7 @@ mod paint;
 mod result;
 mod scales;
 mod stack;
+mod study_labels;
 mod summary;
 
 pub use crate::output::error::IoError;
@@ -60,6 +62,7 @@ pub use paint::{
 };
 pub use result::{write_result, Identity, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};
+pub use study_labels::{read_study_labels, VariantLabels};
 pub use summary::{read_summary, AppearanceSummary, EntrySummary, ResultSummary};
 
 /// Version of the layout described in docs/FORMAT.md, stored as `format_version`.

@@ -644,6 +644,43 @@ function stats() {
   return { width: W, height: H, object_pixels: object };
 }
 
+// A study's variants chosen by their axis values: per side one select per
+// axis (the labels from the study's summary.h5); a change picks the variant
+// with every chosen label.
+function axisPickers() {
+  const rs = state.results.filter((r) => r.labels && r.labels.length);
+  const box = $("axes");
+  if (!rs.length) { box.innerHTML = ""; return; }
+  const axes = [...new Set(rs.flatMap((r) => r.labels.map(([a]) => a)))];
+  const labelOf = (r, a) => { const p = r && r.labels.find(([x]) => x === a); return p ? p[1] : ""; };
+  let html = "";
+  for (const side of ["a", "b"]) {
+    html += `<div>${side.toUpperCase()} by axis: ` + axes.map((a) => {
+      const vals = [...new Set(rs.map((r) => labelOf(r, a)).filter((v) => v))];
+      return `<label>${a} <select data-side="${side}" data-axis="${a}">${vals.map((v) => `<option>${v}</option>`).join("")}</select></label>`;
+    }).join(" ") + "</div>";
+  }
+  box.innerHTML = html + `<div id="axes-note" class="note"></div>`;
+  const sync = () => {
+    for (const el of box.querySelectorAll("select")) {
+      const r = state.results.find((x) => x.id === state[el.dataset.side]);
+      const v = labelOf(r, el.dataset.axis);
+      if (v) el.value = v;
+    }
+  };
+  sync();
+  for (const el of box.querySelectorAll("select")) el.addEventListener("change", () => {
+    const side = el.dataset.side, want = {};
+    for (const s of box.querySelectorAll(`select[data-side=${side}]`)) want[s.dataset.axis] = s.value;
+    const hit = rs.find((r) => axes.every((a) => !labelOf(r, a) || labelOf(r, a) === want[a]));
+    if (!hit) { $("axes-note").textContent = `no variant has ${axes.map((a) => `${a} = ${want[a]}`).join(", ")}`; return; }
+    $("axes-note").textContent = "";
+    state[side] = hit.id;
+    $("sel-" + side).value = String(hit.id);
+    select();
+  });
+}
+
 function probe(kind) {
   const out = { kind, renderer: gl.getParameter(gl.RENDERER), settings: { theta: state.theta, phi: state.phi, sky: state.sky, ev: state.ev, mode: state.mode, a: state.a, b: state.b } };
   out.centres = centres().map(([x, y, id]) => ({ x, y, id, rgb: pixel(x, y) }));
@@ -686,6 +723,13 @@ function probe(kind) {
     state.glints = true;
     draw();
   }
+  if (kind === "axes") {
+    // Choose A by its axis values as a user would: the last label of every axis.
+    const picks = [...document.querySelectorAll("#axes select[data-side=a]")];
+    for (const el of picks) el.value = el.options[el.options.length - 1].value;
+    if (picks.length) picks[picks.length - 1].dispatchEvent(new Event("change"));
+    out.axes = { pickers: picks.length, chosen: picks.map((el) => [el.dataset.axis, el.value]), a: state.results.find((r) => r.id === state.a).name, note: $("axes-note").textContent };
+  }
   if (kind === "live" && live.params.length) {
     // Move the first live control as a user would; report once the picture changed.
     const p = live.params[0], el = $("live-" + p.key);
@@ -715,6 +759,7 @@ async function main() {
     $("sel-a").value = state.a; $("sel-b").value = state.b;
     $("title").textContent = state.results.length === 1 ? state.results[0].name : `${state.results.length} results`;
     bindControls();
+    axisPickers();
     syncLightSliders();
     await initLive();
     await select();

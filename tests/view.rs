@@ -536,3 +536,21 @@ fn a_studys_variants_are_chosen_by_their_axis_values() {
     assert_eq!(a.str("a"), "pigment-yellow", "{a:?}");
     assert_eq!(a.str("note"), "");
 }
+
+/// An effect paint's result file is served as its paint, recomputed live
+/// from the exact config the file holds.
+#[test]
+fn a_paint_result_is_recomputed_from_the_config_it_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/metallic.toml");
+    let out = d.to_str().unwrap();
+    let (ok, _, err) = inksim_in(d, &["run", config.to_str().unwrap(), "--output-dir", out]);
+    assert!(ok, "{err}");
+    let served = serve(&[&d.join("metallic.h5")]);
+    let url = &served.1;
+    let (queries, ran) = (vec!["layer1_flakes=0.03".to_string()], "metallic (live)");
+    let (_, results) = live_sweep(url, &["layer1_flakes", "layer1_spread_deg"], &queries);
+    assert_eq!(results[0].str("name"), ran);
+    assert!(results[0].get("sparkle").num("flakes_per_cell") > 0.0);
+}

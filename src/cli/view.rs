@@ -13,7 +13,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 pub static SERVING: AtomicBool = AtomicBool::new(false);
 
 /// Serve `inputs` (result files, study folders, summary files, and at most
-/// one scene file recomputed live) on `host`:`port`.
+/// one scene file or effect paint's result recomputed live) on
+/// `host`:`port`.
 pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> Result<()> {
     let mut results = vec![];
     let mut live: Option<Box<dyn LiveModel>> = None;
@@ -38,6 +39,19 @@ pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> 
             } else {
                 Box::new(RadiativeTransfer::new(&config.scene()?)?)
             });
+            continue;
+        }
+        if input.is_file() && inksim::output::h5::is_paint_result(input).unwrap_or(false) {
+            // A paint's result: its fast model from the exact config it holds.
+            if live.is_some() {
+                bail!(
+                    "{}: one scene is recomputed live at a time",
+                    input.display()
+                );
+            }
+            let (config_path, text) = inksim::output::h5::read_paint_config(input)?;
+            let scene = inksim::config::parse_paint(std::path::Path::new(&config_path), &text)?;
+            live = Some(Box::new(LivePaint::new(scene)?));
             continue;
         }
         let files = source::result_files(input)?;

@@ -57,8 +57,8 @@ pub(crate) use described::{about, dim, Scales};
 pub use file::{create, open};
 pub use geometry::GeometrySummary;
 pub use paint::{
-    is_paint_result, read_paint, write_paint, AngleRecord, PaintRecord, PaintResultSet,
-    SparkleRecord, SparkleTable, PAINT_KIND,
+    is_paint_result, read_paint, read_paint_config, write_paint, AngleRecord, PaintRecord,
+    PaintResultSet, SparkleRecord, SparkleTable, PAINT_KIND,
 };
 pub use result::{write_result, Identity, RealisationStop, ResultSet};
 pub use stack::{read_stack_totals, LayerMatrices, StackTables};

@@ -430,6 +430,23 @@ pub fn is_paint_result(path: &Path) -> Result<bool, IoError> {
     Ok(read_str_attr(&file, "kind").is_ok_and(|k| k == PAINT_KIND))
 }
 
+/// The exact TOML text a paint result was computed from (`/config`) and the
+/// path it was read from then (root attribute `config_path`).
+pub fn read_paint_config(path: &Path) -> Result<(String, String), IoError> {
+    let hdf = |source| IoError::Hdf5 {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = super::open(path).map_err(hdf)?;
+    let text = file
+        .dataset("config")
+        .and_then(|d| d.read_scalar::<hdf5::types::VarLenUnicode>())
+        .map(|s| s.as_str().to_string())
+        .map_err(hdf)?;
+    let config_path = read_str_attr(&file, "config_path").map_err(hdf)?;
+    Ok((config_path, text))
+}
+
 /// The multi-angle colours, flop index and sparkle of a paint result.
 pub fn read_paint(path: &Path) -> Result<PaintRecord, IoError> {
     let hdf = |source| IoError::Hdf5 {

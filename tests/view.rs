@@ -541,6 +541,8 @@ fn a_studys_variants_are_chosen_by_their_axis_values() {
 /// from the exact config the file holds.
 #[test]
 fn a_paint_result_is_recomputed_from_the_config_it_holds() {
+    // Its run takes both cores for a second: not beside a timed recompute.
+    let _only = exclusive();
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let config = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/metallic.toml");

@@ -265,8 +265,11 @@ enum Command {
     /// stops it. Nothing is fetched from the network.
     View {
         /// Result files (.h5), a study's folder (its variants/) or its
-        /// summary.h5; the first is A. A scene file (.toml) is recomputed
-        /// live by its radiative-transfer baseline as its controls move.
+        /// summary.h5 (A and B then also chosen by axis values); the first
+        /// is A. A scene file (.toml) is recomputed live by its
+        /// radiative-transfer baseline as its controls move; an effect paint
+        /// ([paint] file, or its result file) by its fast model, with its
+        /// whole BRDF and glints. One live input at a time.
         #[arg(required = true)]
         inputs: Vec<PathBuf>,
         /// Port to listen on (0: any free port).

@@ -161,13 +161,12 @@ macro_rules! widest {
                 fn avx2($($arg: $ty),*) -> $ret {
                     $body($($arg),*)
                 }
-                if std::arch::is_x86_feature_detected!("avx512f") {
-                    // SAFETY: the CPU has AVX-512F (checked just above).
-                    return unsafe { avx512($($arg),*) };
-                }
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU has AVX2 (checked just above).
-                    return unsafe { avx2($($arg),*) };
+                match $crate::solver::simd::unit() {
+                    // SAFETY: `unit` found AVX-512F on this CPU.
+                    $crate::solver::simd::Unit::Avx512 => return unsafe { avx512($($arg),*) },
+                    // SAFETY: `unit` found AVX2 on this CPU.
+                    $crate::solver::simd::Unit::Avx2 => return unsafe { avx2($($arg),*) },
+                    $crate::solver::simd::Unit::Portable => {}
                 }
             }
             $body($($arg),*)
@@ -182,17 +181,38 @@ pub(crate) use widest;
 #[inline(always)]
 pub fn dispatch<R>(f: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { avx512(f) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { avx2(f) };
-        }
+    match unit() {
+        // SAFETY: `unit` found AVX-512F on this CPU.
+        Unit::Avx512 => return unsafe { avx512(f) },
+        // SAFETY: `unit` found AVX2 on this CPU.
+        Unit::Avx2 => return unsafe { avx2(f) },
+        Unit::Portable => {}
     }
     f()
+}
+
+/// The vector units the kernels are compiled for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    Avx512,
+    Avx2,
+    Portable,
+}
+
+/// The widest of them this CPU has (what [`dispatch`] and [`widest!`] run
+/// on).
+#[inline(always)]
+pub fn unit() -> Unit {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            return Unit::Avx512;
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            return Unit::Avx2;
+        }
+    }
+    Unit::Portable
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -6,7 +6,7 @@ use inksim::view::live::{LiveModel, RadiativeTransfer};
 use inksim::view::paint::LivePaint;
 use inksim::view::{result, server, source};
 use std::net::IpAddr;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Set while the page is being served: Ctrl-C then ends quietly (exit 0).
@@ -19,39 +19,18 @@ pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> 
     let mut results = vec![];
     let mut live: Option<Box<dyn LiveModel>> = None;
     for input in inputs {
-        if input.extension().and_then(|e| e.to_str()) == Some("toml") {
-            let config = super::ConfigFile::read(input)?;
-            if config.is_study() {
-                bail!(
-                    "{}: a study file; give its results' folder (<output_dir>/<profile>) or its summary.h5",
-                    config.display()
-                );
-            }
+        let scene_file = input.extension().and_then(|e| e.to_str()) == Some("toml");
+        let paint_result = !scene_file
+            && input.is_file()
+            && inksim::output::h5::is_paint_result(input).unwrap_or(false);
+        if scene_file || paint_result {
             if live.is_some() {
                 bail!(
                     "{}: one scene is recomputed live at a time",
                     input.display()
                 );
             }
-            live = Some(if config.is_paint() {
-                let scene = inksim::config::parse_paint(input, &config.text)?;
-                Box::new(LivePaint::new(scene)?)
-            } else {
-                Box::new(RadiativeTransfer::new(&config.scene()?)?)
-            });
-            continue;
-        }
-        if input.is_file() && inksim::output::h5::is_paint_result(input).unwrap_or(false) {
-            // A paint's result: its fast model from the exact config it holds.
-            if live.is_some() {
-                bail!(
-                    "{}: one scene is recomputed live at a time",
-                    input.display()
-                );
-            }
-            let (config_path, text) = inksim::output::h5::read_paint_config(input)?;
-            let scene = inksim::config::parse_paint(std::path::Path::new(&config_path), &text)?;
-            live = Some(Box::new(LivePaint::new(scene)?));
+            live = Some(live_model(input, paint_result)?);
             continue;
         }
         let files = source::result_files(input)?;
@@ -79,4 +58,27 @@ pub fn view(inputs: &[PathBuf], host: IpAddr, port: u16, allow_remote: bool) -> 
     let stop = AtomicBool::new(false);
     server::serve(&srv, &site, &stop);
     Ok(())
+}
+
+/// The live model of a scene or paint file, or of a paint's result (its
+/// fast model from the exact config the file holds).
+fn live_model(input: &Path, paint_result: bool) -> Result<Box<dyn LiveModel>> {
+    if paint_result {
+        let (config_path, text) = inksim::output::h5::read_paint_config(input)?;
+        let scene = inksim::config::parse_paint(Path::new(&config_path), &text)?;
+        return Ok(Box::new(LivePaint::new(scene)?));
+    }
+    let config = super::ConfigFile::read(input)?;
+    if config.is_study() {
+        bail!(
+            "{}: a study file; give its results' folder (<output_dir>/<profile>) or its summary.h5",
+            config.display()
+        );
+    }
+    Ok(if config.is_paint() {
+        let scene = inksim::config::parse_paint(input, &config.text)?;
+        Box::new(LivePaint::new(scene)?)
+    } else {
+        Box::new(RadiativeTransfer::new(&config.scene()?)?)
+    })
 }

@@ -74,6 +74,8 @@ pub struct LivePaint {
     knobs: Vec<(Knob, Param)>,
     observer: Observer,
     wavelengths_nm: Vec<f64>,
+    /// Linear sRGB of a unit reflectance factor at each live wavelength.
+    weights: Vec<[f64; 3]>,
     params: ModelParams,
     /// Largest ΔE00 of the live colours from the full model's at start.
     live_error: f64,
@@ -188,19 +190,21 @@ impl LivePaint {
         };
         let observer = Observer::standard(scene.illuminant, scene.observer);
         let wavelengths_nm = thinned(&scene.wavelengths_nm, LIVE_STEP_NM);
+        let weights = rgb_weights(&observer, &wavelengths_nm)?;
         let mut live = LivePaint {
             scene,
             knobs,
             observer,
             wavelengths_nm,
+            weights,
             params,
             live_error: f64::NAN,
         };
         // The live fidelity's cost in colour at the starting values.
         let fine = live.solve(&live.scene, &full, &live.scene.wavelengths_nm)?;
         let coarse = live.solve(&live.scene, &live.params, &live.wavelengths_nm)?;
-        let a = live.colours(&fine, &live.scene.wavelengths_nm)?;
-        let b = live.colours(&coarse, &live.wavelengths_nm)?;
+        let (_, a) = live.colours(&fine, &live.scene.wavelengths_nm)?;
+        let (_, b) = live.colours(&coarse, &live.wavelengths_nm)?;
         live.live_error = a
             .iter()
             .zip(&b)
@@ -254,15 +258,17 @@ impl LivePaint {
             .collect()
     }
 
-    /// The multi-angle colours and their reflectance-factor spectra.
+    /// The multi-angle geometries' reflectance-factor spectra (per
+    /// geometry, per wavelength) and their colours.
     fn colours(
         &self,
         reflections: &[PaintReflection],
         wavelengths_nm: &[f64],
-    ) -> Result<Vec<AngleColour>, ViewError> {
+    ) -> Result<(Vec<Vec<f64>>, Vec<AngleColour>), ViewError> {
         let rows = factors(reflections)?;
-        multiangle::colours(&self.observer, wavelengths_nm, &rows)
-            .map_err(|e| ViewError::Live(e.to_string()))
+        let colours = multiangle::colours(&self.observer, wavelengths_nm, &rows)
+            .map_err(|e| ViewError::Live(e.to_string()))?;
+        Ok((rows, colours))
     }
 }
 
@@ -311,18 +317,21 @@ fn table(reflections: &[PaintReflection], weights: &[[f64; 3]], anchor: String) 
         rgb
     };
     let pi = std::f64::consts::PI;
+    let most = reflections.iter().map(|r| r.terms.len()).max().unwrap_or(1);
+    // `cos mφ` of every Δφ of the grid (the same in every row), made once.
+    let cos_table = std::sync::OnceLock::<Vec<f64>>::new();
     PageBrdf::tabulate(
         &|ti, to, phis| {
             // The page's Δφ is 0 on the light's side; the model's azimuth is
             // 0 on the mirror side.
-            let most = reflections.iter().map(|r| r.terms.len()).max().unwrap_or(1);
-            let cos: Vec<f64> = phis
-                .iter()
-                .flat_map(|&p| {
-                    let phi = (180.0 - p).to_radians();
-                    (0..most).map(move |m| (m as f64 * phi).cos())
-                })
-                .collect();
+            let cos = cos_table.get_or_init(|| {
+                phis.iter()
+                    .flat_map(|&p| {
+                        let phi = (180.0 - p).to_radians();
+                        (0..most).map(move |m| (m as f64 * phi).cos())
+                    })
+                    .collect()
+            });
             let mut out = vec![[0.0; 3]; phis.len()];
             let mut terms = Vec::new();
             for ((a, r), w) in air.iter().zip(reflections).zip(weights) {
@@ -427,9 +436,7 @@ impl LiveModel for LivePaint {
         let scene = self.with(values);
         let wl = &self.wavelengths_nm;
         let reflections = self.solve(&scene, &self.params, wl)?;
-        let rows = factors(&reflections)?;
-        let angle = multiangle::colours(&self.observer, wl, &rows)
-            .map_err(|e| ViewError::Live(e.to_string()))?;
+        let (rows, angle) = self.colours(&reflections, wl)?;
         // 45as45 (45° light, normal view: the 45°/0° geometry) first.
         let mut order: Vec<usize> = (0..angle.len()).collect();
         order.sort_by_key(|&g| {
@@ -458,19 +465,19 @@ impl LiveModel for LivePaint {
             .collect();
         let obs = &self.observer;
         let colours = page_colours(&records, &spectra, obs);
-        let weights = rgb_weights(obs, wl)?;
         let flop = multiangle::flop_index_of(&angle)
             .map_or("no flop index".into(), |f| format!("flop index {f:.2}"));
-        let sparkle = sparkle(&scene, wl, &weights)?;
+        let sparkle = sparkle(&scene, wl, &self.weights)?;
         let glints = sparkle.as_ref().map_or(String::new(), |s| {
             format!(
-                "; glints by the sparkle model, a canvas pixel one resolution cell at {:.0} mm                  ({:.0} flakes per cell, {:.2} glints per cell under a 45° lamp)",
+                "; glints by the sparkle model, a canvas pixel one resolution cell at {:.0} mm \
+                 ({:.0} flakes per cell, {:.2} glints per cell under a 45° lamp)",
                 s.viewing_distance_mm, s.flakes_per_cell, s.mean_glints_45
             )
         });
         let brdf = table(
             &reflections,
-            &weights,
+            &self.weights,
             format!(
                 "colour from each direction's spectrum ({} wavelengths, no gains); {flop}{glints}",
                 wl.len()

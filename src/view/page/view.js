@@ -215,8 +215,8 @@ vec3 glints(int k, vec3 n, vec3 cell) {
   vec3 t1 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
   vec3 t2 = cross(n, t1);
   float count = 0.0;
+  uvec3 c = uvec3(ivec3(cell) + ivec3(1 << 20));
   for (int j = 0; j < M; j++) {
-    uvec3 c = uvec3(ivec3(cell) + ivec3(1 << 20));
     float u1 = rnd(c, uint(2 * j)), u2 = rnd(c, uint(2 * j + 1));
     float tilt = s.y * sqrt(-2.0 * log(u1)), az = 6.283185307 * u2;
     vec3 m = cos(tilt) * n + sin(tilt) * (cos(az) * t1 + sin(az) * t2);
@@ -307,6 +307,16 @@ function uploadResult(k, r) {
   sparkle[k] = r.sparkle || null;
 }
 
+// The object's radius in clip units, alone or side by side (A/B).
+const OBJECT_SCALE = 0.8, SIDE_SCALE = 0.42;
+
+// The scale and what follows from it: the object's length per canvas pixel
+// (one resolution cell of the glints).
+function setScale(scale, W) {
+  gl.uniform1f(loc.uScale, scale);
+  gl.uniform1f(loc.uCell, 2 / W / scale);
+}
+
 function draw() {
   const W = gl.drawingBufferWidth, H = gl.drawingBufferHeight;
   gl.viewport(0, 0, W, H);
@@ -348,13 +358,11 @@ function draw() {
   gl.uniform1f(loc.uDiscCos, Math.cos(DISC_DEG * Math.PI / 180));
   gl.uniform1i(loc.uClip, state.clip ? 1 : 0);
   if (hasB && state.mode === "side") {
-    gl.uniform1f(loc.uScale, 0.42);
-    gl.uniform1f(loc.uCell, 2 / W / 0.42);
+    setScale(SIDE_SCALE, W);
     gl.uniform1f(loc.uSplitPx, W / 2);
     for (const x of [-0.5, 0.5]) { gl.uniform2f(loc.uOffset, x, 0); gl.drawArrays(gl.TRIANGLES, 0, mesh.count); }
   } else {
-    gl.uniform1f(loc.uScale, 0.8);
-    gl.uniform1f(loc.uCell, 2 / W / 0.8);
+    setScale(OBJECT_SCALE, W);
     gl.uniform2f(loc.uOffset, 0, 0);
     gl.uniform1f(loc.uSplitPx, hasB ? state.split * W : 1e9);
     gl.drawArrays(gl.TRIANGLES, 0, mesh.count);
@@ -498,6 +506,7 @@ async function fetchResult(id) {
 }
 
 async function select() {
+  syncAxes();
   uploadResult(0, await fetchResult(state.a));
   if (state.b >= 0) uploadResult(1, await fetchResult(state.b));
   draw();
@@ -647,12 +656,25 @@ function stats() {
 // A study's variants chosen by their axis values: per side one select per
 // axis (the labels from the study's summary.h5); a change picks the variant
 // with every chosen label.
+function labelOf(r, axis) {
+  const p = r && r.labels && r.labels.find(([x]) => x === axis);
+  return p ? p[1] : "";
+}
+
+// The pickers showing A's and B's own labels (after any way of choosing them).
+function syncAxes() {
+  for (const el of $("axes").querySelectorAll("select")) {
+    const r = state.results.find((x) => x.id === state[el.dataset.side]);
+    const v = labelOf(r, el.dataset.axis);
+    if (v) el.value = v;
+  }
+}
+
 function axisPickers() {
   const rs = state.results.filter((r) => r.labels && r.labels.length);
   const box = $("axes");
   if (!rs.length) { box.innerHTML = ""; return; }
   const axes = [...new Set(rs.flatMap((r) => r.labels.map(([a]) => a)))];
-  const labelOf = (r, a) => { const p = r && r.labels.find(([x]) => x === a); return p ? p[1] : ""; };
   let html = "";
   for (const side of ["a", "b"]) {
     html += `<div>${side.toUpperCase()} by axis: ` + axes.map((a) => {
@@ -661,14 +683,7 @@ function axisPickers() {
     }).join(" ") + "</div>";
   }
   box.innerHTML = html + `<div id="axes-note" class="note"></div>`;
-  const sync = () => {
-    for (const el of box.querySelectorAll("select")) {
-      const r = state.results.find((x) => x.id === state[el.dataset.side]);
-      const v = labelOf(r, el.dataset.axis);
-      if (v) el.value = v;
-    }
-  };
-  sync();
+  syncAxes();
   for (const el of box.querySelectorAll("select")) el.addEventListener("change", () => {
     const side = el.dataset.side, want = {};
     for (const s of box.querySelectorAll(`select[data-side=${side}]`)) want[s.dataset.axis] = s.value;
@@ -706,7 +721,7 @@ function probe(kind) {
       return set;
     };
     const g1 = lit();
-    const R = 0.8 * Math.min(W, H) / 2, r2 = (0.08 * R) ** 2;
+    const R = OBJECT_SCALE * Math.min(W, H) / 2, r2 = (0.08 * R) ** 2;
     let centre = 0, centreLit = 0;
     for (let y = 0; y < H; y++) for (let x = 0; x < W; x++) {
       if ((x + 0.5 - W / 2) ** 2 + (y + 0.5 - H / 2) ** 2 > r2) continue;

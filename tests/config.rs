@@ -228,6 +228,20 @@ fn effective_medium_tolerance_defaults_and_is_limited() {
 }
 
 #[test]
+fn energy_balance_limit_defaults_and_is_limited() {
+    assert_eq!(parse(&base()).unwrap().solver.energy_balance_limit, 1e-4);
+    for v in [1e-8, 1e-3, 1e-2] {
+        let s = parse(&base().energy_balance_limit(v)).unwrap();
+        assert_eq!(s.solver.energy_balance_limit, v);
+    }
+    for v in [0.0, -1e-4, 0.05, f64::NAN] {
+        let (key, msg) = invalid(&base().energy_balance_limit(v));
+        assert_eq!(key, "solver.energy_balance_limit");
+        assert!(msg.contains("[1e-8, 1e-2]"), "{msg}");
+    }
+}
+
+#[test]
 fn unknown_key_is_named_on_one_line() {
     // The literal text is the point: the typo sits on line 4, column 1.
     let text = BY_HAND.replacen(

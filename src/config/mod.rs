@@ -21,7 +21,9 @@ mod wave;
 
 use std::path::{Path, PathBuf};
 
-pub use check::{is_paint_text, load_scene, parse_paint, parse_scene};
+pub use check::{
+    is_paint_text, load_scene, parse_paint, parse_scene, DEFAULT_ENERGY_BALANCE_LIMIT,
+};
 pub use colour::{Illuminant, Measurement, StandardObserver};
 pub use ground::{
     GroundReflectance, ReflectanceSpectrum, SpectrumError, Substrate, DEFAULT_PAPER_ALBEDO,
@@ -347,6 +349,9 @@ pub struct SolverSpec {
     /// layer by the homogeneous slab of the volume-averaged ε (closed form,
     /// no solve) when the measured estimate allows it; 0 never does.
     pub effective_medium_tolerance: f64,
+    /// Largest |ΣR + ΣT + A − 1| a solve may leave: one whose balance is
+    /// worse at `tolerance` is solved again to a tenth of it.
+    pub energy_balance_limit: f64,
 }
 
 impl SolverSpec {

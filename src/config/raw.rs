@@ -336,6 +336,9 @@ pub struct RawSolver {
     pub precision: Option<RawPrecision>,
     pub background: Option<RawBackground>,
     pub effective_medium_tolerance: Option<f64>,
+    /// Largest |ΣR + ΣT + A − 1| accepted before a solve is solved again,
+    /// tighter.
+    pub energy_balance_limit: Option<f64>,
     /// `"auto"`, `"two-solves"` or `"random-phase"` (Maxwell's natural
     /// light).
     pub natural_light: Option<RawNaturalLight>,

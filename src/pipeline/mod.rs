@@ -74,7 +74,7 @@ pub use paint::{paint_files, paint_plan, probe_paint, run_paint, PaintProbe, Pai
 pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};
-pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps, ENERGY_BALANCE_LIMIT};
+pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
 
 /// The progress of a run of `total` solves, its plan's lines logged first;
 /// hidden when `quiet` (a study's variants report through its own bar).

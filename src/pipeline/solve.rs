@@ -20,12 +20,6 @@ use super::eps::{fraction_eps, mean_eps};
 use super::plan::{incidences, RunPlan};
 use super::PipelineError;
 
-/// The largest |R + T + A − 1| a solve may leave: one whose balance is
-/// worse at the scene's tolerance is solved again to a tenth of it (down to
-/// 1e-10, or 1e-6 with f32 storage), so a residual test that converged
-/// early cannot pass an energy error on to the colours.
-pub const ENERGY_BALANCE_LIMIT: f64 = 1e-4;
-
 /// One progress step per solve, with its R, T, A, method and balance.
 fn log_solve(progress: &Progress, e: &SolveEntry) {
     let eff = &e.efficiencies;
@@ -184,14 +178,20 @@ pub fn solve_layer(
                     "{lambda} nm, {}° {side}",
                     (inc.polar_deg * 100.0).round() / 100.0
                 );
-                let (efficiencies, mut record) =
-                    solve_balanced(&p, scene.solver.method, ctl, &beat, progress, &label).map_err(
-                        |source| PipelineError::Solve {
-                            wavelength_nm: lambda,
-                            polar_deg: inc.polar_deg,
-                            source,
-                        },
-                    )?;
+                let (efficiencies, mut record) = solve_balanced(
+                    &p,
+                    scene.solver.method,
+                    ctl,
+                    scene.solver.energy_balance_limit,
+                    &beat,
+                    progress,
+                    &label,
+                )
+                .map_err(|source| PipelineError::Solve {
+                    wavelength_nm: lambda,
+                    polar_deg: inc.polar_deg,
+                    source,
+                })?;
                 if p.tensor.is_some() {
                     record.note.push_str(&format!(
                         "; tensor ε: {} cut voxels anisotropic, {} crystal-grain voxels",
@@ -230,8 +230,8 @@ pub fn heartbeat_interval() -> std::time::Duration {
 }
 
 /// One problem solved and held to the energy balance, not only to the
-/// residual: while `|ΣR + ΣT + A − 1|` exceeds [`ENERGY_BALANCE_LIMIT`] it is
-/// solved again to a tenth of the tolerance (down to 1e-10, or 1e-6 with
+/// residual: while `|ΣR + ΣT + A − 1|` exceeds `limit` (`[solver]
+/// energy_balance_limit`) it is solved again to a tenth of the tolerance (down to 1e-10, or 1e-6 with
 /// f32 storage), saying so in the log (`label` names the solve) and in the
 /// record, whose cost includes the attempts it replaced. Where the tighter
 /// solve fails, the answer at the looser tolerance is kept and the log and
@@ -243,6 +243,7 @@ fn solve_balanced(
     p: &Problem,
     method: Method,
     mut ctl: Controls,
+    limit: f64,
     beat: &dyn Fn(Beat),
     progress: &Progress,
     label: &str,
@@ -285,15 +286,13 @@ fn solve_balanced(
         };
         let eff = farfield::efficiencies(&sol);
         let tighter = ctl.tolerance / 10.0;
-        if eff.energy_balance.abs() <= ENERGY_BALANCE_LIMIT
-            || tighter < ctl.precision.select(1e-10, 1e-6)
-        {
+        if eff.energy_balance.abs() <= limit || tighter < ctl.precision.select(1e-10, 1e-6) {
             break (eff, sol.record);
         }
         progress.log(&format!(
             "[inksim] {label}: energy balance {:.1e} above {:.0e} at tolerance {:.0e}; \
              solving again to {tighter:.0e}",
-            eff.energy_balance, ENERGY_BALANCE_LIMIT, ctl.tolerance
+            eff.energy_balance, limit, ctl.tolerance
         ));
         again.push_str(&format!(
             "; solved again to {tighter:.0e} (energy balance {:.1e} at {:.0e})",

@@ -217,6 +217,10 @@ impl SceneToml {
         self.set("solver.effective_medium_tolerance", tol)
     }
 
+    pub fn energy_balance_limit(self, limit: f64) -> Self {
+        self.set("solver.energy_balance_limit", limit)
+    }
+
     /// Results as `dir/name.*`.
     pub fn output(self, dir: &Path, name: &str) -> Self {
         self.set("output.dir", dir.display().to_string())

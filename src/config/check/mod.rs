@@ -48,6 +48,7 @@ mod paint;
 mod pigments;
 mod scene;
 mod solver;
+pub use solver::DEFAULT_ENERGY_BALANCE_LIMIT;
 mod stack;
 mod structure;
 

@@ -1,6 +1,6 @@
 //! `[solver]`: the wave equation, the method, tolerance, iteration limit,
-//! field precision, the Krylov methods' background and the effective-medium
-//! tolerance; and `[illumination] polarisation`, which only Maxwell's
+//! field precision, the Krylov methods' background, the effective-medium
+//! tolerance and the energy-balance limit; and `[illumination] polarisation`, which only Maxwell's
 //! equation can honour.
 
 use super::Checker;
@@ -23,6 +23,11 @@ const MAX_ITERATIONS: i64 = 10_000_000;
 pub const DEFAULT_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 1e-3;
 /// Largest accepted error of the effective-medium shortcut.
 pub const MAX_EFFECTIVE_MEDIUM_TOLERANCE: f64 = 0.1;
+/// Default largest |ΣR + ΣT + A − 1| a solve may leave before it is solved
+/// again, tighter: well inside what the colours notice (ΔE00 ~0.01 per
+/// 1e-4 of R), so a residual test that converged early cannot pass an
+/// energy error on to them.
+pub const DEFAULT_ENERGY_BALANCE_LIMIT: f64 = 1e-4;
 
 impl Checker<'_> {
     pub(super) fn solver(
@@ -124,6 +129,15 @@ impl Checker<'_> {
             (0.0..=MAX_EFFECTIVE_MEDIUM_TOLERANCE).contains(&e),
             "[0, 0.1] (absolute error in R, T, A; 0 never takes the shortcut)",
         )?;
+        let b = raw
+            .and_then(|s| s.energy_balance_limit)
+            .unwrap_or(DEFAULT_ENERGY_BALANCE_LIMIT);
+        let energy_balance_limit = self.range(
+            "solver.energy_balance_limit",
+            b,
+            (1e-8..=1e-2).contains(&b),
+            "[1e-8, 1e-2] (largest |R + T + A - 1| before a solve is solved again, tighter)",
+        )?;
         Ok(SolverSpec {
             equation,
             polarisation,
@@ -134,6 +148,7 @@ impl Checker<'_> {
             precision,
             background,
             effective_medium_tolerance,
+            energy_balance_limit,
         })
     }
 }

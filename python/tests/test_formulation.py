@@ -78,3 +78,34 @@ def test_a_file_of_another_kind_is_refused(match, fit, tmp_path):
         inksim.open_fit(match.path)
     with pytest.raises(FileNotFoundError):
         inksim.open_match(tmp_path / "missing.h5")
+
+
+def test_a_verified_match_on_its_step_axis(binary, tmp_path):
+    """A match with ``[match.verify]`` (dissolved dyes: the wave solution in
+    closed form, so it runs in a second): ``verified`` has one dataset per
+    verified recipe on its ``step`` axis, the wave colour with units."""
+    palette = ('[[palette]]\nname = "red"\nmaterial = { builtin = "red" }\n'
+               'shape = { kind = "molecular" }\npvc_range = [0.0, 0.3]\n')
+    text = (
+        '[match]\nname = "v"\ntolerance_de00 = 0.3\nmax_colourants = 1\n'
+        '[match.verify]\nmax_steps = 2\nwavelength_step_nm = 30.0\n'
+        '[target]\nkind = "lab"\nilluminant = "D65"\nobserver_deg = 10\n'
+        'colour = [{ geometry = "45/0", lab = [60.0, 40.0, 10.0] }]\n'
+        '[base.layer]\nthickness_nm = 1000.0\nfragment_nm = [2000.0, 2000.0]\nbinder_index = 1.5\n'
+        '[base.grid]\ncell_nm = 50.0\n'
+        '[base.illumination]\nwavelengths_nm = [430.0, 700.0]\npolar_deg = [0.0]\n'
+        '[base.substrate]\nkind = "white"\nalbedo = 0.85\n' + palette)
+    cfg = tmp_path / "v.toml"
+    cfg.write_text(text)
+    out = tmp_path / "out"
+    subprocess.run([*binary, "match", str(cfg), "--output-dir", str(out)],
+                   check=True, capture_output=True, text=True)
+    m = inksim.open_match(out / "v.h5")
+    assert len(m.verified) == 1 and "equation" in m.verify_fidelity
+    v = m.verified[0]
+    assert v["lab"].dims == ("step", "geometry", "lab")
+    assert v["de00"].dims == ("step", "geometry")
+    assert v["pvc"].dims == ("step", "pigment")
+    assert list(v["step"].values) == list(range(v.sizes["step"]))
+    assert v.attrs["rank"] == 1 and "outcome" in v.attrs
+    assert np.all(np.isfinite(v["de00"].values))

@@ -46,6 +46,15 @@ pub fn check(config: &ConfigFile) -> Result<()> {
         problem.model.wavelengths_nm().len(),
         spec.output_dir.display()
     );
+    if let Some(v) = &spec.verify {
+        println!(
+            "  verification: the best {} recipe(s) by the wave solver, up to {} correction \
+             step(s): {}",
+            v.recipes,
+            v.max_steps,
+            inksim::r#match::verify::fidelity(&spec)
+        );
+    }
     Ok(())
 }
 
@@ -64,12 +73,15 @@ pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
     let written = write::write_outputs(&spec, &report, &spec.output_dir)?;
     print_report(&spec, &report);
     say(&format!(
-        "{} subset(s) in {:.2} s ({} model evaluations); wrote {} and {}",
+        "{} subset(s) in {:.2} s ({} model evaluations); wrote {} and {}{}",
         report.subsets,
         report.seconds,
         report.evaluations,
         written.h5.display(),
-        written.csv.display()
+        written.csv.display(),
+        written
+            .verify_csv
+            .map_or(String::new(), |p| format!(" and {}", p.display()))
     ));
     Ok(())
 }
@@ -143,6 +155,46 @@ fn print_report(spec: &MatchSpec, r: &MatchReport) {
                 f if f.is_empty() => String::new(),
                 f => format!("\n     not determined: {}", f.join("; ")),
             }
+        );
+    }
+    print_verified(spec, r);
+}
+
+/// The wave-optics verification: per verified recipe its corrected
+/// composition, the wave colour's ΔE00 (± its standard error) and the
+/// outcome.
+fn print_verified(spec: &MatchSpec, r: &MatchReport) {
+    let Some(fidelity) = &r.fidelity else {
+        return;
+    };
+    println!("verified with the wave solver ({fidelity}):");
+    for v in &r.verified {
+        // The verified recipe: the last step where it reached the
+        // tolerance, else the closest step.
+        let last = if v.verified { v.last() } else { v.best() };
+        let parts: Vec<String> = spec
+            .palette
+            .iter()
+            .zip(&last.fractions)
+            .filter(|(_, &f)| f > 0.0)
+            .map(|(p, f)| format!("{} {}", p.name, num(*f)))
+            .collect();
+        let de: Vec<String> = r
+            .target_lab
+            .iter()
+            .enumerate()
+            .map(|(k, (m, _))| match last.de00_se[k] {
+                Some(se) => format!("{:.3} ± {se:.3} ΔE00 at {}", last.de00[k], m.name()),
+                None => format!("{:.3} ΔE00 at {}", last.de00[k], m.name()),
+            })
+            .collect();
+        println!(
+            "  {}. {} (thickness {:.0} nm): {}\n     {}",
+            v.rank,
+            parts.join(", "),
+            last.thickness_nm,
+            de.join(", "),
+            v.outcome
         );
     }
 }

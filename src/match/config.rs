@@ -109,6 +109,26 @@ pub struct Search {
     pub recipes: usize,
 }
 
+/// The wave-optics verification of the best recipes (`[match.verify]`):
+/// each is solved by the full pipeline at the base scene's own fidelity
+/// (grid, fragment, realisations, equation, tolerance) and corrected by
+/// the fast–exact difference until it is within the tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerifySpec {
+    /// How many of the best recipes are verified.
+    pub recipes: usize,
+    /// Most correction steps after the first verification.
+    pub max_steps: usize,
+    /// Solved wavelengths: every this many nm over the colour band (both
+    /// ends included).
+    pub wavelength_step_nm: f64,
+}
+
+/// Most recipes verified.
+pub const MAX_VERIFIED: usize = 5;
+/// Most correction steps.
+pub const MAX_STEPS: usize = 10;
+
 /// A checked match file.
 #[derive(Debug, Clone)]
 pub struct MatchSpec {
@@ -123,6 +143,12 @@ pub struct MatchSpec {
     pub model: Baseline,
     pub palette: Vec<PaletteEntry>,
     pub search: Search,
+    /// The wave-optics verification, when asked for.
+    pub verify: Option<VerifySpec>,
+    /// The base scene's table with the palette as its pigments (the
+    /// verification's scenes are made from it), and the path it is read as.
+    pub base: Table,
+    pub base_path: PathBuf,
 }
 
 #[derive(Debug, Deserialize)]
@@ -148,6 +174,15 @@ struct RawSettings {
     max_total_pvc: Option<f64>,
     thickness_range_nm: Option<Vec<f64>>,
     recipes: Option<usize>,
+    verify: Option<RawVerify>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawVerify {
+    recipes: Option<usize>,
+    max_steps: Option<usize>,
+    wavelength_step_nm: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -256,12 +291,18 @@ impl MatchSpec {
             "a match file has [match], [target], base and [[palette]]",
         )?;
         let target = check_target(path, raw.target)?;
-        let (palette, scene) = check_palette(path, raw.base, raw.palette)?;
+        let (palette, scene, base, base_path) = check_palette(path, raw.base, raw.palette)?;
         let model = fast_model(path, &scene)?;
         let search = check_search(path, &raw.settings, &target, &scene, palette.len())?;
+        let verify = raw
+            .settings
+            .verify
+            .as_ref()
+            .map(|v| check_verify(path, v, &search))
+            .transpose()?;
         let (name, output_dir) =
             output_names(path, "match", raw.settings.name, raw.settings.output_dir)?;
-        Ok(MatchSpec {
+        let spec = MatchSpec {
             path: path.to_path_buf(),
             name,
             output_dir,
@@ -270,7 +311,24 @@ impl MatchSpec {
             model,
             palette,
             search,
-        })
+            verify,
+            base,
+            base_path,
+        };
+        if spec.verify.is_some() {
+            // Everything a verification run will read or write is checked
+            // now: its scene, made for a recipe of every palette pigment.
+            let every: Vec<f64> = spec
+                .palette
+                .iter()
+                .map(|p| 0.5 * (p.pvc_range[0] + p.pvc_range[1]))
+                .collect();
+            let total: f64 = every.iter().sum();
+            let scale = (spec.search.max_total_pvc / total).min(1.0);
+            let fractions: Vec<f64> = every.iter().map(|f| f * scale).collect();
+            super::verify::scene(&spec, &fractions, spec.scene.layer.thickness_nm, "check")?;
+        }
+        Ok(spec)
     }
 }
 
@@ -432,7 +490,7 @@ fn check_palette(
     file: &Path,
     base: Option<Value>,
     palette: Vec<Table>,
-) -> Result<(Vec<PaletteEntry>, Scene), MatchError> {
+) -> Result<(Vec<PaletteEntry>, Scene, Table, PathBuf), MatchError> {
     let (mut table, scene_path) = base_without_pigments(
         file,
         base,
@@ -505,7 +563,7 @@ fn check_palette(
         "base scene with the palette as its pigments",
         &|m| m.replace("pigment[", "palette["),
     )?;
-    Ok((entries, scene))
+    Ok((entries, scene, table, scene_path))
 }
 
 /// The base scene's table of the file `file` (inline or its own file, and
@@ -569,6 +627,42 @@ fn scene_message(e: &ConfigError) -> String {
         ConfigError::Invalid { key, message, .. } => format!("key `{key}`: {message}"),
         other => other.to_string(),
     }
+}
+
+fn check_verify(file: &Path, raw: &RawVerify, search: &Search) -> Result<VerifySpec, MatchError> {
+    let recipes = raw.recipes.unwrap_or(1);
+    if !(1..=MAX_VERIFIED.min(search.recipes)).contains(&recipes) {
+        return Err(invalid(
+            file,
+            "match.verify.recipes",
+            format!(
+                "{recipes} is outside [1, {}] (at most {MAX_VERIFIED}, and no more than \
+                 match.recipes)",
+                MAX_VERIFIED.min(search.recipes)
+            ),
+        ));
+    }
+    let max_steps = raw.max_steps.unwrap_or(3);
+    if max_steps > MAX_STEPS {
+        return Err(invalid(
+            file,
+            "match.verify.max_steps",
+            format!("{max_steps} is outside [0, {MAX_STEPS}]"),
+        ));
+    }
+    let step = raw.wavelength_step_nm.unwrap_or(20.0);
+    if !(step.is_finite() && (5.0..=100.0).contains(&step)) {
+        return Err(invalid(
+            file,
+            "match.verify.wavelength_step_nm",
+            format!("{step} is outside [5, 100] nm"),
+        ));
+    }
+    Ok(VerifySpec {
+        recipes,
+        max_steps,
+        wavelength_step_nm: step,
+    })
 }
 
 fn check_search(

@@ -9,7 +9,7 @@
 //! a fast recipe by a slower, exact model's colour.
 
 use super::problem::Problem;
-use super::solve::{jacobian, normal_matrix, Bounds};
+use super::solve::{jacobian, normal_matrix};
 
 /// The corrected unknowns of `subset` after one step from `x`, given the
 /// CIELAB measured in each target geometry (stacked, 3 per geometry).
@@ -20,33 +20,169 @@ pub fn correction_step(
     x: &[f64],
     measured_lab: &[f64],
 ) -> Option<Vec<f64>> {
-    let (lo, hi) = problem.bounds(subset);
-    let k = subset.len();
-    let project = |y: &mut [f64]| problem.project_total(k, &lo, y);
-    let bounds = Bounds {
-        lo: &lo,
-        hi: &hi,
-        project: &project,
-    };
-    let lab = |y: &[f64]| problem.lab_stack(&problem.recipe(subset, y));
-    let j = jacobian(&lab, x, &bounds);
-    let target: Vec<f64> = problem.target_lab.iter().flat_map(|(_, l)| *l).collect();
-    let d: Vec<f64> = target
-        .iter()
-        .zip(measured_lab)
-        .map(|(t, m)| t - m)
-        .collect();
-    let n = x.len();
-    let a = normal_matrix(&j, &vec![1.0; j.len()]);
-    let rhs = crate::optics::baseline::matrix::Matrix::from_fn(n, |p, q| {
-        if q == 0 {
-            j.iter().zip(&d).map(|(row, di)| row[p] * di).sum()
-        } else {
-            0.0
+    problem.with_bounds(subset, |bounds| {
+        let lab = |y: &[f64]| problem.lab_stack(&problem.recipe(subset, y));
+        let j = jacobian(&lab, x, bounds);
+        let target: Vec<f64> = problem.target_lab.iter().flat_map(|(_, l)| *l).collect();
+        let d: Vec<f64> = target
+            .iter()
+            .zip(measured_lab)
+            .map(|(t, m)| t - m)
+            .collect();
+        let n = x.len();
+        let a = normal_matrix(&j, &vec![1.0; j.len()]);
+        let rhs = crate::optics::baseline::matrix::Matrix::from_fn(n, |p, q| {
+            if q == 0 {
+                j.iter().zip(&d).map(|(row, di)| row[p] * di).sum()
+            } else {
+                0.0
+            }
+        });
+        let step = super::solve::inverse(&a)?.mul(&rhs);
+        let mut y: Vec<f64> = (0..n).map(|p| x[p] + step[(p, 0)]).collect();
+        bounds.clamp(&mut y);
+        Some(y)
+    })
+}
+
+/// What the verification knows of the exact model's difference from the
+/// fast one, `e(y) = exact(y) − fast(y)` (CIELAB stacked, 3 per
+/// geometry): `e(y) ≈ e(a) + B (y − a)`, anchored at the verified recipe
+/// `a` closest to the target so far (exact there), its slope `B` learnt
+/// from each verified step by Broyden's rank-one update (zero at first: a
+/// constant offset). Anchoring at the best recipe rather than the last
+/// keeps a step that made the colour worse from leading the next one; what
+/// that step taught the slope is kept.
+#[derive(Debug, Clone)]
+pub struct ModelDifference {
+    /// The last verified recipe and its difference.
+    last: (Vec<f64>, Vec<f64>),
+    /// The anchor (recipe, difference) and its distance to the target.
+    anchor: (Vec<f64>, Vec<f64>),
+    anchor_score: f64,
+    /// Rows: the stacked CIELAB coordinates; columns: the unknowns.
+    slope: Vec<Vec<f64>>,
+}
+
+impl ModelDifference {
+    /// The difference at the first verified recipe `x`, whose exact colour
+    /// is `measured_lab` at `score` (its largest ΔE00 to the target).
+    pub fn new(
+        problem: &Problem,
+        subset: &[usize],
+        x: &[f64],
+        measured_lab: &[f64],
+        score: f64,
+    ) -> Self {
+        let e = difference(problem, subset, x, measured_lab);
+        ModelDifference {
+            last: (x.to_vec(), e.clone()),
+            anchor: (x.to_vec(), e),
+            anchor_score: score,
+            slope: vec![vec![0.0; x.len()]; measured_lab.len()],
         }
-    });
-    let step = super::solve::inverse(&a)?.mul(&rhs);
-    let mut y: Vec<f64> = (0..n).map(|p| x[p] + step[(p, 0)]).collect();
-    bounds.clamp(&mut y);
-    Some(y)
+    }
+
+    /// Learn from the next verified recipe `y`, its exact colour and its
+    /// score.
+    pub fn update(
+        &mut self,
+        problem: &Problem,
+        subset: &[usize],
+        y: &[f64],
+        measured_lab: &[f64],
+        score: f64,
+    ) {
+        let e = difference(problem, subset, y, measured_lab);
+        let (x, e0) = &self.last;
+        let dx: Vec<f64> = y.iter().zip(x).map(|(a, b)| a - b).collect();
+        let norm: f64 = dx.iter().map(|d| d * d).sum();
+        if norm > 0.0 {
+            for (r, row) in self.slope.iter_mut().enumerate() {
+                let predicted: f64 = row.iter().zip(&dx).map(|(b, d)| b * d).sum();
+                let miss = e[r] - e0[r] - predicted;
+                for (b, d) in row.iter_mut().zip(&dx) {
+                    *b += miss * d / norm;
+                }
+            }
+        }
+        self.last = (y.to_vec(), e.clone());
+        if score < self.anchor_score {
+            self.anchor = (y.to_vec(), e);
+            self.anchor_score = score;
+        }
+    }
+
+    /// The anchor, from which the next correction starts.
+    pub fn x(&self) -> &[f64] {
+        &self.anchor.0
+    }
+
+    /// The modelled difference at `y`.
+    pub fn at(&self, y: &[f64]) -> Vec<f64> {
+        let (a, e) = &self.anchor;
+        e.iter()
+            .zip(&self.slope)
+            .map(|(o, row)| {
+                o + row
+                    .iter()
+                    .zip(y.iter().zip(a))
+                    .map(|(b, (p, q))| b * (p - q))
+                    .sum::<f64>()
+            })
+            .collect()
+    }
+}
+
+/// `measured − fast(x)`, stacked.
+fn difference(problem: &Problem, subset: &[usize], x: &[f64], measured_lab: &[f64]) -> Vec<f64> {
+    let fast = problem.lab_stack(&problem.recipe(subset, x));
+    measured_lab.iter().zip(&fast).map(|(m, f)| m - f).collect()
+}
+
+/// The recipe of `subset` that the fast model plus the modelled fast–exact
+/// difference `d` puts on the target: the bounded Levenberg–Marquardt fit
+/// of `fast(y) + d(y) = target` from the last verified recipe, polished on
+/// the RMS ΔE00 of `fast(y) + d(y)` to the target. Where the difference
+/// changes slowly with the recipe, repeating it (with `d` updated from
+/// each verified step) converges on the exact model's recipe; unlike one
+/// Gauss–Newton step ([`correction_step`]) it keeps the bounds and the
+/// total volume fraction inside the fit, not clamped after it. None when
+/// the fit gives no finite recipe.
+pub fn offset_correction(
+    problem: &Problem,
+    subset: &[usize],
+    d: &ModelDifference,
+) -> Option<Vec<f64>> {
+    problem.with_bounds(subset, |bounds| {
+        let target: Vec<f64> = problem.target_lab.iter().flat_map(|(_, l)| *l).collect();
+        let shifted = |y: &[f64]| -> Vec<f64> {
+            let lab = problem.lab_stack(&problem.recipe(subset, y));
+            lab.iter().zip(d.at(y)).map(|(l, o)| l + o).collect()
+        };
+        let residuals = |y: &[f64]| -> Vec<f64> {
+            shifted(y).iter().zip(&target).map(|(a, t)| a - t).collect()
+        };
+        let de00 = |y: &[f64]| -> f64 {
+            let lab = shifted(y);
+            let sum: f64 = lab
+                .chunks(3)
+                .zip(target.chunks(3))
+                .map(|(a, t)| {
+                    crate::optics::colour::delta_e2000([a[0], a[1], a[2]], [t[0], t[1], t[2]])
+                        .powi(2)
+                })
+                .sum();
+            (sum / problem.target_lab.len().max(1) as f64).sqrt()
+        };
+        let m = super::solve::levenberg_marquardt(&residuals, d.x(), bounds, 200, 1e-14);
+        let mut y = m.x;
+        if de00(&y) > 1e-3 {
+            let p = super::solve::nelder_mead(&de00, &y, bounds, 400, 1e-9);
+            if p.cost < de00(&y) {
+                y = p.x;
+            }
+        }
+        y.iter().all(|v| v.is_finite()).then_some(y)
+    })
 }

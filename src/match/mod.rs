@@ -15,6 +15,8 @@
 //! - [`uncertainty`]: the recipe's standard errors from the target's noise,
 //!   and the ingredients it cannot tell apart.
 //! - [`correct`]: one correction step of a recipe from a measured colour.
+//! - [`verify`]: the best recipes solved by the wave pipeline at the base
+//!   scene's fidelity and corrected by the fast–exact difference.
 //! - [`report`]: the reported recipes (composition, ΔE00 per geometry,
 //!   metamerism indices, uncertainty).
 //! - [`write`]: the HDF5 file and the recipes CSV, written atomically.
@@ -33,7 +35,9 @@ pub mod report;
 pub mod search;
 pub mod solve;
 pub mod uncertainty;
+pub mod verify;
 pub mod write;
+mod write_verify;
 
 pub use config::MatchSpec;
 pub use report::{run, MatchReport, RecipeReport};

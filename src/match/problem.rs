@@ -8,6 +8,7 @@ use crate::optics::colour::{self, Observer};
 
 use super::config::{MatchSpec, Objective, TargetColour};
 use super::forward::{FastModel, Recipe};
+use super::solve::Bounds;
 use super::MatchError;
 
 /// What one recipe's colour is against the target.
@@ -105,6 +106,19 @@ impl Problem {
             hi.push(b);
         }
         (lo, hi)
+    }
+
+    /// `f` of the box and the total volume fraction of `subset`'s unknowns,
+    /// as the solvers take them.
+    pub fn with_bounds<R>(&self, subset: &[usize], f: impl FnOnce(&Bounds) -> R) -> R {
+        let (lo, hi) = self.bounds(subset);
+        let k = subset.len();
+        let project = |y: &mut [f64]| self.project_total(k, &lo, y);
+        f(&Bounds {
+            lo: &lo,
+            hi: &hi,
+            project: &project,
+        })
     }
 
     /// Whether `subset`'s least volume fractions fit the total.

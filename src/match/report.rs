@@ -22,6 +22,7 @@ use super::forward::{FastModel, Recipe};
 use super::problem::Problem;
 use super::search::{search, Candidate};
 use super::uncertainty::{uncertainty, Uncertainty};
+use super::verify::{self, Verification};
 use super::MatchError;
 
 /// One reported recipe.
@@ -68,7 +69,11 @@ pub struct MatchReport {
     pub subsets: usize,
     pub largest: usize,
     pub evaluations: usize,
-    /// Wall time of the search and the report, s.
+    /// The wave-optics verifications of the best recipes (`[match.verify]`;
+    /// empty without it), in rank order, and the fidelity they solved at.
+    pub verified: Vec<Verification>,
+    pub fidelity: Option<String>,
+    /// Wall time of the search, the report and the verification, s.
     pub seconds: f64,
 }
 
@@ -126,7 +131,20 @@ pub fn run(spec: &MatchSpec, progress: &dyn Fn(&str)) -> Result<MatchReport, Mat
     for (i, c) in outcome.ranked.iter().take(s.recipes).enumerate() {
         recipes.push(recipe_report(spec, &problem, i + 1, c)?);
     }
+    let mut verified = Vec::new();
+    let fidelity = spec.verify.as_ref().map(|_| verify::fidelity(spec));
+    if let (Some(v), Some(f)) = (&spec.verify, &fidelity) {
+        progress(&format!(
+            "verifying the best {} recipe(s) with the wave solver: {f}",
+            v.recipes.min(recipes.len())
+        ));
+        for r in recipes.iter().take(v.recipes) {
+            verified.push(verify::verify(spec, &problem, r, progress)?);
+        }
+    }
     Ok(MatchReport {
+        verified,
+        fidelity,
         recipes,
         wavelengths_nm: problem.model.wavelengths_nm().to_vec(),
         target_lab: problem.target_lab.clone(),

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::config::Objective;
 use super::problem::{Fit, Problem};
-use super::solve::{levenberg_marquardt, nelder_mead, Bounds};
+use super::solve::{levenberg_marquardt, nelder_mead};
 
 /// The best recipe found for one subset of the palette.
 #[derive(Debug, Clone)]
@@ -99,47 +99,47 @@ fn start(s: usize, lo: &[f64], hi: &[f64]) -> Vec<f64> {
 
 /// Fit one subset from `starts` starting points; its best recipe.
 pub fn fit_subset(problem: &Problem, subset: &[usize], starts: usize) -> Candidate {
-    let (lo, hi) = problem.bounds(subset);
-    let k = subset.len();
-    let project = |x: &mut [f64]| problem.project_total(k, &lo, x);
-    let bounds = Bounds {
-        lo: &lo,
-        hi: &hi,
-        project: &project,
-    };
-    let residuals = |x: &[f64]| problem.residuals(&problem.recipe(subset, x));
-    let de00 = |x: &[f64]| problem.fit(&problem.recipe(subset, x)).de00_rms();
-    let mut best: Option<Candidate> = None;
-    let mut evaluations = 0;
-    for s in 0..starts {
-        let m = levenberg_marquardt(&residuals, &start(s, &lo, &hi), &bounds, 200, 1e-14);
-        evaluations += m.evaluations;
-        let mut x = m.x;
-        if problem.objective == Objective::De00 && de00(&x) > 1e-3 {
-            let p = nelder_mead(&de00, &x, &bounds, 400, 1e-9);
-            evaluations += p.evaluations;
-            if p.cost < de00(&x) {
-                x = p.x;
+    problem.with_bounds(subset, |bounds| {
+        let residuals = |x: &[f64]| problem.residuals(&problem.recipe(subset, x));
+        let de00 = |x: &[f64]| problem.fit(&problem.recipe(subset, x)).de00_rms();
+        let mut best: Option<Candidate> = None;
+        let mut evaluations = 0;
+        for s in 0..starts {
+            let m = levenberg_marquardt(
+                &residuals,
+                &start(s, bounds.lo, bounds.hi),
+                bounds,
+                200,
+                1e-14,
+            );
+            evaluations += m.evaluations;
+            let mut x = m.x;
+            if problem.objective == Objective::De00 && de00(&x) > 1e-3 {
+                let p = nelder_mead(&de00, &x, bounds, 400, 1e-9);
+                evaluations += p.evaluations;
+                if p.cost < de00(&x) {
+                    x = p.x;
+                }
+            }
+            let fit = problem.fit(&problem.recipe(subset, &x));
+            let objective = match problem.objective {
+                Objective::SpectralRms => fit.spectral_rms.unwrap_or_else(|| fit.de00_rms()),
+                Objective::De00 => fit.de00_rms(),
+            };
+            if best.as_ref().is_none_or(|b| objective < b.objective) {
+                best = Some(Candidate {
+                    subset: subset.to_vec(),
+                    x,
+                    fit,
+                    objective,
+                    evaluations: 0,
+                });
             }
         }
-        let fit = problem.fit(&problem.recipe(subset, &x));
-        let objective = match problem.objective {
-            Objective::SpectralRms => fit.spectral_rms.unwrap_or_else(|| fit.de00_rms()),
-            Objective::De00 => fit.de00_rms(),
-        };
-        if best.as_ref().is_none_or(|b| objective < b.objective) {
-            best = Some(Candidate {
-                subset: subset.to_vec(),
-                x,
-                fit,
-                objective,
-                evaluations: 0,
-            });
-        }
-    }
-    let mut best = best.expect("at least one start");
-    best.evaluations = evaluations;
-    best
+        let mut best = best.expect("at least one start");
+        best.evaluations = evaluations;
+        best
+    })
 }
 
 /// Search the palette (module docs); `progress` hears one line per subset

@@ -2,7 +2,9 @@
 //! the target, the palette and every reported recipe with its colour,
 //! uncertainty and metamerism; layout in docs/MATCH.md, every dataset with
 //! its units, description and labelled axes) and `<name>-recipes.csv` (one
-//! row per recipe). Both are written atomically under the output lock.
+//! row per recipe), with the verification's part (`/verify`,
+//! `<name>-verify.csv`) from [`super::write_verify`]. All are written
+//! atomically under the output lock.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -31,6 +33,8 @@ const BOUND: &str = "bound";
 pub struct Written {
     pub h5: PathBuf,
     pub csv: PathBuf,
+    /// `<name>-verify.csv`, when recipes were verified.
+    pub verify_csv: Option<PathBuf>,
 }
 
 /// Write the report of `spec` into `dir`.
@@ -49,8 +53,19 @@ pub fn write_outputs(
         })
     })?;
     write_atomic(&csv, recipes_csv(spec, report).as_bytes())?;
+    let verify_csv = if report.verified.is_empty() {
+        None
+    } else {
+        let path = dir.join(format!("{}-verify.csv", spec.name));
+        write_atomic(&path, super::write_verify::csv(spec, report).as_bytes())?;
+        Some(path)
+    };
     drop(lock);
-    Ok(Written { h5, csv })
+    Ok(Written {
+        h5,
+        csv,
+        verify_csv,
+    })
 }
 
 fn strings(xs: &[String]) -> hdf5::Result<Vec<VarLenUnicode>> {
@@ -184,6 +199,7 @@ fn write_h5(spec: &MatchSpec, r: &MatchReport, path: &Path) -> hdf5::Result<()> 
         let rg = g.create_group(&format!("{:03}", x.rank))?;
         write_recipe(&mut sc, &rg, x)?;
     }
+    super::write_verify::write_h5(&mut sc, &f, r)?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@ xarray on the axes the files label (docs/MATCH.md).
 >>> m = inksim.open_match("runs/match-red-tint/match-red-tint.h5")
 >>> m.recipes["pvc"].sel(recipe=0)        # the best recipe's PVC per pigment
 >>> m.recipe(1)                            # rank 1's unknowns with s.e. and flags
+>>> m.verified[0][["de00", "de00_se"]]    # the wave verification, step by step
 >>> f = inksim.open_fit("runs/fit-red/fit-red.h5")
 >>> f.constants[["k", "k_se"]]             # k(λ) with its standard error
 """
@@ -56,7 +57,14 @@ class MatchResult:
     - ``recipes``: every recipe's PVC per pigment, thickness and ΔE00 per
       geometry, on a ``recipe`` axis (0 the best);
     - ``recipe(i)``: recipe ``i``'s unknowns with standard errors,
-      correlations and flags, its CIELAB and reflectance factor.
+      correlations and flags, its CIELAB and reflectance factor;
+    - ``verified``: with ``[match.verify]``, one dataset per verified recipe
+      on a ``step`` axis (0 the fast model's recipe, k after k corrections):
+      its PVC per pigment, the wave solution's CIELAB with standard error,
+      the fast model's CIELAB of the same recipe, ΔE00 to the target and the
+      fast model's error, each step's result file; attributes ``rank``,
+      ``verified`` and ``outcome``. ``verify_fidelity`` says what the wave
+      solver solved at (None without a verification).
     """
 
     def __init__(self, path: str):
@@ -72,6 +80,15 @@ class MatchResult:
                 _dataset(f, f"recipes/{name}", f)
                 for name in sorted(k for k in f["recipes"] if isinstance(f["recipes"][k], h5py.Group))
             ]
+            self.verified: List[xr.Dataset] = []
+            self.verify_fidelity = None
+            if "verify" in f:
+                self.verify_fidelity = _attrs(f["verify"]).get("fidelity")
+                for name in sorted(f["verify"]):
+                    g = f["verify"][name]
+                    if isinstance(g, h5py.Group):
+                        ds = _dataset(f, f"verify/{name}", f)
+                        self.verified.append(ds.set_coords("step") if "step" in ds else ds)
 
     def recipe(self, i: int) -> xr.Dataset:
         """Recipe ``i`` (0 the best) in full."""

@@ -315,19 +315,6 @@ impl MatchSpec {
             base,
             base_path,
         };
-        if spec.verify.is_some() {
-            // Everything a verification run will read or write is checked
-            // now: its scene, made for a recipe of every palette pigment.
-            let every: Vec<f64> = spec
-                .palette
-                .iter()
-                .map(|p| 0.5 * (p.pvc_range[0] + p.pvc_range[1]))
-                .collect();
-            let total: f64 = every.iter().sum();
-            let scale = (spec.search.max_total_pvc / total).min(1.0);
-            let fractions: Vec<f64> = every.iter().map(|f| f * scale).collect();
-            super::verify::scene(&spec, &fractions, spec.scene.layer.thickness_nm, "check")?;
-        }
         Ok(spec)
     }
 }

@@ -105,6 +105,19 @@ pub fn problem(spec: &MatchSpec) -> Result<Problem, MatchError> {
             ),
         });
     }
+    if spec.verify.is_some() {
+        // Everything a verification run will read is checked now: its
+        // scene, made for a recipe of every palette pigment.
+        let every: Vec<f64> = spec
+            .palette
+            .iter()
+            .map(|p| 0.5 * (p.pvc_range[0] + p.pvc_range[1]))
+            .collect();
+        let total: f64 = every.iter().sum();
+        let scale = (spec.search.max_total_pvc / total).min(1.0);
+        let fractions: Vec<f64> = every.iter().map(|f| f * scale).collect();
+        verify::scene(spec, &fractions, spec.scene.layer.thickness_nm, "check")?;
+    }
     Problem::new(spec, FastModel::new(spec.model, &input)?)
 }
 
@@ -139,7 +152,13 @@ pub fn run(spec: &MatchSpec, progress: &dyn Fn(&str)) -> Result<MatchReport, Mat
             v.recipes.min(recipes.len())
         ));
         for r in recipes.iter().take(v.recipes) {
-            verified.push(verify::verify(spec, &problem, r, progress)?);
+            verified.push(verify::verify(
+                spec,
+                &problem,
+                r.rank,
+                &r.candidate,
+                progress,
+            )?);
         }
     }
     Ok(MatchReport {

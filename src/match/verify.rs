@@ -21,7 +21,7 @@ use crate::pipeline::{self, memory::MemoryLimit};
 use super::config::{checked_scene, MatchSpec};
 use super::correct::{offset_correction, ModelDifference};
 use super::problem::Problem;
-use super::report::RecipeReport;
+use super::search::Candidate;
 use super::MatchError;
 
 /// One verified recipe of a correction sequence.
@@ -282,12 +282,13 @@ fn solve(
     Ok(step)
 }
 
-/// Verify recipe `r` with the wave solver and correct it (module docs);
-/// `progress` hears each step.
+/// Verify the recipe of rank `rank`, `candidate`, with the wave solver and
+/// correct it (module docs); `progress` hears each step.
 pub fn verify(
     spec: &MatchSpec,
     problem: &Problem,
-    r: &RecipeReport,
+    rank: usize,
+    candidate: &Candidate,
     progress: &dyn Fn(&str),
 ) -> Result<Verification, MatchError> {
     let v = spec.verify.as_ref().ok_or_else(|| MatchError::Config {
@@ -295,8 +296,8 @@ pub fn verify(
         message: "a verification needs [match.verify]".into(),
     })?;
     let tol = spec.search.tolerance_de00;
-    let subset = &r.candidate.subset;
-    let mut x = r.candidate.x.clone();
+    let subset = &candidate.subset;
+    let mut x = candidate.x.clone();
     let mut steps = Vec::new();
     let mut difference: Option<ModelDifference> = None;
     // A trust region around the best verified recipe, in units of each
@@ -320,11 +321,11 @@ pub fn verify(
             problem,
             &recipe.fractions,
             recipe.thickness_nm,
-            &format!("r{}-step{k}", r.rank),
+            &format!("r{rank}-step{k}"),
         )?;
         progress(&format!(
             "verify recipe {} step {k}: wave ΔE00 {} (fast model's error here {}) in {:.1} s",
-            r.rank,
+            rank,
             geometry_list(problem, &step.de00, &step.de00_se),
             geometry_list(problem, &step.model_error(), &vec![None; step.de00.len()]),
             step.seconds
@@ -393,7 +394,7 @@ pub fn verify(
     };
     let verified = steps.last().is_some_and(|s| s.de00_max() <= tol);
     Ok(Verification {
-        rank: r.rank,
+        rank,
         steps,
         verified,
         outcome,

@@ -723,4 +723,44 @@ fn command_verifies_and_writes_the_steps() {
     }
     let files = std::fs::read_dir(out.join("verify")).unwrap().count();
     assert!(files >= steps.nrows(), "a result file per step");
+    // The page: the target beside the fast recipe and the verified one,
+    // and its spectra figure; drawn by a headless browser where there is
+    // one, the target's patch on the screen.
+    let html = std::fs::read_to_string(out.join("m.html")).unwrap();
+    assert!(html.contains("recipe 1 (fast model)") && html.contains("recipe 1 verified (wave)"));
+    assert!(html.contains("src=\"m-spectra.png\"") && out.join("m-spectra.png").is_file());
+    let Some(browser) = common::browser::chromium() else {
+        eprintln!("SKIPPED the match page in headless Chromium: no chromium on PATH");
+        return;
+    };
+    let shot = dir.path().join("shot.png");
+    let page = out.join("m.html").canonicalize().unwrap();
+    std::process::Command::new(&browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+        ])
+        .arg("--window-size=1200,900")
+        .arg(format!(
+            "--user-data-dir={}",
+            dir.path().join("profile").display()
+        ))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .unwrap();
+    let img = inksim::output::render::Canvas::decode_png(&std::fs::read(&shot).unwrap()).unwrap();
+    let obs = inksim::optics::colour::Observer::standard(
+        inksim::config::Illuminant::D65,
+        inksim::config::StandardObserver::TenDegree,
+    );
+    let want = inksim::optics::colour::gamut::map_lab(&obs, target[0].1).srgb8;
+    let shown = img
+        .px
+        .chunks_exact(3)
+        .filter(|p| (0..3).all(|k| (p[k] as i32 - want[k] as i32).abs() <= 2))
+        .count();
+    assert!(shown > 500, "the target's patch {want:?}: {shown} pixels");
 }

@@ -73,7 +73,7 @@ pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
     let written = write::write_outputs(&spec, &report, &spec.output_dir)?;
     print_report(&spec, &report);
     say(&format!(
-        "{} subset(s) in {:.2} s ({} model evaluations); wrote {} and {}{}",
+        "{} subset(s) in {:.2} s ({} model evaluations); wrote {}, {}{} and the page {}",
         report.subsets,
         report.seconds,
         report.evaluations,
@@ -81,7 +81,8 @@ pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
         written.csv.display(),
         written
             .verify_csv
-            .map_or(String::new(), |p| format!(" and {}", p.display()))
+            .map_or(String::new(), |p| format!(", {}", p.display())),
+        written.page.display()
     ));
     Ok(())
 }

@@ -20,6 +20,8 @@
 //! - [`report`]: the reported recipes (composition, ΔE00 per geometry,
 //!   metamerism indices, uncertainty).
 //! - [`write`]: the HDF5 file and the recipes CSV, written atomically.
+//! - [`page`]: the page of the target and the recipes side by side, and its
+//!   spectra figure.
 //! - [`fit`]: the inverse of a pigment (`inksim fit-material`): its optical
 //!   constants from measured drawdowns, on the same fast model.
 //!
@@ -30,6 +32,7 @@ pub mod config;
 pub mod correct;
 pub mod fit;
 pub mod forward;
+pub mod page;
 pub mod problem;
 pub mod report;
 pub mod search;

@@ -41,6 +41,9 @@ pub struct VerifyStep {
     /// The fast model's CIELAB of the same recipe per geometry: its
     /// difference from `lab` is the fast model's error here.
     pub fast_lab: Vec<[f64; 3]>,
+    /// The wave solution's reflectance factor in the target's first
+    /// geometry: wavelengths (nm) and values.
+    pub spectrum: (Vec<f64>, Vec<f64>),
     /// The wave result file of this step.
     pub result: PathBuf,
     /// Wall time of the wave run, s.
@@ -255,6 +258,7 @@ fn solve(
         de00: Vec::new(),
         de00_se: Vec::new(),
         fast_lab: Vec::new(),
+        spectrum: (Vec::new(), Vec::new()),
         result: report.result_path.clone(),
         seconds,
     };
@@ -272,6 +276,9 @@ fn solve(
                 file: spec.path.clone(),
                 message: format!("the verification's run reported no colour at {}", m.name()),
             })?;
+        if g == 0 {
+            step.spectrum = (c.spectrum_wavelengths_nm.clone(), c.spectrum.clone());
+        }
         step.lab.push(c.lab);
         step.lab_se.push(c.lab_se);
         step.de00.push(colour::delta_e2000(c.lab, *target));

@@ -35,6 +35,8 @@ pub struct Written {
     pub csv: PathBuf,
     /// `<name>-verify.csv`, when recipes were verified.
     pub verify_csv: Option<PathBuf>,
+    /// `<name>.html` and its figure `<name>-spectra.png`.
+    pub page: PathBuf,
 }
 
 /// Write the report of `spec` into `dir`.
@@ -60,11 +62,20 @@ pub fn write_outputs(
         write_atomic(&path, super::write_verify::csv(spec, report).as_bytes())?;
         Some(path)
     };
+    let png_name = format!("{}-spectra.png", spec.name);
+    let figure = super::page::spectra_png(spec, report)
+        .ok()
+        .map(|png| write_atomic(&dir.join(&png_name), &png))
+        .transpose()?;
+    let page = dir.join(format!("{}.html", spec.name));
+    let html = super::page::html(spec, report, figure.map(|_| png_name.as_str()));
+    write_atomic(&page, html.as_bytes())?;
     drop(lock);
     Ok(Written {
         h5,
         csv,
         verify_csv,
+        page,
     })
 }
 

@@ -170,16 +170,7 @@ fn print_verified(spec: &MatchSpec, r: &MatchReport) {
     };
     println!("verified with the wave solver ({fidelity}):");
     for v in &r.verified {
-        // The verified recipe: the last step where it reached the
-        // tolerance, else the closest step.
-        let last = if v.verified { v.last() } else { v.best() };
-        let parts: Vec<String> = spec
-            .palette
-            .iter()
-            .zip(&last.fractions)
-            .filter(|(_, &f)| f > 0.0)
-            .map(|(p, f)| format!("{} {}", p.name, num(*f)))
-            .collect();
+        let last = v.answer();
         let de: Vec<String> = r
             .target_lab
             .iter()
@@ -192,7 +183,7 @@ fn print_verified(spec: &MatchSpec, r: &MatchReport) {
         println!(
             "  {}. {} (thickness {:.0} nm): {}\n     {}",
             v.rank,
-            parts.join(", "),
+            v.composition(spec, &|n, f| format!("{n} {}", num(f))),
             last.thickness_nm,
             de.join(", "),
             v.outcome

@@ -105,18 +105,10 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
         );
     }
     for v in &r.verified {
-        let last = if v.verified { v.last() } else { v.best() };
-        let parts: Vec<String> = spec
-            .palette
-            .iter()
-            .zip(&last.fractions)
-            .filter(|(_, &f)| f > 0.0)
-            .map(|(p, f)| format!("{} {}", esc(&p.name), frac(*f)))
-            .collect();
         s += &format!(
             "<th>recipe {} verified (wave)<br><small>{}</small></th>",
             v.rank,
-            parts.join(", ")
+            v.composition(spec, &|n, f| format!("{} {}", esc(n), frac(f)))
         );
     }
     s += "</tr>\n";
@@ -134,7 +126,7 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
             );
         }
         for v in &r.verified {
-            let last = if v.verified { v.last() } else { v.best() };
+            let last = v.answer();
             s += &patch(&obs, last.lab[g], Some((last.de00[g], last.de00_se[g])));
         }
         s += "</tr>\n";
@@ -194,7 +186,7 @@ pub fn spectra_png(spec: &MatchSpec, r: &MatchReport) -> Result<Vec<u8>, RenderE
         ));
     }
     for (k, v) in r.verified.iter().enumerate() {
-        let last = if v.verified { v.last() } else { v.best() };
+        let last = v.answer();
         series.push(line(
             format!("recipe {} verified (wave)", v.rank),
             k,

@@ -85,6 +85,28 @@ impl Verification {
         self.steps.last().expect("a verification has a step")
     }
 
+    /// The verified recipe: the last step where it reached the tolerance,
+    /// else the closest step.
+    pub fn answer(&self) -> &VerifyStep {
+        if self.verified {
+            self.last()
+        } else {
+            self.best()
+        }
+    }
+
+    /// The answer's pigments in use, with their names from `spec`'s
+    /// palette, each shown by `show`.
+    pub fn composition(&self, spec: &MatchSpec, show: &dyn Fn(&str, f64) -> String) -> String {
+        spec.palette
+            .iter()
+            .zip(&self.answer().fractions)
+            .filter(|(_, &f)| f > 0.0)
+            .map(|(p, &f)| show(&p.name, f))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The step closest to the target (largest ΔE00 over the geometries
     /// least): the recipe to use when none reached the tolerance.
     pub fn best(&self) -> &VerifyStep {

@@ -267,9 +267,10 @@ enum Command {
         /// Result files (.h5), a study's folder (its variants/) or its
         /// summary.h5 (A and B then also chosen by axis values); the first
         /// is A. A scene file (.toml) is recomputed live by its
-        /// radiative-transfer baseline as its controls move; an effect paint
-        /// ([paint] file, or its result file) by its fast model, with its
-        /// whole BRDF and glints. One live input at a time.
+        /// radiative-transfer baseline as its controls move (a stack by the
+        /// adding-doubling of its layers, each layer's controls offered);
+        /// an effect paint ([paint] file, or its result file) by its fast
+        /// model, with its whole BRDF and glints. One live input at a time.
         #[arg(required = true)]
         inputs: Vec<PathBuf>,
         /// Port to listen on (0: any free port).

@@ -401,6 +401,49 @@ fn a_scene_is_recomputed_live_within_200_ms_and_the_page_follows() {
     assert!(p.str("readout").contains("ΔE00"), "{}", p.str("readout"));
 }
 
+/// A stack (configs/overprint.toml: yellow over blue) recomputed live by
+/// its layers' adding–doubling: every change within 200 ms, each layer's
+/// controls offered; as the yellow's area coverage falls the colour turns
+/// from green to the blue under it (b* falls); the page follows.
+#[test]
+fn a_stack_is_recomputed_live_layer_by_layer() {
+    let _only = exclusive();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/overprint.toml");
+    let served = serve(&[&cfg]);
+    let url = &served.1;
+    let queries: Vec<String> = (0..=9)
+        .map(|k| format!("layer1_coverage={}", 1.0 - 0.1 * k as f64))
+        .collect();
+    let keys = [
+        "layer1_pvc0",
+        "layer1_thickness_nm",
+        "layer1_coverage",
+        "layer2_pvc0",
+        "layer2_thickness_nm",
+        "paper_albedo",
+    ];
+    let (worst, results) = live_sweep(url, &keys, &queries);
+    let b_star: Vec<f64> = results
+        .iter()
+        .map(|r| r.arr("colours")[0].arr("lab")[2].as_num())
+        .collect();
+    eprintln!("live stack, 10 changes: slowest {worst:.1} ms (limit 200); b* {b_star:.1?}");
+    assert!(worst < 200.0, "{worst} ms");
+    assert!(b_star.windows(2).all(|w| w[1] < w[0]), "{b_star:?}");
+    assert!(results[0].str("model").contains("stack of 2 layers"));
+    let Some(p) = probe_live(d, url, "live") else {
+        return;
+    };
+    let after = p.get("after");
+    assert_ne!(
+        p.str("colours"),
+        after.str("colours"),
+        "the numbers did not follow"
+    );
+}
+
 /// An effect paint (configs/metallic.toml) recomputed live: every change of
 /// the flakes' spread within 200 ms (server and HTTP together), the
 /// near-specular lightness falling as the spread widens; the page draws the

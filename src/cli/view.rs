@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Result};
 use inksim::view::live::{LiveModel, RadiativeTransfer};
+use inksim::view::live_stack::StackTransfer;
 use inksim::view::paint::LivePaint;
 use inksim::view::{result, server, source};
 use std::net::IpAddr;
@@ -79,6 +80,11 @@ fn live_model(input: &Path, paint_result: bool) -> Result<Box<dyn LiveModel>> {
         let scene = inksim::config::parse_paint(input, &config.text)?;
         Box::new(LivePaint::new(scene)?)
     } else {
-        Box::new(RadiativeTransfer::new(&config.scene()?)?)
+        let scene = config.scene()?;
+        if scene.stack.is_some() {
+            Box::new(StackTransfer::new(&scene)?)
+        } else {
+            Box::new(RadiativeTransfer::new(&scene)?)
+        }
     })
 }

@@ -17,7 +17,7 @@ use super::result::{page_colours, rgb_to_xyz, PageResult};
 use super::table::{display_rgb, PageBrdf};
 use super::ViewError;
 use crate::config::{Baseline, Measurement, Scene};
-use crate::optics::baseline::{self, BaselineInput};
+use crate::optics::baseline::{self, BaselineColour, BaselineInput};
 use crate::optics::colour::Observer;
 use crate::output::h5::{MeasuredRecord, MeasuredSpectrum};
 use crate::pipeline::baseline::baseline_input;
@@ -34,6 +34,48 @@ pub struct Param {
     pub value: f64,
 }
 
+impl Param {
+    /// A pigment's volume fraction, 0–0.55.
+    pub fn volume_fraction(key: String, label: String, value: f64) -> Param {
+        Param::ranged(key, label, "1", (0.0, 0.55, 0.005), value)
+    }
+
+    /// A layer's thickness, 100 nm – 20 µm.
+    pub fn thickness(key: String, label: String, value: f64) -> Param {
+        Param::ranged(key, label, "nm", (100.0, 20000.0, 50.0), value)
+    }
+
+    /// The paper's albedo, 0–1.
+    pub fn paper_albedo(value: f64) -> Param {
+        Param::ranged(
+            "paper_albedo".into(),
+            "paper albedo".into(),
+            "1",
+            (0.0, 1.0, 0.01),
+            value,
+        )
+    }
+
+    /// A control over `(min, max, step)`.
+    pub fn ranged(
+        key: String,
+        label: String,
+        unit: &str,
+        (min, max, step): (f64, f64, f64),
+        value: f64,
+    ) -> Param {
+        Param {
+            key,
+            label,
+            unit: unit.into(),
+            min,
+            max,
+            step,
+            value,
+        }
+    }
+}
+
 /// A model the server recomputes when a control moves.
 pub trait LiveModel: Send {
     /// What it is, in words, for the page.
@@ -46,7 +88,7 @@ pub trait LiveModel: Send {
 }
 
 /// Why a scene cannot be recomputed live.
-fn not_live(scene: &Scene, why: &str) -> ViewError {
+pub(super) fn not_live(scene: &Scene, why: &str) -> ViewError {
     ViewError::NotLive {
         path: scene.path().to_path_buf(),
         why: why.to_string(),
@@ -65,7 +107,10 @@ pub struct RadiativeTransfer {
 impl RadiativeTransfer {
     pub fn new(scene: &Scene) -> Result<RadiativeTransfer, ViewError> {
         if scene.stack.is_some() {
-            return Err(not_live(scene, "a stack (one layer only, for now)"));
+            return Err(not_live(
+                scene,
+                "a stack: its live model is the stack's (view::live_stack)",
+            ));
         }
         let input = baseline_input(scene)
             .map_err(|e| not_live(scene, &e.to_string()))?
@@ -101,34 +146,20 @@ impl LiveModel for RadiativeTransfer {
             .iter()
             .zip(&self.names)
             .enumerate()
-            .map(|(k, (s, name))| Param {
-                key: format!("pvc{k}"),
-                label: format!("volume fraction of {name}"),
-                unit: "1".into(),
-                min: 0.0,
-                max: 0.55,
-                step: 0.005,
-                value: s.volume_fraction,
+            .map(|(k, (s, name))| {
+                Param::volume_fraction(
+                    format!("pvc{k}"),
+                    format!("volume fraction of {name}"),
+                    s.volume_fraction,
+                )
             })
             .collect();
-        p.push(Param {
-            key: "thickness_nm".into(),
-            label: "layer thickness".into(),
-            unit: "nm".into(),
-            min: 100.0,
-            max: 20000.0,
-            step: 50.0,
-            value: self.input.thickness_nm,
-        });
-        p.push(Param {
-            key: "paper_albedo".into(),
-            label: "paper albedo".into(),
-            unit: "1".into(),
-            min: 0.0,
-            max: 1.0,
-            step: 0.01,
-            value: self.input.paper_albedo,
-        });
+        p.push(Param::thickness(
+            "thickness_nm".into(),
+            "layer thickness".into(),
+            self.input.thickness_nm,
+        ));
+        p.push(Param::paper_albedo(self.input.paper_albedo));
         p
     }
 
@@ -146,55 +177,77 @@ impl LiveModel for RadiativeTransfer {
         let colours =
             baseline::baseline_colours(self.model, &input, &geometries, &|_| None, &self.observer)
                 .map_err(|e| ViewError::Live(e.to_string()))?;
-        let records: Vec<MeasuredRecord> = colours
-            .iter()
-            .map(|c| MeasuredRecord {
-                geometry: c.geometry.name().to_string(),
-                lab: c.lab,
-                xyz: [f64::NAN; 3],
-                lab_se: None,
-                de00_se: None,
-            })
-            .collect();
-        let spectra: Vec<MeasuredSpectrum> = colours
-            .iter()
-            .map(|c| MeasuredSpectrum {
-                geometry: c.geometry.name().to_string(),
-                wavelengths_nm: c.spectrum_wavelengths_nm.clone(),
-                spectrum: c.reflectance_factor.clone(),
-                solved_nm: vec![],
-                solved: vec![],
-            })
-            .collect();
-        let obs = &self.observer;
-        let colours = page_colours(&records, &spectra, obs);
-        let lab = colours
-            .iter()
-            .find(|c| c.geometry == Measurement::FortyFiveZero.name())
-            .map(|c| c.lab)
-            .ok_or_else(|| ViewError::Live("no 45°/0° colour".into()))?;
-        let fresnel = baseline::surfaces(self.model, input.equation);
-        let n = input.binder_index;
-        let brdf = PageBrdf::lambertian(
-            display_rgb(obs, lab),
-            &|t| fresnel.external(n, t.min(89.9)),
-            "Lambertian body of the model's 45°/0° colour (gamut mapped) under the binder's \
-             Fresnel surface"
-                .into(),
-        );
-        Ok(PageResult {
-            name: format!("{} (live)", self.name),
-            model: self.describe(),
-            conditions: match obs.conditions() {
-                Some((ill, o)) => format!("{ill}, {}°", o.degrees()),
-                None => "custom observer".into(),
-            },
-            colours,
-            brdf,
-            labels: vec![],
-            rgb_to_xyz: rgb_to_xyz(obs),
-            white_xyz: obs.white_xyz(),
-            sparkle: None,
-        })
+        baseline_page(
+            &self.name,
+            self.describe(),
+            self.model,
+            &input,
+            &colours,
+            &self.observer,
+        )
     }
+}
+
+/// The page's data of a baseline's colours: the colours and spectra in
+/// every geometry, and the object drawn as a Lambertian body of the 45°/0°
+/// colour (gamut mapped) under the binder's Fresnel surface (of `top`, the
+/// layer the light meets first).
+pub(super) fn baseline_page(
+    name: &str,
+    description: String,
+    model: Baseline,
+    top: &BaselineInput,
+    colours: &[BaselineColour],
+    observer: &Observer,
+) -> Result<PageResult, ViewError> {
+    let records: Vec<MeasuredRecord> = colours
+        .iter()
+        .map(|c| MeasuredRecord {
+            geometry: c.geometry.name().to_string(),
+            lab: c.lab,
+            xyz: [f64::NAN; 3],
+            lab_se: None,
+            de00_se: None,
+        })
+        .collect();
+    let spectra: Vec<MeasuredSpectrum> = colours
+        .iter()
+        .map(|c| MeasuredSpectrum {
+            geometry: c.geometry.name().to_string(),
+            wavelengths_nm: c.spectrum_wavelengths_nm.clone(),
+            spectrum: c.reflectance_factor.clone(),
+            solved_nm: vec![],
+            solved: vec![],
+        })
+        .collect();
+    let obs = observer;
+    let colours = page_colours(&records, &spectra, obs);
+    let lab = colours
+        .iter()
+        .find(|c| c.geometry == Measurement::FortyFiveZero.name())
+        .map(|c| c.lab)
+        .ok_or_else(|| ViewError::Live("no 45°/0° colour".into()))?;
+    let fresnel = baseline::surfaces(model, top.equation);
+    let n = top.binder_index;
+    let brdf = PageBrdf::lambertian(
+        display_rgb(obs, lab),
+        &|t| fresnel.external(n, t.min(89.9)),
+        "Lambertian body of the model's 45°/0° colour (gamut mapped) under the binder's \
+         Fresnel surface"
+            .into(),
+    );
+    Ok(PageResult {
+        name: format!("{name} (live)"),
+        model: description,
+        conditions: match obs.conditions() {
+            Some((ill, o)) => format!("{ill}, {}°", o.degrees()),
+            None => "custom observer".into(),
+        },
+        colours,
+        brdf,
+        labels: vec![],
+        rgb_to_xyz: rgb_to_xyz(obs),
+        white_xyz: obs.white_xyz(),
+        sparkle: None,
+    })
 }

@@ -15,6 +15,7 @@
 //! - [`source`]: which results a command line names (files, a study's folder);
 //! - [`live`]: the recompute hook ([`live::LiveModel`]) and the scenes' radiative-transfer
 //!   baselines recomputed as a control moves;
+//! - [`live_stack`]: a stack's adding–doubling baseline recomputed live;
 //! - [`paint`]: an effect paint's fast model recomputed live, its whole BRDF
 //!   on the page's grid;
 //! - [`server`]: the HTTP server and its routes; [`page`]: the embedded page.
@@ -22,6 +23,7 @@
 //! Imports from every earlier stage; nothing imports from it.
 
 pub mod live;
+pub mod live_stack;
 pub mod page;
 pub mod paint;
 pub mod result;

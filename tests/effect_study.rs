@@ -281,3 +281,63 @@ labels = ["gold", "red", "blue", "green"]
     assert!((50.0..110.0).contains(&hue[0]), "gold {hue:?}");
     assert!((200.0..300.0).contains(&hue[2]), "blue {hue:?}");
 }
+
+/// `inksim slurm` of an effect study: the sbatch script of a job array
+/// with its limits from the effect plan, whose task k runs the variants
+/// of index k (mod N) and only those.
+#[test]
+fn an_effect_study_fans_out_as_a_slurm_job_array() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = format!(
+        "[study]\nname = \"eff\"\noutput_dir = \"runs\"\n{}\n[[axis]]\nname = \"spread\"\n\
+         key = \"paint.layer.1.flakes.orientation_sd_deg\"\nvalues = [6.0, 12.0, 18.0]\n",
+        base("wavelengths_nm = [450.0, 550.0, 650.0]")
+    );
+    std::fs::write(d.join("sweep.toml"), &text).unwrap();
+    let exe = env!("CARGO_BIN_EXE_inksim");
+    let out = std::process::Command::new(exe)
+        .current_dir(d)
+        .args(["slurm", "sweep.toml", "--shards", "2", "--cpus", "1"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("3 variants in 2 array tasks"), "{stdout}");
+    let script = std::fs::read_to_string(d.join("runs/eff.sbatch")).unwrap();
+    assert!(script.contains("#SBATCH --array=0-1\n"), "{script}");
+    assert!(
+        script.contains("run '") && script.contains("sweep.toml' --jobs 1"),
+        "{script}"
+    );
+    // What task 1 of 2 runs: the second variant only.
+    let run = std::process::Command::new(exe)
+        .current_dir(d)
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .args(["run", "sweep.toml"])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let s = Study::parse(&d.join("sweep.toml"), &text).unwrap();
+    let mut exp = s.expand_paint(None).unwrap();
+    exp.study_dir = d.join(&exp.study_dir);
+    for v in &mut exp.variants {
+        v.scene.output.dir = d.join(&v.scene.output.dir);
+    }
+    let done: Vec<usize> = exp
+        .variants
+        .iter()
+        .filter(|v| inksim::study::run::state(v) == State::Done)
+        .map(|v| v.index)
+        .collect();
+    assert_eq!(done, vec![1], "task 1 of 2 runs index 1 only");
+}

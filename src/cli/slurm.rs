@@ -18,26 +18,48 @@ pub fn slurm(
 ) -> Result<()> {
     let study = config.study(None)?;
     anyhow::ensure!(cpus >= 1, "--cpus must be at least 1");
-    let exp = study.expand(profile)?;
-    let n = exp.variants.len();
+    let here = super::threads(None);
+    // Per variant: estimated seconds on this machine and peak bytes; the
+    // profile and the study's folder. An effect study's variants are timed
+    // by its own plan (the fast model at each middle wavelength).
+    let (est, profile, study_dir): (Vec<(f64, f64)>, Option<String>, PathBuf) = if study.is_paint()
+    {
+        let exp = study.expand_paint(profile)?;
+        let est = exp
+            .variants
+            .iter()
+            .map(|v| {
+                inksim::study::effect::plan::estimate(v, here)
+                    .map(|e| (e.seconds, e.bytes))
+                    .map_err(|e| anyhow::anyhow!("variant {}: {e}", v.name))
+            })
+            .collect::<Result<_>>()?;
+        (est, exp.profile, exp.study_dir)
+    } else {
+        let exp = study.expand(profile)?;
+        let est = super::plan::estimates(&exp)
+            .iter()
+            .map(|e| (e.seconds, e.bytes))
+            .collect();
+        (est, exp.profile, exp.study_dir)
+    };
+    let n = est.len();
     let shards = shards.unwrap_or(n.min(64));
     anyhow::ensure!(shards >= 1, "--shards must be at least 1");
-    let est = super::plan::estimates(&exp);
     // Longest shard, at the calibrated speed scaled to the task's CPUs.
-    let here = super::threads(None) as f64;
     let longest = (0..shards)
         .map(|k| {
             est.iter()
                 .enumerate()
                 .filter(|(i, _)| i % shards == k)
-                .map(|(_, e)| e.seconds)
+                .map(|(_, e)| e.0)
                 .sum::<f64>()
         })
         .fold(0.0, f64::max)
-        * here
+        * here as f64
         / cpus as f64;
     let time_min = ((3.0 * longest / 60.0).ceil() as u64 + 10).max(15);
-    let peak = est.iter().map(|e| e.bytes).fold(0.0, f64::max);
+    let peak = est.iter().map(|e| e.1).fold(0.0, f64::max);
     let mem_mb = ((1.5 * peak / 1e6).ceil() as u64).max(256);
     let cwd = std::env::current_dir().context("current directory")?;
     let abs = |p: &Path| {
@@ -47,7 +69,7 @@ pub fn slurm(
             cwd.join(p)
         }
     };
-    let log_dir = abs(&exp.study_dir.join("slurm"));
+    let log_dir = abs(&study_dir.join("slurm"));
     std::fs::create_dir_all(&log_dir).with_context(|| format!("creating {}", log_dir.display()))?;
     let exe = std::env::current_exe().context("locating the inksim executable")?;
     let o = slurm::SlurmOptions {
@@ -57,7 +79,7 @@ pub fn slurm(
         mem_mb,
         time_min,
         partition,
-        profile: exp.profile.clone(),
+        profile: profile.clone(),
         exe,
         workdir: cwd.clone(),
         sweep: abs(&study.path),
@@ -65,10 +87,10 @@ pub fn slurm(
         variants: n,
     };
     let path = script.unwrap_or_else(|| {
-        exp.study_dir.join(format!(
+        study_dir.join(format!(
             "{}{}.sbatch",
             study.name,
-            exp.profile
+            profile
                 .as_deref()
                 .map(|p| format!("-{p}"))
                 .unwrap_or_default()
@@ -84,7 +106,7 @@ pub fn slurm(
     println!(
         "then, when all tasks are done: inksim merge {}{}",
         study.path.display(),
-        exp.profile
+        profile
             .as_deref()
             .map(|p| format!(" --profile {p}"))
             .unwrap_or_default()

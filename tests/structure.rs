@@ -13,6 +13,18 @@ use std::path::Path;
 
 mod common;
 use common::airy::tmm;
+
+/// Held by the tests here that write an HDF5 file and open it again, and
+/// by the one that starts `inksim` processes: a child started while a file
+/// is open for writing (between HDF5's create and our close-on-exec) would
+/// inherit its lock and make the reopen fail.
+static FILES_AND_CHILDREN: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn files_and_children() -> std::sync::MutexGuard<'static, ()> {
+    FILES_AND_CHILDREN
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
 use common::scene::{PigmentToml, PrimitiveToml, SceneToml};
 
 fn material() -> Material {
@@ -148,6 +160,7 @@ fn buried_slab_matches_the_transfer_matrix() {
 
 #[test]
 fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
+    let _serial = files_and_children();
     let dir = tempfile::tempdir().unwrap();
     let text = bodies_scene(
         dir.path(),
@@ -234,6 +247,7 @@ fn hdf5_grid_gives_the_answer_of_the_primitives_it_holds() {
 
 #[test]
 fn check_reads_a_structure_file_as_a_run_would() {
+    let _serial = files_and_children();
     let dir = tempfile::tempdir().unwrap();
     let text = slab_scene(dir.path(), 10.0)
         .structure_file("eps.h5")
@@ -329,6 +343,7 @@ fn check_reads_a_structure_file_as_a_run_would() {
 
 #[test]
 fn structure_input_errors_name_the_key() {
+    let _serial = files_and_children();
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("s.toml");
     let base = slab_scene(dir.path(), 10.0);

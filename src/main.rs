@@ -210,7 +210,14 @@ enum Command {
     /// composition with standard errors from the target's measurement noise
     /// (and the ingredients it cannot tell apart), ΔE00 per geometry, and
     /// for a spectrum target the metamerism index under CIE A, FL11 and
-    /// LED-B3; for an unreachable target the closest reachable colour.
+    /// LED-B3; for an unreachable target the closest reachable colour; and
+    /// a page of the target beside the recipes, <name>.html.
+    ///
+    /// With [match.verify] the best recipes are solved by the wave pipeline
+    /// at the base scene's fidelity (held to --max-memory) and corrected by
+    /// the fast–exact difference until the wave colour is within the
+    /// tolerance, or it says why not (<name>-verify.csv, /verify, each
+    /// step's result file under <output_dir>/verify/).
     Match {
         /// Match file (TOML with [match], [target], base and [[palette]]),
         /// e.g. configs/match-red-tint.toml.
@@ -395,7 +402,7 @@ fn real_main() -> Result<ExitCode> {
             allow_remote,
         } => cli::view::view(&inputs, host, port, allow_remote)?,
         Command::Match { config, output_dir } => {
-            cli::r#match::run(&cli::ConfigFile::read(&config)?, output_dir)?
+            cli::r#match::run(&cli::ConfigFile::read(&config)?, output_dir, memory)?
         }
         Command::FitMaterial { config, output_dir } => {
             cli::fit_material::run(&cli::ConfigFile::read(&config)?, output_dir)?
@@ -405,7 +412,7 @@ fn real_main() -> Result<ExitCode> {
             if config.is_fit() {
                 cli::fit_material::check(&config)?;
             } else if config.is_match() {
-                cli::r#match::check(&config)?;
+                cli::r#match::check(&config, memory)?;
             } else if config.is_study() {
                 cli::study::check(&config, memory)?;
             } else {

@@ -764,3 +764,40 @@ fn command_verifies_and_writes_the_steps() {
         .count();
     assert!(shown > 500, "the target's patch {want:?}: {shown} pixels");
 }
+
+/// A verification whose wave runs would not fit `--max-memory` is refused
+/// by `check` and by `match` before anything runs: one line naming the
+/// grid and the limit, nothing written.
+#[test]
+fn a_verification_beyond_the_memory_limit_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/match-red-tint.toml"),
+    )
+    .unwrap()
+    .replace("runs/match-red-tint", "out");
+    std::fs::write(
+        dir.path().join("m.toml"),
+        format!("{good}\n[match.verify]\nmax_steps = 1\n"),
+    )
+    .unwrap();
+    for cmd in ["check", "match"] {
+        let (ok, _, stderr) = inksim_in(dir.path(), &[cmd, "m.toml", "--max-memory", "1M"]);
+        assert!(!ok, "{cmd}");
+        let lines: Vec<&str> = stderr
+            .lines()
+            .filter(|l| !l.contains("[inksim] match:"))
+            .collect();
+        assert_eq!(lines.len(), 1, "{cmd}: {stderr}");
+        assert!(
+            lines[0].contains("exceeds 1 MB (--max-memory)")
+                && lines[0].contains("grid 40 × 40 × "),
+            "{cmd}: {}",
+            lines[0]
+        );
+        assert!(
+            !dir.path().join("out").exists(),
+            "{cmd}: nothing is written"
+        );
+    }
+}

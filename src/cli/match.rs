@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use inksim::output::progress::utc_stamp;
+use inksim::pipeline::memory::MemoryLimit;
 use inksim::r#match::{report, write, MatchReport, MatchSpec};
 use std::path::PathBuf;
 use std::time::SystemTime;
@@ -21,9 +22,10 @@ fn spec(config: &ConfigFile) -> Result<MatchSpec> {
 
 /// `inksim check` of a match file: the file, its base scene and palette,
 /// and the fast model built, without searching.
-pub fn check(config: &ConfigFile) -> Result<()> {
+pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
     let spec = spec(config)?;
     let problem = report::problem(&spec)?;
+    report::check_verification(&spec, memory)?;
     println!(
         "{}: match file OK: target in {} ({}, {}), {} palette pigment(s), up to {} colourant(s), \
          {} start(s) per subset, objective {}, tolerance {} ΔE00; fast model {} on {} \
@@ -59,7 +61,11 @@ pub fn check(config: &ConfigFile) -> Result<()> {
 }
 
 /// `inksim match FILE`.
-pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
+pub fn run(
+    config: &ConfigFile,
+    output_dir: Option<PathBuf>,
+    memory: Option<MemoryLimit>,
+) -> Result<()> {
     let mut spec = spec(config)?;
     if let Some(d) = output_dir {
         spec.output_dir = d;
@@ -69,7 +75,7 @@ pub fn run(config: &ConfigFile, output_dir: Option<PathBuf>) -> Result<()> {
         config.display(),
         spec.palette.len()
     ));
-    let report = inksim::r#match::run(&spec, &say)?;
+    let report = inksim::r#match::report::run_with(&spec, memory, &say)?;
     let written = write::write_outputs(&spec, &report, &spec.output_dir)?;
     print_report(&spec, &report);
     say(&format!(

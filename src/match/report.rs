@@ -16,6 +16,7 @@ use crate::optics::colour::{special_metamerism_index, Metamerism, TestSource};
 pub const TEST_SOURCES: [TestSource; 3] = TestSource::ALL;
 use crate::pipeline::baseline::baseline_input;
 use crate::pipeline::fine_grid;
+use crate::pipeline::memory::MemoryLimit;
 
 use super::config::MatchSpec;
 use super::forward::{FastModel, Recipe};
@@ -105,26 +106,50 @@ pub fn problem(spec: &MatchSpec) -> Result<Problem, MatchError> {
             ),
         });
     }
-    if spec.verify.is_some() {
-        // Everything a verification run will read is checked now: its
-        // scene, made for a recipe of every palette pigment.
-        let every: Vec<f64> = spec
-            .palette
-            .iter()
-            .map(|p| 0.5 * (p.pvc_range[0] + p.pvc_range[1]))
-            .collect();
-        let total: f64 = every.iter().sum();
-        let scale = (spec.search.max_total_pvc / total).min(1.0);
-        let fractions: Vec<f64> = every.iter().map(|f| f * scale).collect();
-        verify::scene(spec, &fractions, spec.scene.layer.thickness_nm, "check")?;
-    }
     Problem::new(spec, FastModel::new(spec.model, &input)?)
 }
 
-/// Match the target of `spec`; `progress` hears what is done.
+/// The verification's scene (`[match.verify]`; nothing without it) checked
+/// before anything runs: made for a recipe of every palette pigment at the
+/// thickest allowed layer, checked by the scene checker and its memory
+/// estimate against `memory`.
+pub fn check_verification(spec: &MatchSpec, memory: Option<MemoryLimit>) -> Result<(), MatchError> {
+    if spec.verify.is_none() {
+        return Ok(());
+    }
+    let every: Vec<f64> = spec
+        .palette
+        .iter()
+        .map(|p| 0.5 * (p.pvc_range[0] + p.pvc_range[1]))
+        .collect();
+    let total: f64 = every.iter().sum();
+    let scale = (spec.search.max_total_pvc / total).min(1.0);
+    let fractions: Vec<f64> = every.iter().map(|f| f * scale).collect();
+    let thickness = spec
+        .search
+        .thickness_range_nm
+        .map_or(spec.scene.layer.thickness_nm, |[_, hi]| hi);
+    let scene = verify::scene(spec, &fractions, thickness, "check")?;
+    crate::pipeline::memory::fits(&scene, memory)?;
+    Ok(())
+}
+
+/// Match the target of `spec`; `progress` hears what is done. A
+/// verification's wave runs are held to the machine's available memory.
 pub fn run(spec: &MatchSpec, progress: &dyn Fn(&str)) -> Result<MatchReport, MatchError> {
+    run_with(spec, MemoryLimit::resolve(None), progress)
+}
+
+/// [`run`] with the verification's wave runs held to `memory` (each stops
+/// before allocating when its estimate exceeds it).
+pub fn run_with(
+    spec: &MatchSpec,
+    memory: Option<MemoryLimit>,
+    progress: &dyn Fn(&str),
+) -> Result<MatchReport, MatchError> {
     let start = Instant::now();
     let problem = problem(spec)?;
+    check_verification(spec, memory)?;
     progress(&format!(
         "fast model {} on {} wavelengths, {} palette pigment(s), objective {}",
         spec.model.name(),
@@ -155,8 +180,8 @@ pub fn run(spec: &MatchSpec, progress: &dyn Fn(&str)) -> Result<MatchReport, Mat
             verified.push(verify::verify(
                 spec,
                 &problem,
-                r.rank,
-                &r.candidate,
+                (r.rank, &r.candidate),
+                memory,
                 progress,
             )?);
         }

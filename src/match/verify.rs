@@ -259,13 +259,13 @@ pub fn scene(
 fn solve(
     spec: &MatchSpec,
     problem: &Problem,
-    fractions: &[f64],
-    thickness_nm: f64,
+    (fractions, thickness_nm): (&[f64], f64),
     label: &str,
+    memory: Option<MemoryLimit>,
 ) -> Result<VerifyStep, MatchError> {
     let scene = scene(spec, fractions, thickness_nm, label)?;
     let start = Instant::now();
-    let report = pipeline::run_with(&scene, true, MemoryLimit::resolve(None))?;
+    let report = pipeline::run_with(&scene, true, memory)?;
     let seconds = start.elapsed().as_secs_f64();
     let measured = report
         .appearance
@@ -312,12 +312,13 @@ fn solve(
 }
 
 /// Verify the recipe of rank `rank`, `candidate`, with the wave solver and
-/// correct it (module docs); `progress` hears each step.
+/// correct it (module docs), each wave run held to `memory`; `progress`
+/// hears each step.
 pub fn verify(
     spec: &MatchSpec,
     problem: &Problem,
-    rank: usize,
-    candidate: &Candidate,
+    (rank, candidate): (usize, &Candidate),
+    memory: Option<MemoryLimit>,
     progress: &dyn Fn(&str),
 ) -> Result<Verification, MatchError> {
     let v = spec.verify.as_ref().ok_or_else(|| MatchError::Config {
@@ -348,9 +349,9 @@ pub fn verify(
         let step = solve(
             spec,
             problem,
-            &recipe.fractions,
-            recipe.thickness_nm,
+            (&recipe.fractions, recipe.thickness_nm),
             &format!("r{rank}-step{k}"),
+            memory,
         )?;
         progress(&format!(
             "verify recipe {} step {k}: wave ΔE00 {} (fast model's error here {}) in {:.1} s",

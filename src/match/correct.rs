@@ -8,8 +8,8 @@
 //! long as the model's *change* of colour is right. The same step corrects
 //! a fast recipe by a slower, exact model's colour.
 
-use super::problem::Problem;
-use super::solve::{jacobian, normal_matrix};
+use super::problem::{rms, Problem};
+use super::solve::{fit_and_polish, jacobian, normal_matrix};
 
 /// The corrected unknowns of `subset` after one step from `x`, given the
 /// CIELAB measured in each target geometry (stacked, 3 per geometry).
@@ -23,8 +23,8 @@ pub fn correction_step(
     problem.with_bounds(subset, |bounds| {
         let lab = |y: &[f64]| problem.lab_stack(&problem.recipe(subset, y));
         let j = jacobian(&lab, x, bounds);
-        let target: Vec<f64> = problem.target_lab.iter().flat_map(|(_, l)| *l).collect();
-        let d: Vec<f64> = target
+        let d: Vec<f64> = problem
+            .target_stack()
             .iter()
             .zip(measured_lab)
             .map(|(t, m)| t - m)
@@ -65,35 +65,20 @@ pub struct ModelDifference {
 }
 
 impl ModelDifference {
-    /// The difference at the first verified recipe `x`, whose exact colour
-    /// is `measured_lab` at `score` (its largest ΔE00 to the target).
-    pub fn new(
-        problem: &Problem,
-        subset: &[usize],
-        x: &[f64],
-        measured_lab: &[f64],
-        score: f64,
-    ) -> Self {
-        let e = difference(problem, subset, x, measured_lab);
+    /// The difference `e` (exact minus fast CIELAB, stacked) at the first
+    /// verified recipe `x`, whose `score` is its largest ΔE00 to the target.
+    pub fn new(x: &[f64], e: Vec<f64>, score: f64) -> Self {
         ModelDifference {
+            slope: vec![vec![0.0; x.len()]; e.len()],
             last: (x.to_vec(), e.clone()),
             anchor: (x.to_vec(), e),
             anchor_score: score,
-            slope: vec![vec![0.0; x.len()]; measured_lab.len()],
         }
     }
 
-    /// Learn from the next verified recipe `y`, its exact colour and its
+    /// Learn from the next verified recipe `y`, its difference `e` and its
     /// score.
-    pub fn update(
-        &mut self,
-        problem: &Problem,
-        subset: &[usize],
-        y: &[f64],
-        measured_lab: &[f64],
-        score: f64,
-    ) {
-        let e = difference(problem, subset, y, measured_lab);
+    pub fn update(&mut self, y: &[f64], e: Vec<f64>, score: f64) {
         let (x, e0) = &self.last;
         let dx: Vec<f64> = y.iter().zip(x).map(|(a, b)| a - b).collect();
         let norm: f64 = dx.iter().map(|d| d * d).sum();
@@ -118,6 +103,11 @@ impl ModelDifference {
         &self.anchor.0
     }
 
+    /// The anchor's score: the least largest ΔE00 verified so far.
+    pub fn best_score(&self) -> f64 {
+        self.anchor_score
+    }
+
     /// The modelled difference at `y`.
     pub fn at(&self, y: &[f64]) -> Vec<f64> {
         let (a, e) = &self.anchor;
@@ -132,12 +122,6 @@ impl ModelDifference {
             })
             .collect()
     }
-}
-
-/// `measured − fast(x)`, stacked.
-fn difference(problem: &Problem, subset: &[usize], x: &[f64], measured_lab: &[f64]) -> Vec<f64> {
-    let fast = problem.lab_stack(&problem.recipe(subset, x));
-    measured_lab.iter().zip(&fast).map(|(m, f)| m - f).collect()
 }
 
 /// The recipe of `subset` that the fast model plus the modelled fast–exact
@@ -155,7 +139,7 @@ pub fn offset_correction(
     d: &ModelDifference,
 ) -> Option<Vec<f64>> {
     problem.with_bounds(subset, |bounds| {
-        let target: Vec<f64> = problem.target_lab.iter().flat_map(|(_, l)| *l).collect();
+        let target = problem.target_stack();
         let shifted = |y: &[f64]| -> Vec<f64> {
             let lab = problem.lab_stack(&problem.recipe(subset, y));
             lab.iter().zip(d.at(y)).map(|(l, o)| l + o).collect()
@@ -163,26 +147,8 @@ pub fn offset_correction(
         let residuals = |y: &[f64]| -> Vec<f64> {
             shifted(y).iter().zip(&target).map(|(a, t)| a - t).collect()
         };
-        let de00 = |y: &[f64]| -> f64 {
-            let lab = shifted(y);
-            let sum: f64 = lab
-                .chunks(3)
-                .zip(target.chunks(3))
-                .map(|(a, t)| {
-                    crate::optics::colour::delta_e2000([a[0], a[1], a[2]], [t[0], t[1], t[2]])
-                        .powi(2)
-                })
-                .sum();
-            (sum / problem.target_lab.len().max(1) as f64).sqrt()
-        };
-        let m = super::solve::levenberg_marquardt(&residuals, d.x(), bounds, 200, 1e-14);
-        let mut y = m.x;
-        if de00(&y) > 1e-3 {
-            let p = super::solve::nelder_mead(&de00, &y, bounds, 400, 1e-9);
-            if p.cost < de00(&y) {
-                y = p.x;
-            }
-        }
+        let de00 = |y: &[f64]| rms(&problem.de00_each(&shifted(y)));
+        let (y, _) = fit_and_polish(&residuals, Some(&de00), d.x(), bounds);
         y.iter().all(|v| v.is_finite()).then_some(y)
     })
 }

@@ -23,10 +23,15 @@ pub struct Fit {
     pub spectral_rms: Option<f64>,
 }
 
+/// Root-mean-square of per-geometry ΔE00 values.
+pub fn rms(de00: &[f64]) -> f64 {
+    (de00.iter().map(|d| d * d).sum::<f64>() / de00.len().max(1) as f64).sqrt()
+}
+
 impl Fit {
     /// Root-mean-square of the geometries' ΔE00.
     pub fn de00_rms(&self) -> f64 {
-        (self.de00.iter().map(|d| d * d).sum::<f64>() / self.de00.len().max(1) as f64).sqrt()
+        rms(&self.de00)
     }
 
     /// The largest ΔE00 over the geometries.
@@ -167,6 +172,20 @@ impl Problem {
             .collect()
     }
 
+    /// The target's CIELAB, stacked as [`Problem::lab_stack`] stacks a
+    /// recipe's.
+    pub fn target_stack(&self) -> Vec<f64> {
+        self.target_lab.iter().flat_map(|(_, l)| *l).collect()
+    }
+
+    /// CIEDE2000 to the target per geometry of a stacked CIELAB `lab`.
+    pub fn de00_each(&self, lab: &[f64]) -> Vec<f64> {
+        lab.chunks(3)
+            .zip(&self.target_lab)
+            .map(|(l, (_, t))| colour::delta_e2000([l[0], l[1], l[2]], *t))
+            .collect()
+    }
+
     /// The residuals the search minimises the squares of: CIELAB
     /// differences per geometry (`de00`, polished on ΔE00 itself), or the
     /// reflectance-factor differences on the grid over `√N` (`spectral-rms`).
@@ -179,21 +198,19 @@ impl Problem {
             }
             _ => {
                 let lab = self.lab_stack(recipe);
-                let target = self.target_lab.iter().flat_map(|(_, l)| *l);
-                lab.iter().zip(target).map(|(a, b)| a - b).collect()
+                lab.iter()
+                    .zip(self.target_stack())
+                    .map(|(a, b)| a - b)
+                    .collect()
             }
         }
     }
 
     /// How the recipe's colour stands against the target.
     pub fn fit(&self, recipe: &Recipe) -> Fit {
-        let lab = self.lab_stack(recipe);
-        let lab: Vec<[f64; 3]> = lab.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let de00 = lab
-            .iter()
-            .zip(&self.target_lab)
-            .map(|(l, (_, t))| colour::delta_e2000(*l, *t))
-            .collect();
+        let stack = self.lab_stack(recipe);
+        let de00 = self.de00_each(&stack);
+        let lab: Vec<[f64; 3]> = stack.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
         let spectral_rms = self.target_factor.as_ref().map(|t| {
             let f = self.model.factor(recipe, self.target_lab[0].0);
             (f.iter().zip(t).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / t.len() as f64).sqrt()

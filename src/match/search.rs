@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::config::Objective;
 use super::problem::{Fit, Problem};
-use super::solve::{levenberg_marquardt, nelder_mead};
+use super::solve::fit_and_polish;
 
 /// The best recipe found for one subset of the palette.
 #[derive(Debug, Clone)]
@@ -105,22 +105,11 @@ pub fn fit_subset(problem: &Problem, subset: &[usize], starts: usize) -> Candida
         let mut best: Option<Candidate> = None;
         let mut evaluations = 0;
         for s in 0..starts {
-            let m = levenberg_marquardt(
-                &residuals,
-                &start(s, bounds.lo, bounds.hi),
-                bounds,
-                200,
-                1e-14,
-            );
-            evaluations += m.evaluations;
-            let mut x = m.x;
-            if problem.objective == Objective::De00 && de00(&x) > 1e-3 {
-                let p = nelder_mead(&de00, &x, bounds, 400, 1e-9);
-                evaluations += p.evaluations;
-                if p.cost < de00(&x) {
-                    x = p.x;
-                }
-            }
+            let polish =
+                (problem.objective == Objective::De00).then_some(&de00 as super::solve::ScalarFn);
+            let (x, spent) =
+                fit_and_polish(&residuals, polish, &start(s, bounds.lo, bounds.hi), bounds);
+            evaluations += spent;
             let fit = problem.fit(&problem.recipe(subset, &x));
             let objective = match problem.objective {
                 Objective::SpectralRms => fit.spectral_rms.unwrap_or_else(|| fit.de00_rms()),

@@ -101,6 +101,32 @@ pub struct Minimum {
     pub evaluations: usize,
 }
 
+/// A scalar objective of the unknowns.
+pub type ScalarFn<'a> = &'a dyn Fn(&[f64]) -> f64;
+
+/// One start of a fit: Levenberg–Marquardt on `residuals` from `x0`,
+/// then, where `polish` is given and exceeds 1e-3 there, Nelder–Mead on
+/// it, kept where it does better. The point and the evaluations spent.
+pub fn fit_and_polish(
+    residuals: &dyn Fn(&[f64]) -> Vec<f64>,
+    polish: Option<ScalarFn>,
+    x0: &[f64],
+    bounds: &Bounds,
+) -> (Vec<f64>, usize) {
+    let m = levenberg_marquardt(residuals, x0, bounds, 200, 1e-14);
+    let (mut x, mut evaluations) = (m.x, m.evaluations);
+    if let Some(f) = polish {
+        if f(&x) > 1e-3 {
+            let p = nelder_mead(f, &x, bounds, 400, 1e-9);
+            evaluations += p.evaluations;
+            if p.cost < f(&x) {
+                x = p.x;
+            }
+        }
+    }
+    (x, evaluations)
+}
+
 /// Minimise `Σ r(x)²` from `x0` inside `bounds` by projected
 /// Levenberg–Marquardt (Marquardt's diagonal scaling; the damping is cut
 /// by 3 after a step that lowers the cost and raised by 4 until one does).

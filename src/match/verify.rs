@@ -6,8 +6,9 @@
 //! the fast–exact difference ([`offset_correction`]): the fast model,
 //! shifted by the wave solution's colour minus its own at this recipe, is
 //! fitted to the target again, so the fast model supplies only how the
-//! colour changes with the recipe and the wave solver the colour itself. Each step's result file is
-//! kept (`<output_dir>/verify/`), with its exact scene inside.
+//! colour changes with the recipe and the wave solver the colour itself.
+//! Each step's result file is kept (`<output_dir>/verify/`), with its exact
+//! scene inside.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -20,6 +21,7 @@ use crate::pipeline::{self, memory::MemoryLimit};
 
 use super::config::{checked_scene, MatchSpec};
 use super::correct::{offset_correction, ModelDifference};
+use super::forward::Recipe;
 use super::problem::Problem;
 use super::search::Candidate;
 use super::MatchError;
@@ -54,6 +56,16 @@ impl VerifyStep {
     /// The largest ΔE00 over the geometries.
     pub fn de00_max(&self) -> f64 {
         self.de00.iter().copied().fold(0.0, f64::max)
+    }
+
+    /// The wave solution's CIELAB minus the fast model's, stacked (3 per
+    /// geometry): the fast–exact difference at this recipe.
+    pub fn difference(&self) -> Vec<f64> {
+        self.lab
+            .iter()
+            .zip(&self.fast_lab)
+            .flat_map(|(w, f)| [w[0] - f[0], w[1] - f[1], w[2] - f[2]])
+            .collect()
     }
 
     /// ΔE00 between the fast model's and the wave solution's colour of
@@ -110,11 +122,16 @@ impl Verification {
     /// The step closest to the target (largest ΔE00 over the geometries
     /// least): the recipe to use when none reached the tolerance.
     pub fn best(&self) -> &VerifyStep {
-        self.steps
-            .iter()
-            .min_by(|a, b| a.de00_max().total_cmp(&b.de00_max()))
-            .expect("a verification has a step")
+        &self.steps[best_step(&self.steps)]
     }
+}
+
+/// The verification's settings of `spec`; an error without them.
+fn settings(spec: &MatchSpec) -> Result<&super::config::VerifySpec, MatchError> {
+    spec.verify.as_ref().ok_or_else(|| MatchError::Config {
+        file: spec.path.clone(),
+        message: "a verification needs [match.verify]".into(),
+    })
 }
 
 /// The fidelity the verification solves at, in words: the base scene's.
@@ -164,10 +181,7 @@ pub fn scene(
     thickness_nm: f64,
     label: &str,
 ) -> Result<Scene, MatchError> {
-    let v = spec.verify.as_ref().ok_or_else(|| MatchError::Config {
-        file: spec.path.clone(),
-        message: "a verification needs [match.verify]".into(),
-    })?;
+    let v = settings(spec)?;
     let mut t = spec.base.clone();
     let all = match t.get("pigment") {
         Some(Value::Array(a)) => a.clone(),
@@ -259,22 +273,21 @@ pub fn scene(
 fn solve(
     spec: &MatchSpec,
     problem: &Problem,
-    (fractions, thickness_nm): (&[f64], f64),
+    recipe: &Recipe,
     label: &str,
     memory: Option<MemoryLimit>,
 ) -> Result<VerifyStep, MatchError> {
-    let scene = scene(spec, fractions, thickness_nm, label)?;
+    let scene = scene(spec, &recipe.fractions, recipe.thickness_nm, label)?;
     let start = Instant::now();
     let report = pipeline::run_with(&scene, true, memory)?;
     let seconds = start.elapsed().as_secs_f64();
     let measured = report
         .appearance
         .as_ref()
-        .map(|a| a.measured.clone())
-        .unwrap_or_default();
+        .map_or(&[][..], |a| a.measured.as_slice());
     let mut step = VerifyStep {
-        fractions: fractions.to_vec(),
-        thickness_nm,
+        fractions: recipe.fractions.clone(),
+        thickness_nm: recipe.thickness_nm,
         lab: Vec::new(),
         lab_se: Vec::new(),
         de00: Vec::new(),
@@ -284,12 +297,7 @@ fn solve(
         result: report.result_path.clone(),
         seconds,
     };
-    let recipe = super::forward::Recipe {
-        fractions: fractions.to_vec(),
-        thickness_nm,
-        paper_albedo: problem.paper_albedo,
-    };
-    let fast = problem.lab_stack(&recipe);
+    let fast = problem.lab_stack(recipe);
     for (g, (m, target)) in problem.target_lab.iter().enumerate() {
         let c = measured
             .iter()
@@ -321,10 +329,7 @@ pub fn verify(
     memory: Option<MemoryLimit>,
     progress: &dyn Fn(&str),
 ) -> Result<Verification, MatchError> {
-    let v = spec.verify.as_ref().ok_or_else(|| MatchError::Config {
-        file: spec.path.clone(),
-        message: "a verification needs [match.verify]".into(),
-    })?;
+    let v = settings(spec)?;
     let tol = spec.search.tolerance_de00;
     let subset = &candidate.subset;
     let mut x = candidate.x.clone();
@@ -342,17 +347,10 @@ pub fn verify(
             .fold(0.0, f64::max)
     };
     let mut radius = 1.0_f64;
-    let mut best: Option<(Vec<f64>, f64)> = None;
     let outcome = loop {
         let k = steps.len();
         let recipe = problem.recipe(subset, &x);
-        let step = solve(
-            spec,
-            problem,
-            (&recipe.fractions, recipe.thickness_nm),
-            &format!("r{rank}-step{k}"),
-            memory,
-        )?;
+        let step = solve(spec, problem, &recipe, &format!("r{rank}-step{k}"), memory)?;
         progress(&format!(
             "verify recipe {} step {k}: wave ΔE00 {} (fast model's error here {}) in {:.1} s",
             rank,
@@ -360,7 +358,7 @@ pub fn verify(
             geometry_list(problem, &step.model_error(), &vec![None; step.de00.len()]),
             step.seconds
         ));
-        let lab: Vec<f64> = step.lab.iter().flatten().copied().collect();
+        let e = step.difference();
         let worst = step.de00_max();
         steps.push(step);
         if worst <= tol {
@@ -376,30 +374,30 @@ pub fn verify(
                 best_step(&steps)
             );
         }
-        match &best {
-            Some((a, score)) if worst >= *score => radius = 0.5 * scaled(&x, a),
-            _ => {
-                if best.is_some() {
-                    radius = (4.0 * radius).min(1.0);
-                }
-                best = Some((x.clone(), worst));
-            }
+        // The trust region follows whether this step improved on the best
+        // so far (the difference model's anchor before it learns the step).
+        if let Some(d) = &difference {
+            radius = if worst >= d.best_score() {
+                0.5 * scaled(&x, d.x())
+            } else {
+                (4.0 * radius).min(1.0)
+            };
         }
+        let d = match difference.as_mut() {
+            None => difference.insert(ModelDifference::new(&x, e, worst)),
+            Some(d) => {
+                d.update(&x, e, worst);
+                d
+            }
+        };
         if radius < 1e-4 {
             break format!(
                 "no correction step improves on step {} any more (the steps that tried made the \
                  colour worse; largest ΔE00 there {:.3})",
                 best_step(&steps),
-                best.as_ref().map_or(worst, |b| b.1)
+                d.best_score()
             );
         }
-        let d = match difference.as_mut() {
-            None => difference.insert(ModelDifference::new(problem, subset, &x, &lab, worst)),
-            Some(d) => {
-                d.update(problem, subset, &x, &lab, worst);
-                d
-            }
-        };
         let Some(mut next) = offset_correction(problem, subset, d) else {
             break "the shifted fast model found no corrected recipe; the last verified recipe \
                    is reported"

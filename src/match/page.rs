@@ -9,6 +9,7 @@
 
 use crate::optics::colour::gamut::map_lab;
 use crate::optics::colour::Observer;
+use crate::output::html::escape as esc;
 use crate::output::render::plot::{self, Panel, PanelSize, Point, Scale, Series};
 use crate::output::render::RenderError;
 
@@ -26,13 +27,6 @@ fn frac(v: f64) -> String {
     } else {
         format!("{v:.4}")
     }
-}
-
-fn esc(t: &str) -> String {
-    t.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// One table cell: a patch of `lab` and its numbers (and ΔE00 to the

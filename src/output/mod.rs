@@ -8,6 +8,7 @@
 //!   `render`'s preview shades a sphere with);
 //! - [`progress`]: timestamped progress lines on long work;
 //! - [`space`]: the free space of an output's file system;
+//! - [`html`]: text escaped for the pages;
 //! - [`export`]: a result's numbers as CSV tables ([`csv`]: the table
 //!   writer; [`export_paint`]: an effect paint's tables).
 //!
@@ -21,6 +22,7 @@ pub mod export;
 pub mod export_paint;
 pub mod h5;
 pub mod hiding;
+pub mod html;
 pub mod lock;
 pub mod merl;
 pub mod mitsuba;

@@ -7,6 +7,7 @@ use super::findings::{self, hue_name, LabelMeans, Step, DE00_FLOOR, FACE, FLOP_F
 use super::row::EffectRow;
 use crate::config::paint::PaintScene;
 use crate::optics::flakes::multiangle::ASPECULAR_45_DEG;
+use crate::output::html::escape as esc;
 use crate::study::sweep::{Expansion, Study};
 use std::path::{Path, PathBuf};
 
@@ -228,13 +229,6 @@ pub fn markdown(blocks: &[Block]) -> String {
         }
     }
     s
-}
-
-fn esc(t: &str) -> String {
-    t.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// Inline `code` spans of Markdown as HTML.

@@ -11,6 +11,7 @@ use super::effects::{Effect, MeanSe};
 use super::Row;
 use crate::config::Equation;
 use crate::optics::colour::{lab_to_lch, lch_se};
+use crate::output::html::escape;
 use crate::study::run;
 use crate::study::sweep::{Expansion, Study, Variant};
 use std::fmt::Write as _;
@@ -329,13 +330,6 @@ pub fn effect_table(effects: &[Effect]) -> (Vec<&'static str>, Vec<Vec<String>>)
     (head, rows)
 }
 
-pub(super) fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 fn tr(cells: &[String], tag: &str) -> String {
     let mut s = String::from("<tr>");
     for c in cells {
@@ -399,7 +393,7 @@ pub(super) const BASELINE_TEXT: &str = "CIEDE2000 between each classical baselin
     coupling, the binder skin or the boundary matter (docs/VALIDATION.md).";
 
 pub(super) fn html_page(p: &PageInput) -> String {
-    let e = html_escape;
+    let e = escape;
     let title = format!("Study {} — profile {}", p.study.name, p.profile());
     let mut body = format!("<h1>{}</h1>\n<table class=\"facts\">\n", e(&title));
     for (k, v) in p.facts() {
@@ -481,7 +475,7 @@ pub(super) fn html_page(p: &PageInput) -> String {
 }
 
 fn variants_html(p: &PageInput) -> String {
-    let e = html_escape;
+    let e = escape;
     let mut head: Vec<String> = vec!["#".into(), "name".into()];
     head.extend(p.columns().iter().map(|a| e(a)));
     let cr = any_hiding(p);

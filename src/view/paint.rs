@@ -102,15 +102,10 @@ impl LivePaint {
         // The flakes' controls first (what moves an effect finish most),
         // then the pigments', then the thicknesses.
         let (mut flakes, mut pigments, mut thicknesses) = (vec![], vec![], vec![]);
-        let param = |key: String, label: String, unit: &str, range: [f64; 3], value: f64| Param {
-            key,
-            label,
-            unit: unit.into(),
-            min: range[0],
-            max: range[1],
-            step: range[2],
-            value: value.clamp(range[0], range[1]),
-        };
+        let param =
+            |key: String, label: String, unit: &str, [min, max, step]: [f64; 3], value: f64| {
+                Param::ranged(key, label, unit, (min, max, step), value.clamp(min, max))
+            };
         for (k, l) in scene.layers.iter().enumerate() {
             thicknesses.push((
                 Knob::Thickness(k),

@@ -1115,3 +1115,41 @@ fn a_dissolved_variant_under_a_realisation_target_is_finished() {
     let (ok, _, err) = inksim_in(dir.path(), &["merge", p]);
     assert!(ok, "{err}");
 }
+
+/// `plan`'s time model scales its assumed applications per solve by the
+/// decades of tolerance asked (`study::plan::tolerance_factor`); a real
+/// granular layer, solved at 1e-3 and at 1e-6, needs what it says within 25 %.
+#[test]
+fn the_time_models_tolerance_factor_matches_the_solver() {
+    use inksim::output::progress::Progress;
+    use inksim::pipeline::{self, RunPlan};
+    use inksim::study::plan::tolerance_factor;
+    let applications = |tol: f64| {
+        let text = format!(
+            "seed = 3\n[layer]\nthickness_nm = 1000.0\nfragment_nm = [600.0, 600.0]\npvc = 0.3\n\
+             [[pigment]]\nname = \"red\"\nmaterial = {{ builtin = \"red\" }}\ndiameter_nm = 200.0\n\
+             [illumination]\nwavelengths_nm = [450.0, 550.0, 650.0]\npolar_deg = [0.0, 40.0]\n\
+             [grid]\ncell_nm = 25.0\n[solver]\ntolerance = {tol:e}\n[appearance]\noutputs = []\n"
+        );
+        let scene = inksim::config::parse_scene(Path::new("t.toml"), &text).unwrap();
+        let layer = pipeline::layer::solve(&scene, &RunPlan::of(&scene), &Progress::hidden(1, "t"))
+            .unwrap();
+        let total: f64 = layer
+            .entries
+            .iter()
+            .map(|e| {
+                (e.record.iterations as f64 + 1.0)
+                    * e.record.method.solver().applications_per_iteration()
+            })
+            .sum();
+        total / layer.entries.len() as f64
+    };
+    let (tight, loose) = (applications(1e-6), applications(1e-3));
+    eprintln!("applications per solve: {tight:.1} at 1e-6, {loose:.1} at 1e-3");
+    let measured = tight / loose;
+    let model = tolerance_factor(1e-6, 1e-3);
+    assert!(
+        (measured / model - 1.0).abs() < 0.25,
+        "1e-6 against 1e-3: measured {measured:.2}×, the model {model:.2}×"
+    );
+}

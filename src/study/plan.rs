@@ -64,16 +64,40 @@ pub const MEAN_APPLICATIONS: f64 = 21.0;
 /// standard profile's 9 red variants of these kinds needed 56–260, mean 93.
 pub const MEAN_APPLICATIONS_SURFACE: f64 = 93.0;
 
+/// The tolerance the mean background's assumed rates were measured at
+/// ([`MEAN_APPLICATIONS`], [`MEAN_APPLICATIONS_SURFACE`]).
+pub const MEAN_RATE_TOLERANCE: f64 = 1e-4;
+/// The tolerance [`BINDER_APPLICATIONS`] was measured at.
+pub const BINDER_RATE_TOLERANCE: f64 = 1e-6;
+
+/// Decades of tolerance a Krylov solve's applications carry beyond the
+/// ones it converges: applications grow linearly in the decades
+/// `log10(1/tol)` asked, as `(TOLERANCE_OFFSET_DECADES + decades)`.
+/// Fitted to BiCGStab on the three ACCURACY layers in Maxwell
+/// (iterations + 1 against 1e-4, mean of the three): 0.63 at 1e-2, 0.83 at
+/// 1e-3, 1.31 at 1e-6, 1.73 at 1e-9 (docs/PERFORMANCE.md, "The solver
+/// tolerance in the time model").
+pub const TOLERANCE_OFFSET_DECADES: f64 = 2.5;
+
+/// Applications at tolerance `tol` against those at `reference`
+/// ([`TOLERANCE_OFFSET_DECADES`]).
+pub fn tolerance_factor(tol: f64, reference: f64) -> f64 {
+    let work = |t: f64| TOLERANCE_OFFSET_DECADES + (-t.log10()).max(0.0);
+    work(tol) / work(reference)
+}
+
 /// Operator applications per solve assumed for `scene` when no result of
 /// the study exists yet: by its solver background and, on the mean
-/// background, by whether its top is flat.
+/// background, by whether its top is flat; scaled from the tolerance each
+/// rate was measured at to the scene's ([`tolerance_factor`]).
 pub fn default_applications(scene: &Scene) -> f64 {
     let flat = scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat;
-    match scene.solver.background {
-        Background::Binder => BINDER_APPLICATIONS,
-        Background::Mean if flat => MEAN_APPLICATIONS,
-        Background::Mean => MEAN_APPLICATIONS_SURFACE,
-    }
+    let (rate, measured_at) = match scene.solver.background {
+        Background::Binder => (BINDER_APPLICATIONS, BINDER_RATE_TOLERANCE),
+        Background::Mean if flat => (MEAN_APPLICATIONS, MEAN_RATE_TOLERANCE),
+        Background::Mean => (MEAN_APPLICATIONS_SURFACE, MEAN_RATE_TOLERANCE),
+    };
+    rate * tolerance_factor(scene.solver.tolerance, measured_at)
 }
 /// Wave solves per incidence: one (Helmholtz, and Maxwell's random-phase
 /// natural light), or one per polarisation solved (Maxwell; natural light
@@ -401,7 +425,8 @@ mod tests {
             let text = format!(
                 "[layer]\nthickness_nm = 500.0\nfragment_nm = [400.0, 400.0]\npvc = 0.3\n{extra}\n\
                  [[pigment]]\nname = \"red\"\nmaterial = {{ builtin = \"red\" }}\n\
-                 diameter_nm = 100.0\n[illumination]\nwavelengths_nm = [550.0]\npolar_deg = [0.0]\n[grid]\ncell_nm = 25.0\n"
+                 diameter_nm = 100.0\n[illumination]\nwavelengths_nm = [550.0]\npolar_deg = [0.0]\n[grid]\ncell_nm = 25.0\n\
+                 [solver]\ntolerance = 1e-4\n"
             );
             crate::config::parse_scene(std::path::Path::new("t.toml"), &text).unwrap()
         };
@@ -419,7 +444,24 @@ mod tests {
         }
         let mut binder = scene("");
         binder.solver.background = Background::Binder;
+        binder.solver.tolerance = BINDER_RATE_TOLERANCE;
         assert_eq!(default_applications(&binder), BINDER_APPLICATIONS);
+    }
+
+    /// The rates hold at the tolerance they were measured at; a looser one
+    /// needs fewer applications, a tighter one more, by the decades asked.
+    #[test]
+    fn the_assumed_rate_follows_the_tolerance() {
+        assert_eq!(tolerance_factor(1e-4, 1e-4), 1.0);
+        let f = |t: f64| tolerance_factor(t, MEAN_RATE_TOLERANCE);
+        assert!(f(1e-2) < f(1e-3) && f(1e-3) < 1.0 && f(1e-6) > 1.0 && f(1e-9) > f(1e-6));
+        // Ten times looser never costs more than a decade's share of the work.
+        assert!(
+            (f(1e-3) - (TOLERANCE_OFFSET_DECADES + 3.0) / (TOLERANCE_OFFSET_DECADES + 4.0)).abs()
+                < 1e-12
+        );
+        // A tolerance of 1 or more asks for no decade at all.
+        assert_eq!(f(1.0), f(10.0));
     }
 
     /// Natural light in Maxwell is two wave solves per incidence (one as a

@@ -90,6 +90,7 @@ pub fn paint(metallic: bool, ad: f64) -> (Vec<PaintLayer>, Ground) {
             orientation: Orientation {
                 sigma_rad: f64::to_radians(sigma_deg),
             },
+            diffraction_rad: 0.0,
             table: reflector.table(LACQUER, WL),
         }),
     };

@@ -59,6 +59,7 @@ fn aligned_mirror_flakes_match_the_two_stream_closed_form() {
         flakes: Some(FlakeMedium {
             area_per_nm: a,
             orientation: Orientation { sigma_rad: 0.0 },
+            diffraction_rad: 0.0,
             table,
         }),
     };
@@ -160,6 +161,7 @@ fn paint_layers(absorbing: bool, spread_deg: f64) -> Vec<PaintLayer> {
                 orientation: Orientation {
                     sigma_rad: spread_deg.to_radians(),
                 },
+                diffraction_rad: 0.0,
                 table: flake.table(LACQUER, 550.0),
             }),
         },

@@ -32,6 +32,7 @@ fn flakes(h: f64, ad: f64, sigma_deg: f64, reflector: Reflector) -> PaintLayer {
             orientation: Orientation {
                 sigma_rad: sigma_deg.to_radians(),
             },
+            diffraction_rad: 0.0,
             table: reflector.table(LACQUER, 550.0),
         }),
     }

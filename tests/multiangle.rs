@@ -88,6 +88,7 @@ fn an_aluminium_paint_flops() {
         orientation: Orientation {
             sigma_rad: 12f64.to_radians(),
         },
+        diffraction_rad: 0.0,
         table: aluminium.table(1.5, 550.0),
     });
     let layers = [clear(40_000.0), base];

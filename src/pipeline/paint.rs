@@ -130,18 +130,17 @@ pub fn model_params(scene: &PaintScene) -> ModelParams {
     }
 }
 
-/// The flakes' orientation at a wavelength (with the diffraction lobe of a
-/// disc of the mean diameter where asked).
-fn orientation(
-    f: &crate::config::paint::FlakeSpec,
-    wavelength_nm: f64,
-    lacquer: f64,
-) -> Orientation {
-    let sigma = f.orientation_sd_deg.to_radians();
+/// The flakes' diffraction spread at a wavelength (that of a disc of the
+/// mean diameter where asked, else 0).
+fn diffraction(f: &crate::config::paint::FlakeSpec, wavelength_nm: f64, lacquer: f64) -> f64 {
     if f.diffraction {
-        Orientation::with_diffraction(sigma, f.diameter_um * 1000.0, wavelength_nm, lacquer)
+        crate::optics::flakes::normals::diffraction_rad(
+            f.diameter_um * 1000.0,
+            wavelength_nm,
+            lacquer,
+        )
     } else {
-        Orientation { sigma_rad: sigma }
+        0.0
     }
 }
 
@@ -193,7 +192,10 @@ pub fn layers_at(scene: &PaintScene, wavelength_nm: f64) -> Result<Vec<PaintLaye
             None => None,
             Some(f) => Some(FlakeMedium {
                 area_per_nm: f.area_per_nm(),
-                orientation: orientation(f, wavelength_nm, n),
+                orientation: Orientation {
+                    sigma_rad: f.orientation_sd_deg.to_radians(),
+                },
+                diffraction_rad: diffraction(f, wavelength_nm, n),
                 table: reflector(&f.reflector, wavelength_nm)?.table(n, wavelength_nm),
             }),
         };

@@ -58,6 +58,12 @@ pub struct FlakeMedium {
     /// Projected flake area per unit volume, 1/nm.
     pub area_per_nm: f64,
     pub orientation: Orientation,
+    /// The disc's diffraction as a spread of the normals for light along
+    /// the normal (`normals::diffraction_rad`; 0: none). Light at incidence
+    /// cosine `μ` sees `orientation` broadened by `σ_d/μ`
+    /// ([`Orientation::at_incidence`]); what the flakes intercept and absorb
+    /// follows `orientation` alone.
+    pub diffraction_rad: f64,
     /// The flake's `R`, `T` against the local angle.
     pub table: LocalTable,
 }
@@ -233,7 +239,7 @@ pub fn flake_kernels(
     let mut opp = vec![Matrix::zeros(n); modes];
     let mut absorbed = vec![0.0; n];
     let mut cos_m = vec![0.0; modes];
-    let aligned = flakes.orientation.sigma_rad <= 0.0;
+    let aligned = flakes.orientation.sigma_rad <= 0.0 && flakes.diffraction_rad <= 0.0;
     if !aligned {
         let sampling = quadrature.lobe_sampling.clamp(0.1, 4.0);
         integrate_lobes(ords, flakes, modes, sampling, &mut same, &mut opp);
@@ -358,7 +364,11 @@ fn integrate_lobes_body(
     opp: &mut [Matrix],
 ) {
     let n = ords.len();
-    let sigma = flakes.orientation.sigma_rad;
+    // The narrowest lobe (along the normal) sets the azimuths.
+    let sigma = flakes
+        .orientation
+        .at_incidence(flakes.diffraction_rad, 1.0)
+        .sigma_rad;
     let a = flakes.area_per_nm;
     let least = (128.0 * sampling).ceil() as usize;
     let azimuths = ((8.0 * sampling * PI / sigma).ceil() as usize).clamp(least, 2048);
@@ -401,7 +411,10 @@ fn integrate_lobes_body(
     // grows while its `z` part stays), so the azimuths it reaches within
     // the density's extent are a leading run: the loop stops at the first
     // beyond.
-    let table = flakes.orientation.density_table();
+    // Without diffraction one table serves every incident direction; with
+    // it each direction has its own spread (made once per direction).
+    let shared = (flakes.diffraction_rad <= 0.0).then(|| flakes.orientation.density_table());
+    let mut own = None;
     let mut profile = vec![0.0; azimuths];
     // Per cell and hemisphere, the azimuthal profile summed over the cell's
     // points (the projection on `cos mφ` is linear, so it is done once per
@@ -412,9 +425,18 @@ fn integrate_lobes_body(
         let mu_j = ords.mu[j];
         let wj = [(1.0 - mu_j * mu_j).max(0.0).sqrt(), 0.0, mu_j];
         let scale = 0.25 * a / mu_j;
+        let (table, sigma_j) = match &shared {
+            Some(t) => (t, sigma),
+            None => {
+                let o = flakes
+                    .orientation
+                    .at_incidence(flakes.diffraction_rad, mu_j);
+                (&*own.insert(o.density_table()), o.sigma_rad)
+            }
+        };
         for (k, &(lo, hi)) in cells.iter().enumerate() {
             let span = (lo.clamp(0.0, 1.0).acos() - hi.clamp(0.0, 1.0).acos()).abs();
-            let points = ((2.0 * sampling * span / sigma).ceil() as usize).clamp(3, 24);
+            let points = ((2.0 * sampling * span / sigma_j).ceil() as usize).clamp(3, 24);
             let (x, w) = &rules[points];
             let mut reach = [0usize; 2];
             for (x, w) in x.iter().zip(w) {

@@ -8,7 +8,9 @@
 //! they are **discs** of a given diameter, scattered at random through each
 //! layer, each with its own normal drawn from the orientation
 //! distribution, reflecting `R_f(|ω·m|)` about its normal and letting `T_f`
-//! go on undeviated from both faces, as the fast model's flakes do; a ray
+//! go on undeviated from both faces, as the fast model's flakes do (a
+//! small disc's diffraction as a Gaussian tilt of the reflecting normal,
+//! `σ_d` over the local cosine, drawn per reflection); a ray
 //! cannot meet one flake twice in a row, and its way down and back up
 //! passes the same discs, which the fast model's independent sublayers do
 //! not know. The discs are a stationary random field without a box: the
@@ -558,6 +560,16 @@ impl Paint<'_> {
                     return;
                 }
                 if rng.gen::<f64>() * kept < pw.r {
+                    // The disc's diffraction: the mirror's normal spread by
+                    // σ_d over the local cosine, drawn per reflection.
+                    let m = if f.diffraction_rad > 0.0 {
+                        let o =
+                            Orientation { sigma_rad: 0.0 }.at_incidence(f.diffraction_rad, cos_l);
+                        let tilt = draw_tilt(&o, rng);
+                        turn(m, tilt.cos(), 2.0 * PI * rng.gen::<f64>())
+                    } else {
+                        m
+                    };
                     let dm = dot(d, m);
                     d = [
                         d[0] - 2.0 * dm * m[0],

@@ -21,6 +21,16 @@
 use crate::optics::baseline::ordinates::gauss_legendre;
 use std::f64::consts::{FRAC_PI_2, PI};
 
+/// The normals' equivalent spread of a disc's diffraction for light along
+/// the normal, `σ_d = λ/(√2 π n D)` ([`Orientation::with_diffraction`]).
+pub fn diffraction_rad(diameter_nm: f64, wavelength_nm: f64, lacquer: f64) -> f64 {
+    wavelength_nm / (std::f64::consts::SQRT_2 * PI * lacquer * diameter_nm)
+}
+
+/// The smallest incidence cosine the diffraction spread is widened for
+/// (`σ_d/μ` stays below 10 σ_d: grazing light in the lacquer).
+pub const MIN_DIFFRACTION_COSINE: f64 = 0.1;
+
 /// A Gaussian-in-angle distribution of normals of spread `sigma_rad` (≥ 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Orientation {
@@ -47,15 +57,33 @@ impl Orientation {
     /// normals' equivalent spread is `σ_ψ/2`, added in quadrature:
     /// `σ_eff² = σ² + λ²/(2 π² n² D²)`. (The rings beyond the first zero,
     /// 16 % of the power, are folded into the Gaussian's tail.)
+    ///
+    /// That holds for light along the normal. A normal tilted by `δ` moves
+    /// the reflected direction's in-plane component by `2 cos θ δ` at
+    /// incidence `θ`, while the disc's far field is fixed in that component
+    /// (Kirchhoff's aperture), so at incidence cosine `μ` the equivalent
+    /// spread is `σ_d/μ` ([`Orientation::at_incidence`]); a wave solution of
+    /// a 2 µm aluminium flake at 45° confirms it (tests/flake_wave.rs).
     pub fn with_diffraction(
         sigma_rad: f64,
         diameter_nm: f64,
         wavelength_nm: f64,
         lacquer: f64,
     ) -> Orientation {
-        let d = wavelength_nm / (std::f64::consts::SQRT_2 * PI * lacquer * diameter_nm);
+        Orientation { sigma_rad }
+            .at_incidence(diffraction_rad(diameter_nm, wavelength_nm, lacquer), 1.0)
+    }
+
+    /// This spread broadened by a disc's diffraction `diffraction_rad`
+    /// ([`diffraction_rad`]) for light at incidence cosine `mu` to the layer
+    /// normal (at least [`MIN_DIFFRACTION_COSINE`]): `σ² + (σ_d/μ)²`.
+    pub fn at_incidence(&self, diffraction_rad: f64, mu: f64) -> Orientation {
+        if diffraction_rad <= 0.0 {
+            return *self;
+        }
+        let d = diffraction_rad / mu.abs().max(MIN_DIFFRACTION_COSINE);
         Orientation {
-            sigma_rad: (sigma_rad * sigma_rad + d * d).sqrt(),
+            sigma_rad: (self.sigma_rad * self.sigma_rad + d * d).sqrt(),
         }
     }
 

@@ -50,7 +50,8 @@ pub fn plan(
          applications × one operator application × {} (Maxwell: per polarisation solved, \
          natural light one random-phase solve for an ensemble, else two); applications per solve {:.0} under a \
          flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
-         background), × {:.2}: {}",
+         background; measured at a tolerance of 1e-4, 1e-6 on the binder, and scaled to each \
+         scene's as 2.5 + log10(1/tolerance)), × {:.2}: {}",
         plan::KRYLOV_OVERHEAD,
         plan::MEAN_APPLICATIONS,
         plan::MEAN_APPLICATIONS_SURFACE,

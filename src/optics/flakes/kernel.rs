@@ -352,8 +352,10 @@ crate::solver::simd::widest! {
 }
 
 /// Relative step of the per-direction spreads of diffracting flakes
-/// ([`integrate_lobes`]): a lobe 0.1 % wider or narrower than asked.
-const SPREAD_STEP: f64 = 1e-3;
+/// ([`integrate_lobes`]): a lobe up to 0.5 % wider or narrower than asked,
+/// well inside what the Gaussian lobe itself leaves out of Airy's pattern
+/// (docs/VALIDATION.md, "A small flake in wave optics").
+const SPREAD_STEP: f64 = 1e-2;
 
 /// Azimuths per chunk of [`integrate_lobes`]'s vector lanes.
 const CHUNK: usize = 8;
@@ -417,7 +419,7 @@ fn integrate_lobes_body(
     // beyond.
     // Without diffraction one table serves every incident direction; with
     // it each direction has its own spread, rounded to a relative step of
-    // SPREAD_STEP so that directions whose spreads agree that closely (all
+    // SPREAD_STEP so that directions whose spreads agree that closely (most
     // of them where σ_d ≪ σ) share one table.
     let shared = (flakes.diffraction_rad <= 0.0).then(|| flakes.orientation.density_table());
     let mut own: Option<(i64, DensityTable, f64)> = None;

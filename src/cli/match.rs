@@ -78,6 +78,12 @@ pub fn run(
     let report = inksim::r#match::report::run_with(&spec, memory, &say)?;
     let written = write::write_outputs(&spec, &report, &spec.output_dir)?;
     print_report(&spec, &report);
+    if let Some(why) = &written.figure_skipped {
+        say(&format!(
+            "{why}; the page {} goes without it",
+            written.page.display()
+        ));
+    }
     say(&format!(
         "{} subset(s) in {:.2} s ({} model evaluations); wrote {}, {}{} and the page {}",
         report.subsets,

@@ -37,6 +37,9 @@ pub struct Written {
     pub verify_csv: Option<PathBuf>,
     /// `<name>.html` and its figure `<name>-spectra.png`.
     pub page: PathBuf,
+    /// Why the spectra figure was not drawn (the page then goes without
+    /// it), if it was not.
+    pub figure_skipped: Option<String>,
 }
 
 /// Write the report of `spec` into `dir`.
@@ -63,12 +66,15 @@ pub fn write_outputs(
         Some(path)
     };
     let png_name = format!("{}-spectra.png", spec.name);
-    let figure = super::page::spectra_png(spec, report)
-        .ok()
-        .map(|png| write_atomic(&dir.join(&png_name), &png))
-        .transpose()?;
+    let (figure, figure_skipped) = match super::page::spectra_png(spec, report) {
+        Ok(png) => {
+            write_atomic(&dir.join(&png_name), &png)?;
+            (Some(png_name.as_str()), None)
+        }
+        Err(e) => (None, Some(format!("the spectra figure was not drawn: {e}"))),
+    };
     let page = dir.join(format!("{}.html", spec.name));
-    let html = super::page::html(spec, report, figure.map(|_| png_name.as_str()));
+    let html = super::page::html(spec, report, figure);
     write_atomic(&page, html.as_bytes())?;
     drop(lock);
     Ok(Written {
@@ -76,6 +82,7 @@ pub fn write_outputs(
         csv,
         verify_csv,
         page,
+        figure_skipped,
     })
 }
 

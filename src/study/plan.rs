@@ -75,8 +75,8 @@ pub const BINDER_RATE_TOLERANCE: f64 = 1e-6;
 /// `log10(1/tol)` asked, as `(TOLERANCE_OFFSET_DECADES + decades)`.
 /// Fitted to BiCGStab on the three ACCURACY layers in Maxwell
 /// (iterations + 1 against 1e-4, mean of the three): 0.63 at 1e-2, 0.83 at
-/// 1e-3, 1.31 at 1e-6, 1.73 at 1e-9 (docs/PERFORMANCE.md, "The solver
-/// tolerance in the time model").
+/// 1e-3, 1.31 at 1e-6, 1.73 at 1e-9 (docs/ACCURACY.md, "The solver
+/// tolerance in Maxwell's equations").
 pub const TOLERANCE_OFFSET_DECADES: f64 = 2.5;
 
 /// Applications at tolerance `tol` against those at `reference`

@@ -62,10 +62,15 @@ fn close_on_exec(file: &hdf5::File) -> hdf5::Result<()> {
 mod tests {
     use super::*;
 
-    /// A child started while a file is open does not keep it locked: the
-    /// file opens again at once after the program closes it. Without
-    /// close-on-exec the reopen fails with "unable to lock file" until the
-    /// child exits.
+    /// A child started while a file is open does not keep it: once the child
+    /// has replaced its image, none of its descriptors leads to the file, and
+    /// the file opens again at once after the program closes it. Without
+    /// close-on-exec the child holds the descriptor (and HDF5's lock) for its
+    /// whole life and the wait below runs out.
+    ///
+    /// The wait is needed because the kernel lets a parent of `vfork`
+    /// (`posix_spawn`) go on as soon as the child's new memory is in place,
+    /// a few microseconds before it closes its close-on-exec descriptors.
     #[test]
     fn a_child_process_does_not_inherit_an_open_file() {
         let dir = tempfile::tempdir().unwrap();
@@ -75,10 +80,24 @@ mod tests {
             .arg("5")
             .spawn()
             .unwrap();
+        let fds = format!("/proc/{}/fd", child.id());
+        let holds = || {
+            std::fs::read_dir(&fds).map_or(false, |entries| {
+                entries
+                    .flatten()
+                    .any(|e| std::fs::read_link(e.path()).is_ok_and(|t| t == path))
+            })
+        };
+        let start = std::time::Instant::now();
+        while holds() && start.elapsed() < std::time::Duration::from_secs(2) {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        let held = holds();
         file.close().unwrap();
         let reopened = open(&path);
         child.kill().unwrap();
         child.wait().unwrap();
+        assert!(!held, "the child still holds the file after 2 s");
         reopened.unwrap();
     }
 }

@@ -29,6 +29,13 @@ def match(binary, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
+def effect(binary, tmp_path_factory):
+    out = tmp_path_factory.mktemp("effect")
+    _run(binary, "match", "match-pearl.toml", out)
+    return inksim.open_match(out / "match-pearl.h5")
+
+
+@pytest.fixture(scope="module")
 def fit(binary, tmp_path_factory):
     out = tmp_path_factory.mktemp("fit")
     _run(binary, "fit-material", "fit-red.toml", out)
@@ -58,6 +65,25 @@ def test_one_recipe_in_full(match):
     np.testing.assert_allclose(np.diag(best["correlation"].values), 1.0)
     assert best["reflectance_factor"].dims == ("wavelength_nm",)
     assert "recipe" in repr(match) or "ΔE00" in repr(match)
+
+
+def test_effect_paint_match(effect):
+    """The pearl example: its target was made from flakes at 0.03 with a 132 nm coating."""
+    assert effect.attrs["kind"] == "effect" and bool(effect.attrs["reached"])
+    r = effect.recipes
+    assert r["concentration"].dims == ("recipe", "flake_layer")
+    assert list(r["flake_layer"].values) == ["basecoat"]
+    assert r["coating_nm"].attrs["units"] == "nm"
+    assert r["de00"].dims == ("recipe", "geometry") and r["de00_se"].dims == ("recipe", "geometry")
+    assert list(r["geometry"].values) == ["45as-15", "45as15", "45as25", "45as45", "45as75", "45as110"]
+    assert abs(float(r["concentration"].values[0, 0]) - 0.03) < 3e-4
+    assert abs(float(r["coating_nm"].values[0, 0]) - 132.0) < 1.0
+    assert np.all(r["de00"].values[0] < 0.1)
+    assert abs(float(r["flop_index"].values[0]) - effect.target.attrs["flop_index"]) < 0.05
+    best = effect.recipe(0)
+    assert list(best["unknown"].values) == ["basecoat.flakes concentration", "basecoat.flakes coating_nm"]
+    assert best["lab_all"].dims == ("multi_angle_geometry", "lab") and best.sizes["multi_angle_geometry"] == 11
+    assert "coating 132" in repr(effect)
 
 
 def test_fitted_constants(fit):

@@ -11,7 +11,7 @@ use std::time::SystemTime;
 use super::ConfigFile;
 
 /// A progress line with its UTC time.
-fn say(line: &str) {
+pub(super) fn say(line: &str) {
     eprintln!("{} [inksim] match: {line}", utc_stamp(SystemTime::now()));
 }
 
@@ -23,6 +23,9 @@ fn spec(config: &ConfigFile) -> Result<MatchSpec> {
 /// `inksim check` of a match file: the file, its base scene and palette,
 /// and the fast model built, without searching.
 pub fn check(config: &ConfigFile, memory: Option<MemoryLimit>) -> Result<()> {
+    if config.is_effect_match() {
+        return super::match_effect::check(config);
+    }
     let spec = spec(config)?;
     let problem = report::problem(&spec)?;
     report::check_verification(&spec, memory)?;
@@ -66,6 +69,9 @@ pub fn run(
     output_dir: Option<PathBuf>,
     memory: Option<MemoryLimit>,
 ) -> Result<()> {
+    if config.is_effect_match() {
+        return super::match_effect::run(config, output_dir);
+    }
     let mut spec = spec(config)?;
     if let Some(d) = output_dir {
         spec.output_dir = d;
@@ -101,7 +107,7 @@ pub fn run(
 
 /// A number with four significant digits or so: fixed between 0.01 and
 /// 10⁵, scientific otherwise.
-fn num(v: f64) -> String {
+pub(super) fn num(v: f64) -> String {
     if v == 0.0 {
         "0".into()
     } else if (0.01..1e5).contains(&v.abs()) {

@@ -23,6 +23,7 @@ pub mod effect_study;
 pub mod export;
 pub mod fit_material;
 pub mod r#match;
+pub mod match_effect;
 pub mod materials;
 pub mod paint;
 pub mod plan;
@@ -146,6 +147,11 @@ impl ConfigFile {
     /// Whether it is a match file (has a [match] table).
     pub fn is_match(&self) -> bool {
         inksim::r#match::config::is_match_text(&self.text)
+    }
+
+    /// Whether it is an effect paint's match file (a multi-angle target).
+    pub fn is_effect_match(&self) -> bool {
+        inksim::r#match::config::is_effect_text(&self.text)
     }
 
     /// Whether it is a fit file (has a [fit] table).

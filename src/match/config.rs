@@ -162,24 +162,25 @@ struct RawMatchFile {
     palette: Vec<Table>,
 }
 
+/// `[match]` as written (a scene's match and an effect paint's share it).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawSettings {
-    name: Option<String>,
-    output_dir: Option<PathBuf>,
+pub(crate) struct RawSettings {
+    pub(crate) name: Option<String>,
+    pub(crate) output_dir: Option<PathBuf>,
     tolerance_de00: f64,
     max_colourants: Option<usize>,
     starts: Option<usize>,
     objective: Option<String>,
     max_total_pvc: Option<f64>,
-    thickness_range_nm: Option<Vec<f64>>,
+    pub(crate) thickness_range_nm: Option<Vec<f64>>,
     recipes: Option<usize>,
-    verify: Option<RawVerify>,
+    pub(crate) verify: Option<RawVerify>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawVerify {
+pub(crate) struct RawVerify {
     recipes: Option<usize>,
     max_steps: Option<usize>,
     wavelength_step_nm: Option<f64>,
@@ -208,6 +209,17 @@ enum RawTarget {
 struct RawColour {
     geometry: String,
     lab: Vec<f64>,
+}
+
+/// Whether TOML match-file `text` matches an effect paint: its target is
+/// `kind = "multi-angle"` ([`super::effect`]).
+pub fn is_effect_text(text: &str) -> bool {
+    text.parse::<Table>().is_ok_and(|t| {
+        t.get("target")
+            .and_then(|v| v.get("kind"))
+            .and_then(Value::as_str)
+            == Some("multi-angle")
+    })
 }
 
 /// Whether TOML `text` is a match file (has a `[match]` table).
@@ -345,7 +357,7 @@ pub(crate) fn output_names(
 }
 
 /// The 3 numbers of `key`, each checked by `ok` (`what` says the range).
-fn three(
+pub(crate) fn three(
     file: &Path,
     key: &str,
     v: &[f64],
@@ -367,21 +379,15 @@ fn three(
     Ok([v[0], v[1], v[2]])
 }
 
-fn check_target(file: &Path, raw: RawTarget) -> Result<Target, MatchError> {
-    let (illuminant, observer_deg, noise) = match &raw {
-        RawTarget::Lab {
-            illuminant,
-            observer_deg,
-            noise_lab,
-            ..
-        }
-        | RawTarget::Spectrum {
-            illuminant,
-            observer_deg,
-            noise_lab,
-            ..
-        } => (illuminant, *observer_deg, noise_lab),
-    };
+/// The target's illuminant, observer and noise (`target.illuminant`,
+/// `target.observer_deg`, `target.noise_lab`, default
+/// [`DEFAULT_NOISE_LAB`]).
+pub(crate) fn check_conditions(
+    file: &Path,
+    illuminant: &str,
+    observer_deg: u32,
+    noise: &Option<Vec<f64>>,
+) -> Result<(Illuminant, StandardObserver, [f64; 3]), MatchError> {
     let illuminant = Illuminant::from_name(illuminant).ok_or_else(|| {
         invalid(
             file,
@@ -406,6 +412,26 @@ fn check_target(file: &Path, raw: RawTarget) -> Result<Target, MatchError> {
         )?,
         None => [DEFAULT_NOISE_LAB; 3],
     };
+    Ok((illuminant, observer, noise_lab))
+}
+
+fn check_target(file: &Path, raw: RawTarget) -> Result<Target, MatchError> {
+    let (illuminant, observer_deg, noise) = match &raw {
+        RawTarget::Lab {
+            illuminant,
+            observer_deg,
+            noise_lab,
+            ..
+        }
+        | RawTarget::Spectrum {
+            illuminant,
+            observer_deg,
+            noise_lab,
+            ..
+        } => (illuminant, *observer_deg, noise_lab),
+    };
+    let (illuminant, observer, noise_lab) =
+        check_conditions(file, illuminant, observer_deg, noise)?;
     let geometry = |key: &str, name: &str| {
         Measurement::from_name(name).ok_or_else(|| {
             invalid(
@@ -483,6 +509,14 @@ fn check_palette(
         base,
         "remove it: the palette's pvc_range bounds give the PVC",
     )?;
+    if table.contains_key("paint") {
+        return Err(invalid(
+            file,
+            "base",
+            "an effect paint ([paint]) is matched to multi-angle colours: give target.kind = \
+             \"multi-angle\" and [[unknown]] tables (docs/MATCH.md, \"Effect paints\")",
+        ));
+    }
     if palette.is_empty() || palette.len() > MAX_PALETTE {
         return Err(invalid(
             file,
@@ -659,6 +693,24 @@ fn check_search(
     scene: &Scene,
     palette: usize,
 ) -> Result<Search, MatchError> {
+    let spectral = matches!(target.colour, TargetColour::Spectrum { .. });
+    let search = check_settings(file, raw, spectral, palette)?;
+    check_band(
+        file,
+        "base.illumination.wavelengths_nm",
+        &scene.wavelengths_nm,
+    )?;
+    Ok(search)
+}
+
+/// The search settings of `[match]` (`spectral`: the target is a
+/// spectrum; `palette`: how many optional colourants there are).
+pub(crate) fn check_settings(
+    file: &Path,
+    raw: &RawSettings,
+    spectral: bool,
+    palette: usize,
+) -> Result<Search, MatchError> {
     let tol = raw.tolerance_de00;
     if !(tol.is_finite() && tol > 0.0 && tol <= 20.0) {
         return Err(invalid(
@@ -685,7 +737,6 @@ fn check_search(
             format!("{starts} is outside [1, {MAX_STARTS}]"),
         ));
     }
-    let spectral = matches!(target.colour, TargetColour::Spectrum { .. });
     let objective = match raw.objective.as_deref() {
         None if spectral => Objective::SpectralRms,
         None | Some("de00") => Objective::De00,
@@ -732,21 +783,6 @@ fn check_search(
             format!("{recipes} is outside [1, 100]"),
         ));
     }
-    let band = (
-        scene.wavelengths_nm.first().copied().unwrap_or(f64::NAN),
-        scene.wavelengths_nm.last().copied().unwrap_or(f64::NAN),
-    );
-    if !(band.0 <= BAND_NM.0 && band.1 >= BAND_NM.1) {
-        return Err(invalid(
-            file,
-            "base.illumination.wavelengths_nm",
-            format!(
-                "the colour grid is the band of these wavelengths, {}–{} nm; it must reach {} nm \
-                 or below and {} nm or above",
-                band.0, band.1, BAND_NM.0, BAND_NM.1
-            ),
-        ));
-    }
     Ok(Search {
         tolerance_de00: tol,
         max_colourants,
@@ -756,4 +792,25 @@ fn check_search(
         thickness_range_nm,
         recipes,
     })
+}
+
+/// The colour grid `wavelengths_nm` (key `key`) reaches far enough into
+/// the blue and the red.
+pub(crate) fn check_band(file: &Path, key: &str, wavelengths_nm: &[f64]) -> Result<(), MatchError> {
+    let band = (
+        wavelengths_nm.first().copied().unwrap_or(f64::NAN),
+        wavelengths_nm.last().copied().unwrap_or(f64::NAN),
+    );
+    if !(band.0 <= BAND_NM.0 && band.1 >= BAND_NM.1) {
+        return Err(invalid(
+            file,
+            key,
+            format!(
+                "the colour grid is the band of these wavelengths, {}–{} nm; it must reach {} nm \
+                 or below and {} nm or above",
+                band.0, band.1, BAND_NM.0, BAND_NM.1
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -22,6 +22,9 @@
 //! - [`write`]: the HDF5 file and the recipes CSV, written atomically.
 //! - [`page`]: the page of the target and the recipes side by side, and its
 //!   spectra figure.
+//! - [`effect`]: the same search for an effect paint: flake concentration,
+//!   coating thickness and pigments from multi-angle colours, on the fast
+//!   flake model.
 //! - [`fit`]: the inverse of a pigment (`inksim fit-material`): its optical
 //!   constants from measured drawdowns, on the same fast model.
 //!
@@ -30,6 +33,7 @@
 
 pub mod config;
 pub mod correct;
+pub mod effect;
 pub mod fit;
 pub mod forward;
 pub mod page;

@@ -21,7 +21,7 @@ const PANEL: PanelSize = PanelSize { w: 560, h: 320 };
 
 /// A volume fraction as the page prints it: four decimals, or three
 /// significant digits below 0.001 (so a trace is not shown as 0.0000).
-fn frac(v: f64) -> String {
+pub(crate) fn frac(v: f64) -> String {
     if v != 0.0 && v.abs() < 1e-3 {
         format!("{v:.2e}")
     } else {
@@ -31,7 +31,7 @@ fn frac(v: f64) -> String {
 
 /// One table cell: a patch of `lab` and its numbers (and ΔE00 to the
 /// target, when given).
-fn patch(obs: &Observer, lab: [f64; 3], de00: Option<(f64, Option<f64>)>) -> String {
+pub(crate) fn patch(obs: &Observer, lab: [f64; 3], de00: Option<(f64, Option<f64>)>) -> String {
     let m = map_lab(obs, lab);
     let [r, g, b] = m.srgb8;
     let de = match de00 {
@@ -53,6 +53,19 @@ fn patch(obs: &Observer, lab: [f64; 3], de00: Option<(f64, Option<f64>)>) -> Str
     )
 }
 
+/// The page's head, style and title for the match `name`.
+pub(crate) fn head(name: &str) -> String {
+    format!(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>match {0}</title>\n\
+         <style>body{{font-family:sans-serif;margin:2em;max-width:110em}}\
+         table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #bbb;\
+         padding:4px 8px;vertical-align:top}}.patch{{width:7em;height:4em;margin-bottom:4px;\
+         color:#fff;font-weight:bold}}img{{max-width:100%}}</style></head><body>\n\
+         <h1>Match <code>{0}</code></h1>\n",
+        esc(name)
+    )
+}
+
 /// The page's HTML; `spectra` is the figure's file name beside it.
 pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String {
     let obs = Observer::standard(spec.target.illuminant, spec.target.observer);
@@ -61,17 +74,11 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
         spec.target.illuminant.name(),
         spec.target.observer.name()
     );
-    let mut s = format!(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>match {}</title>\n\
-         <style>body{{font-family:sans-serif;margin:2em;max-width:110em}}\
-         table{{border-collapse:collapse;font-size:90%}}td,th{{border:1px solid #bbb;\
-         padding:4px 8px;vertical-align:top}}.patch{{width:7em;height:4em;margin-bottom:4px;\
-         color:#fff;font-weight:bold}}img{{max-width:100%}}</style></head><body>\n\
-         <h1>Match <code>{}</code></h1>\n<p>{}. Colours are CIELAB under {} (the target's \
+    let mut s = head(&spec.name);
+    s += &format!(
+        "<p>{}. Colours are CIELAB under {} (the target's \
          conditions); patches in sRGB, a <b>*</b> marks a colour outside the sRGB gamut drawn \
          at its edge with the same L* and hue. Tolerance {} ΔE00; fast model {}; objective {}.</p>\n",
-        esc(&spec.name),
-        esc(&spec.name),
         if r.reached() {
             "The best recipe is within the tolerance on the fast model".to_string()
         } else {

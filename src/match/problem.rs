@@ -23,6 +23,107 @@ pub struct Fit {
     pub spectral_rms: Option<f64>,
 }
 
+impl Fit {
+    /// The fit of a stacked CIELAB `lab` (3 per geometry) against the
+    /// stacked target `target`, without a spectrum.
+    pub fn of_lab(lab: &[f64], target: &[f64]) -> Fit {
+        let lab: Vec<[f64; 3]> = lab.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let de00 = lab
+            .iter()
+            .zip(target.chunks(3))
+            .map(|(l, t)| colour::delta_e2000(*l, [t[0], t[1], t[2]]))
+            .collect();
+        Fit {
+            lab,
+            de00,
+            spectral_rms: None,
+        }
+    }
+}
+
+/// What the search ([`super::search`]) and the uncertainty
+/// ([`super::uncertainty`]) ask of a matching problem, whatever its forward
+/// model: the optional colourants its subsets are drawn from, the bounds of
+/// a subset's unknowns, and the stacked CIELAB (3 per target geometry) of
+/// a subset's unknowns `x`. [`Problem`] is a scene's layer on the
+/// Kubelka–Munk model; `super::effect::EffectProblem` an effect paint on
+/// the fast flake model.
+pub trait Inverse: Sync {
+    /// How many optional colourants the subsets are drawn from.
+    fn colourants(&self) -> usize;
+    /// Fewest colourants in a subset: 1, or 0 where some unknowns are in
+    /// every recipe (an effect paint's flakes).
+    fn fewest(&self) -> usize {
+        1
+    }
+    /// Whether `subset`'s least volume fractions fit the total.
+    fn feasible(&self, subset: &[usize]) -> bool;
+    /// Lower and upper bounds of `subset`'s unknowns.
+    fn bounds(&self, subset: &[usize]) -> (Vec<f64>, Vec<f64>);
+    /// Carry `subset`'s unknowns `x` (inside the box, lower bounds `lo`)
+    /// onto the feasible set.
+    fn project(&self, subset: &[usize], lo: &[f64], x: &mut [f64]);
+    fn objective(&self) -> Objective;
+    /// Whether a `de00` fit is polished by Nelder–Mead on ΔE00 itself.
+    fn polish(&self) -> bool {
+        self.objective() == Objective::De00
+    }
+    /// The relative lowering of the cost below which a least-squares fit
+    /// stops.
+    fn relative_tolerance(&self) -> f64 {
+        super::solve::DEFAULT_RELATIVE_TOLERANCE
+    }
+    /// 1σ noise of L*, a*, b*.
+    fn noise_lab(&self) -> [f64; 3];
+    /// The target's CIELAB, stacked.
+    fn target_stack(&self) -> Vec<f64>;
+    /// CIELAB of `subset`'s unknowns `x` in each target geometry, stacked.
+    fn lab_at(&self, subset: &[usize], x: &[f64]) -> Vec<f64>;
+    /// The residuals the least squares minimise: the CIELAB differences.
+    fn residuals_at(&self, subset: &[usize], x: &[f64]) -> Vec<f64> {
+        self.lab_at(subset, x)
+            .iter()
+            .zip(self.target_stack())
+            .map(|(a, b)| a - b)
+            .collect()
+    }
+    /// How `subset`'s unknowns `x` stand against the target.
+    fn fit_at(&self, subset: &[usize], x: &[f64]) -> Fit {
+        Fit::of_lab(&self.lab_at(subset, x), &self.target_stack())
+    }
+}
+
+/// `f` of the box of `subset`'s unknowns and its projection, as the
+/// solvers take them.
+pub fn with_bounds<P: Inverse + ?Sized, R>(
+    problem: &P,
+    subset: &[usize],
+    f: impl FnOnce(&Bounds) -> R,
+) -> R {
+    let (lo, hi) = problem.bounds(subset);
+    let project = |y: &mut [f64]| problem.project(subset, &lo, y);
+    f(&Bounds {
+        lo: &lo,
+        hi: &hi,
+        project: &project,
+    })
+}
+
+/// Carry the first `k` unknowns of `x` (volume fractions, lower bounds
+/// `lo`) down towards their lower bounds, in proportion, until their total
+/// is at most `max_total`.
+pub fn project_total(max_total: f64, k: usize, lo: &[f64], x: &mut [f64]) {
+    let total: f64 = x[..k].iter().sum();
+    if total <= max_total {
+        return;
+    }
+    let floor: f64 = lo[..k].iter().sum();
+    let t = ((max_total - floor) / (total - floor)).clamp(0.0, 1.0);
+    for (v, l) in x[..k].iter_mut().zip(lo) {
+        *v = l + (*v - l) * t;
+    }
+}
+
 /// Root-mean-square of per-geometry ΔE00 values.
 pub fn rms(de00: &[f64]) -> f64 {
     (de00.iter().map(|d| d * d).sum::<f64>() / de00.len().max(1) as f64).sqrt()
@@ -116,34 +217,7 @@ impl Problem {
     /// `f` of the box and the total volume fraction of `subset`'s unknowns,
     /// as the solvers take them.
     pub fn with_bounds<R>(&self, subset: &[usize], f: impl FnOnce(&Bounds) -> R) -> R {
-        let (lo, hi) = self.bounds(subset);
-        let k = subset.len();
-        let project = |y: &mut [f64]| self.project_total(k, &lo, y);
-        f(&Bounds {
-            lo: &lo,
-            hi: &hi,
-            project: &project,
-        })
-    }
-
-    /// Whether `subset`'s least volume fractions fit the total.
-    pub fn feasible(&self, subset: &[usize]) -> bool {
-        subset.iter().map(|&s| self.pvc_range[s][0]).sum::<f64>() <= self.max_total_pvc
-    }
-
-    /// Carry the fractions of `x` (the first `k`, with lower bounds `lo`)
-    /// down towards their lower bounds, in proportion, until their total is
-    /// at most the limit.
-    pub fn project_total(&self, k: usize, lo: &[f64], x: &mut [f64]) {
-        let total: f64 = x[..k].iter().sum();
-        if total <= self.max_total_pvc {
-            return;
-        }
-        let floor: f64 = lo[..k].iter().sum();
-        let t = ((self.max_total_pvc - floor) / (total - floor)).clamp(0.0, 1.0);
-        for (v, l) in x[..k].iter_mut().zip(lo) {
-            *v = l + (*v - l) * t;
-        }
+        with_bounds(self, subset, f)
     }
 
     /// The recipe of `subset`'s unknowns `x`.
@@ -220,6 +294,48 @@ impl Problem {
             de00,
             spectral_rms,
         }
+    }
+}
+
+impl Inverse for Problem {
+    fn colourants(&self) -> usize {
+        self.pvc_range.len()
+    }
+
+    fn feasible(&self, subset: &[usize]) -> bool {
+        subset.iter().map(|&s| self.pvc_range[s][0]).sum::<f64>() <= self.max_total_pvc
+    }
+
+    fn bounds(&self, subset: &[usize]) -> (Vec<f64>, Vec<f64>) {
+        Problem::bounds(self, subset)
+    }
+
+    fn project(&self, subset: &[usize], lo: &[f64], x: &mut [f64]) {
+        project_total(self.max_total_pvc, subset.len(), lo, x);
+    }
+
+    fn objective(&self) -> Objective {
+        self.objective
+    }
+
+    fn noise_lab(&self) -> [f64; 3] {
+        self.noise_lab
+    }
+
+    fn target_stack(&self) -> Vec<f64> {
+        Problem::target_stack(self)
+    }
+
+    fn lab_at(&self, subset: &[usize], x: &[f64]) -> Vec<f64> {
+        self.lab_stack(&self.recipe(subset, x))
+    }
+
+    fn residuals_at(&self, subset: &[usize], x: &[f64]) -> Vec<f64> {
+        self.residuals(&self.recipe(subset, x))
+    }
+
+    fn fit_at(&self, subset: &[usize], x: &[f64]) -> Fit {
+        self.fit(&self.recipe(subset, x))
     }
 }
 

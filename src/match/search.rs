@@ -1,5 +1,6 @@
 //! The search: every subset of the palette of 1, 2, … up to
-//! `max_colourants` pigments whose least volume fractions fit the total,
+//! `max_colourants` pigments (0, 1, … where some unknowns are in every
+//! recipe, as an effect paint's flakes are) whose least volume fractions fit the total,
 //! fewest first; each subset's unknowns fitted from several starting
 //! points inside its bounds (the middle of the box, then a Halton sequence
 //! over it) by projected Levenberg–Marquardt ([`super::solve`]), a CIEDE2000
@@ -14,8 +15,8 @@
 use rayon::prelude::*;
 
 use super::config::Objective;
-use super::problem::{Fit, Problem};
-use super::solve::fit_and_polish;
+use super::problem::{with_bounds, Fit, Inverse};
+use super::solve::fit_and_polish_to;
 
 /// The best recipe found for one subset of the palette.
 #[derive(Debug, Clone)]
@@ -50,11 +51,15 @@ pub struct Outcome {
     pub evaluations: usize,
 }
 
-/// Subsets of `0..n` of size `k`, in lexicographic order.
+/// Subsets of `0..n` of size `k`, in lexicographic order (one, empty, of
+/// size 0).
 pub fn subsets(n: usize, k: usize) -> Vec<Vec<usize>> {
     let mut out = Vec::new();
     let mut cur: Vec<usize> = (0..k).collect();
-    if k == 0 || k > n {
+    if k == 0 {
+        return vec![Vec::new()];
+    }
+    if k > n {
         return out;
     }
     loop {
@@ -98,20 +103,24 @@ fn start(s: usize, lo: &[f64], hi: &[f64]) -> Vec<f64> {
 }
 
 /// Fit one subset from `starts` starting points; its best recipe.
-pub fn fit_subset(problem: &Problem, subset: &[usize], starts: usize) -> Candidate {
-    problem.with_bounds(subset, |bounds| {
-        let residuals = |x: &[f64]| problem.residuals(&problem.recipe(subset, x));
-        let de00 = |x: &[f64]| problem.fit(&problem.recipe(subset, x)).de00_rms();
+pub fn fit_subset<P: Inverse + ?Sized>(problem: &P, subset: &[usize], starts: usize) -> Candidate {
+    with_bounds(problem, subset, |bounds| {
+        let residuals = |x: &[f64]| problem.residuals_at(subset, x);
+        let de00 = |x: &[f64]| problem.fit_at(subset, x).de00_rms();
         let mut best: Option<Candidate> = None;
         let mut evaluations = 0;
         for s in 0..starts {
-            let polish =
-                (problem.objective == Objective::De00).then_some(&de00 as super::solve::ScalarFn);
-            let (x, spent) =
-                fit_and_polish(&residuals, polish, &start(s, bounds.lo, bounds.hi), bounds);
+            let polish = problem.polish().then_some(&de00 as super::solve::ScalarFn);
+            let (x, spent) = fit_and_polish_to(
+                &residuals,
+                polish,
+                &start(s, bounds.lo, bounds.hi),
+                bounds,
+                problem.relative_tolerance(),
+            );
             evaluations += spent;
-            let fit = problem.fit(&problem.recipe(subset, &x));
-            let objective = match problem.objective {
+            let fit = problem.fit_at(subset, &x);
+            let objective = match problem.objective() {
                 Objective::SpectralRms => fit.spectral_rms.unwrap_or_else(|| fit.de00_rms()),
                 Objective::De00 => fit.de00_rms(),
             };
@@ -133,17 +142,17 @@ pub fn fit_subset(problem: &Problem, subset: &[usize], starts: usize) -> Candida
 
 /// Search the palette (module docs); `progress` hears one line per subset
 /// size.
-pub fn search(
-    problem: &Problem,
+pub fn search<P: Inverse + ?Sized>(
+    problem: &P,
     max_colourants: usize,
     starts: usize,
     tolerance_de00: f64,
     progress: &dyn Fn(&str),
 ) -> Outcome {
-    let n = problem.pvc_range.len();
+    let n = problem.colourants();
     let mut all: Vec<Candidate> = Vec::new();
     let (mut tried, mut largest) = (0, 0);
-    for k in 1..=max_colourants.min(n) {
+    for k in problem.fewest()..=max_colourants.min(n).max(problem.fewest()) {
         let sets: Vec<Vec<usize>> = subsets(n, k)
             .into_iter()
             .filter(|s| problem.feasible(s))

@@ -113,7 +113,22 @@ pub fn fit_and_polish(
     x0: &[f64],
     bounds: &Bounds,
 ) -> (Vec<f64>, usize) {
-    let m = levenberg_marquardt(residuals, x0, bounds, 200, 1e-14);
+    fit_and_polish_to(residuals, polish, x0, bounds, DEFAULT_RELATIVE_TOLERANCE)
+}
+
+/// The relative lowering of the cost below which Levenberg–Marquardt stops.
+pub const DEFAULT_RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// [`fit_and_polish`] with the Levenberg–Marquardt stopping when no step
+/// lowers the cost by more than `relative` of it.
+pub fn fit_and_polish_to(
+    residuals: &dyn Fn(&[f64]) -> Vec<f64>,
+    polish: Option<ScalarFn>,
+    x0: &[f64],
+    bounds: &Bounds,
+    relative: f64,
+) -> (Vec<f64>, usize) {
+    let m = levenberg_marquardt_to(residuals, x0, bounds, 200, 1e-14, relative);
     let (mut x, mut evaluations) = (m.x, m.evaluations);
     if let Some(f) = polish {
         if f(&x) > 1e-3 {
@@ -138,6 +153,26 @@ pub fn levenberg_marquardt(
     bounds: &Bounds,
     max_iterations: usize,
     cost_floor: f64,
+) -> Minimum {
+    levenberg_marquardt_to(
+        f,
+        x0,
+        bounds,
+        max_iterations,
+        cost_floor,
+        DEFAULT_RELATIVE_TOLERANCE,
+    )
+}
+
+/// [`levenberg_marquardt`] stopping when no step lowers the cost by more
+/// than `relative` of it.
+pub fn levenberg_marquardt_to(
+    f: &dyn Fn(&[f64]) -> Vec<f64>,
+    x0: &[f64],
+    bounds: &Bounds,
+    max_iterations: usize,
+    cost_floor: f64,
+    relative: f64,
 ) -> Minimum {
     let n = x0.len();
     let mut x = x0.to_vec();
@@ -177,7 +212,7 @@ pub fn levenberg_marquardt(
             evaluations += 1;
             let cn = sum_sq(&rn);
             if cn.is_finite() && cn < cost {
-                improved = cost - cn > 1e-12 * cost;
+                improved = cost - cn > relative * cost;
                 (x, r, cost) = (xn, rn, cn);
                 lambda = (lambda / 3.0).max(1e-12);
                 break;

@@ -17,7 +17,7 @@
 //! propagation ignores the bounds: an unknown at a bound is reported as
 //! such.
 
-use super::problem::Problem;
+use super::problem::Inverse;
 use super::solve::{inverse, jacobian, normal_matrix, Bounds};
 
 /// Correlation beyond which two unknowns are not told apart.
@@ -40,8 +40,8 @@ pub struct Uncertainty {
 }
 
 /// The uncertainty of `subset`'s unknowns `x`; `names` names them.
-pub fn uncertainty(
-    problem: &Problem,
+pub fn uncertainty<P: Inverse + ?Sized>(
+    problem: &P,
     subset: &[usize],
     x: &[f64],
     names: &[String],
@@ -53,10 +53,10 @@ pub fn uncertainty(
         hi: &hi,
         project: &identity,
     };
-    let lab = |y: &[f64]| problem.lab_stack(&problem.recipe(subset, y));
+    let lab = |y: &[f64]| problem.lab_at(subset, y);
     let j = jacobian(&lab, x, &bounds);
     let w: Vec<f64> = (0..j.len())
-        .map(|i| 1.0 / problem.noise_lab[i % 3].powi(2))
+        .map(|i| 1.0 / problem.noise_lab()[i % 3].powi(2))
         .collect();
     let n = x.len();
     let mut flags = vec![String::new(); n];

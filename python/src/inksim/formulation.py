@@ -55,7 +55,10 @@ class MatchResult:
     - ``target``: the target's CIELAB per geometry and its noise;
     - ``palette``: the pigments and their PVC bounds;
     - ``recipes``: every recipe's PVC per pigment, thickness and ΔE00 per
-      geometry, on a ``recipe`` axis (0 the best);
+      geometry, on a ``recipe`` axis (0 the best); for an effect paint
+      (``attrs["kind"] == "effect"``) its flake ``concentration`` and
+      ``coating_nm`` per ``flake_layer``, ``de00_se`` and ``flop_index``,
+      with the target's ``flop_index`` in ``target.attrs``;
     - ``recipe(i)``: recipe ``i``'s unknowns with standard errors,
       correlations and flags, its CIELAB and reflectance factor;
     - ``verified``: with ``[match.verify]``, one dataset per verified recipe
@@ -101,8 +104,17 @@ class MatchResult:
         lines = [f"<inksim.MatchResult {os.path.basename(self.path)}: {len(self)} recipe(s), "
                  f"objective {self.attrs.get('objective')}, reached {bool(self.attrs.get('reached'))}>"]
         for i in range(len(self)):
-            pvc = self.recipes["pvc"].isel(recipe=i)
-            used = ", ".join(f"{p} {float(v):.4f}" for p, v in zip(pvc["pigment"].values, pvc.values) if v > 0)
+            parts = []
+            if "pvc" in self.recipes:
+                pvc = self.recipes["pvc"].isel(recipe=i)
+                parts += [f"{p} {float(v):.4f}" for p, v in zip(pvc["pigment"].values, pvc.values) if v > 0]
+            if "concentration" in self.recipes:  # an effect paint's flakes
+                c = self.recipes["concentration"].isel(recipe=i)
+                t = self.recipes["coating_nm"].isel(recipe=i)
+                for layer, cv, tv in zip(c["flake_layer"].values, c.values, t.values):
+                    parts.append(f"{layer} flakes {float(cv):.4f}"
+                                 + ("" if np.isnan(tv) else f", coating {float(tv):.1f} nm"))
+            used = ", ".join(parts)
             de = self.recipes["de00"].isel(recipe=i).values
             lines.append(f"  {i}: {used}; ΔE00 {', '.join(f'{x:.2f}' for x in de)}")
         return "\n".join(lines)

@@ -82,7 +82,7 @@ mod tests {
             .unwrap();
         let fds = format!("/proc/{}/fd", child.id());
         let holds = || {
-            std::fs::read_dir(&fds).map_or(false, |entries| {
+            std::fs::read_dir(&fds).is_ok_and(|entries| {
                 entries
                     .flatten()
                     .any(|e| std::fs::read_link(e.path()).is_ok_and(|t| t == path))

@@ -133,6 +133,8 @@ pub const MAX_STEPS: usize = 10;
 #[derive(Debug, Clone)]
 pub struct MatchSpec {
     pub path: PathBuf,
+    /// The file's text as checked (embedded in the result file).
+    pub text: String,
     pub name: String,
     pub output_dir: PathBuf,
     pub target: Target,
@@ -316,6 +318,7 @@ impl MatchSpec {
             output_names(path, "match", raw.settings.name, raw.settings.output_dir)?;
         let spec = MatchSpec {
             path: path.to_path_buf(),
+            text: text.to_string(),
             name,
             output_dir,
             target,

@@ -66,6 +66,8 @@ pub struct PigmentUnknown {
 #[derive(Debug, Clone)]
 pub struct EffectSpec {
     pub path: PathBuf,
+    /// The file's text as checked (embedded in the result file).
+    pub text: String,
     pub name: String,
     pub output_dir: PathBuf,
     pub target: AngleTarget,
@@ -151,6 +153,7 @@ impl EffectSpec {
             output_names(path, "match", raw.settings.name, raw.settings.output_dir)?;
         Ok(EffectSpec {
             path: path.to_path_buf(),
+            text: text.to_string(),
             name,
             output_dir,
             target,

@@ -66,11 +66,11 @@ fn strings(xs: &[String]) -> hdf5::Result<Vec<VarLenUnicode>> {
 
 fn write_h5(spec: &EffectSpec, r: &EffectReport, path: &Path) -> hdf5::Result<()> {
     let f = crate::output::h5::create(path)?;
-    let text = std::fs::read_to_string(&spec.path).unwrap_or_default();
+    let text = &spec.text;
     for (k, v) in [
         ("inksim_version", crate::VERSION),
         ("match_file", &spec.path.display().to_string()),
-        ("match_toml", &text),
+        ("match_toml", text.as_str()),
         ("kind", "effect"),
         ("model", "fast flake model (METHOD §10)"),
         ("objective", spec.search.objective.name()),

@@ -387,15 +387,18 @@ impl<'a> System<'a> {
     /// slab's field `u_s` (the coherent field of the homogenised layer, and
     /// the exact answer where the layer is homogeneous), else `u_bg`.
     pub fn set_start_field(&self, u: &mut Field) {
+        on_field!(u, u => self.fill_start(u))
+    }
+
+    /// [`Self::set_start_field`] in one storage.
+    pub fn fill_start<S: Storage>(&self, u: &mut Array3<S>) {
         let start = match self.shift.kind {
             Background::Mean => &self.shift.us,
             Background::Binder => &self.ubg,
         };
-        on_field!(u, u => {
-            for (j, mut slice) in u.outer_iter_mut().enumerate() {
-                slice.fill(Storage::store(start[j]));
-            }
-        })
+        for (j, mut slice) in u.outer_iter_mut().enumerate() {
+            slice.fill(S::store(start[j]));
+        }
     }
 
     /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)` (ε a tensor

@@ -141,12 +141,10 @@ fn solve_one(v: &Variant) -> Result<Pilot, String> {
     if entries.is_empty() {
         return Err("the pilot solved nothing".into());
     }
+    // The recorded applications, an `auto` solve's fallbacks included.
     let measured: f64 = entries
         .iter()
-        .map(|e| {
-            (e.record.iterations as f64 + 1.0)
-                * e.record.method.solver().applications_per_iteration()
-        })
+        .map(|e| e.record.operator_applications as f64)
         .sum();
     Ok(Pilot {
         variant: v.name.clone(),

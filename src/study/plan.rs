@@ -277,8 +277,12 @@ pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
         };
         files += 1;
         for e in &s.entries {
-            measured +=
-                (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
+            // The recorded applications count an `auto` solve's fallbacks;
+            // its iterations are the answering method's alone.
+            measured += e.operator_applications.map_or_else(
+                || (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration(),
+                |a| a as f64,
+            );
             assumed += default_applications(&v.scene) * wave_solves(&v.scene) as f64;
         }
     }

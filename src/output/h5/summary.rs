@@ -53,6 +53,9 @@ pub struct EntrySummary {
     pub energy_balance: f64,
     pub method: Method,
     pub iterations: u64,
+    /// Operator applications the solve cost, fallbacks and re-solves
+    /// included (None in a file written before it was recorded).
+    pub operator_applications: Option<u64>,
     pub residual: f64,
 }
 
@@ -139,6 +142,10 @@ pub fn read_summary(path: &Path) -> Result<ResultSummary, IoError> {
                 .attr("iterations")
                 .and_then(|a| a.read_scalar::<u64>())
                 .map_err(hdf)?,
+            operator_applications: g
+                .attr("operator_applications")
+                .and_then(|a| a.read_scalar::<u64>())
+                .ok(),
             residual: f("residual")?,
         });
     }

@@ -127,13 +127,23 @@ pub enum SolveError {
         residual: f64,
         window: usize,
     },
+    /// `auto` ran out of methods: what it tried, in order, with each
+    /// failure, then the last method's failure.
+    #[error("auto: {tried}; {last}")]
+    Exhausted {
+        tried: String,
+        /// Operator applications of every attempt.
+        applications: usize,
+        last: Box<SolveError>,
+    },
     #[error("invalid problem: {0}")]
     Invalid(String),
 }
 
 impl SolveError {
     /// Operator applications a failed solve spent (its iterations × its
-    /// method's applications per iteration); none for an invalid problem.
+    /// method's applications per iteration; every attempt of an exhausted
+    /// `auto`); none for an invalid problem.
     pub fn applications(&self) -> usize {
         match *self {
             SolveError::Diverged {
@@ -147,6 +157,7 @@ impl SolveError {
             } => {
                 (iterations as f64 * method.solver().applications_per_iteration()).round() as usize
             }
+            SolveError::Exhausted { applications, .. } => applications,
             SolveError::Invalid(_) => 0,
         }
     }

@@ -68,7 +68,7 @@ impl Solver for Auto {
                 }
             }
         }
-        let mut last_err = None;
+        let methods = chain.len();
         for (i, (m, background)) in chain.into_iter().enumerate() {
             if let Some(bg) = background {
                 sys.use_background(bg);
@@ -95,14 +95,20 @@ impl Solver for Auto {
                     o.note = format!("auto: {}", notes.join("; "));
                     return Ok(o);
                 }
-                Err(e) => {
+                Err(e) if i + 1 < methods => {
                     spent += e.applications();
                     notes.push(format!("{e}; falling back"));
-                    last_err = Some(e);
+                }
+                Err(e) => {
+                    return Err(SolveError::Exhausted {
+                        tried: notes.join("; "),
+                        applications: spent + e.applications(),
+                        last: Box::new(e),
+                    })
                 }
             }
         }
-        Err(last_err.expect("at least one method ran"))
+        unreachable!("the chain ends in time-marching, which returns")
     }
 }
 
@@ -147,16 +153,69 @@ mod tests {
     /// After a failure the next method goes on from the failed one's field
     /// where it is nearer the answer than the start field, and starts
     /// afresh from a field further away or not finite.
-    #[test]
-    fn a_fallback_goes_on_from_the_better_field() {
-        let lat = Problem::lattice([4, 4, 6], [400.0, 400.0, 300.0], 500.0, 20.0, 0.0);
-        let eps = Array3::from_shape_fn((6, 4, 4), |(k, j, i)| {
+    fn grains() -> Array3<C64> {
+        Array3::from_shape_fn((6, 4, 4), |(k, j, i)| {
             if (i + j + k) % 3 == 0 {
                 C64::new(3.0, 0.1)
             } else {
                 C64::new(2.25, 0.0)
             }
-        });
+        })
+    }
+
+    fn lattice() -> crate::solver::Lattice {
+        Problem::lattice([4, 4, 6], [400.0, 400.0, 300.0], 500.0, 20.0, 0.0)
+    }
+
+    /// When every method fails, the error says what each reached, in
+    /// order, and counts every attempt's applications.
+    #[test]
+    fn an_exhausted_auto_says_what_it_tried() {
+        let eps = grains();
+        let p = Problem {
+            tensor: None,
+            lattice: lattice(),
+            eps: &eps,
+            eps_binder: 2.25,
+            wave: Wave::Scalar,
+        };
+        let ctl = Controls {
+            tolerance: 1e-12,
+            max_iterations: 3,
+            precision: Precision::F64,
+            background: Background::Mean,
+        };
+        let Err(e) = crate::solver::solve(&p, Method::Auto, &ctl) else {
+            panic!("3 iterations cannot reach 1e-12");
+        };
+        let SolveError::Exhausted {
+            tried,
+            applications,
+            last,
+        } = &e
+        else {
+            panic!("expected an exhausted auto, got {e}");
+        };
+        assert_eq!(tried.matches("falling back").count(), 2, "{tried}");
+        assert!(tried.contains("bicgstab again"), "{tried}");
+        assert!(
+            matches!(
+                **last,
+                SolveError::NotConverged {
+                    method: Method::TimeMarching,
+                    ..
+                }
+            ),
+            "{last}"
+        );
+        assert!(*applications > last.applications() + 12, "{applications}");
+        assert!(e.to_string().starts_with("auto: "), "{e}");
+    }
+
+    #[test]
+    fn a_fallback_goes_on_from_the_better_field() {
+        let lat = lattice();
+        let eps = grains();
         let p = Problem {
             tensor: None,
             lattice: lat,

@@ -330,8 +330,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     let (mut measured, mut assumed) = (0.0, 0.0);
     for v in &three.variants {
         for e in &got[&v.name].entries {
-            measured +=
-                (e.iterations as f64 + 1.0) * e.method.solver().applications_per_iteration();
+            measured += e.operator_applications.expect("recorded") as f64;
             assumed += inksim::study::plan::default_applications(&v.scene);
         }
     }
@@ -340,7 +339,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     assert!(
         ok && plan2.contains(&format!(
             "× {blended:.2}: the 4 finished result(s) of this study needed {r:.2}× the \
-             assumed rates, averaged with 1× counted as 5 results"
+             assumed rates, averaged with 1× counted as 5 result(s)"
         )),
         "{plan2}"
     );

@@ -20,8 +20,8 @@
 //! and, on the mean background, whether its top is flat — relief, conformal
 //! films and rough surfaces need 3–6× more); once results of this study are
 //! finished, every rate is scaled by what they needed against what was
-//! assumed for them (iterations + 1 times the method's applications per
-//! iteration, from the solver's registry), the assumption counting as
+//! assumed for them (the operator applications each solve recorded), the
+//! assumption counting as
 //! [`PRIOR_RESULTS`] results: a study's axes often run from easy to hard
 //! (small grains first), so its first results are a biased sample (100 nm
 //! spheres take a third of the applications of 450 nm ones); closed-form
@@ -109,6 +109,13 @@ pub fn wave_solves(scene: &Scene) -> usize {
 /// How many finished results the background's measured rate counts as
 /// when it is averaged with them ([`calibrate`]).
 pub const PRIOR_RESULTS: f64 = 5.0;
+
+/// How many finished results a high-contrast group's pilot counts as: one.
+/// It is one solve of one member, and the members differ more than that
+/// between each other (rutile in Maxwell's equations: the pilot, d250 at
+/// 15 %, 1042 applications per solve; the finished d100 variants at 15 %
+/// and 5 %, 2051 and 3432).
+pub const PILOT_RESULTS: f64 = 1.0;
 
 /// Seconds per solve of a closed-form (homogeneous) layer: no grid, no
 /// iteration. Measured: the standard profile's red_pvc30_mol, 176 solves
@@ -320,7 +327,7 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
             let p = pilot::measure(key, rep);
             let prior = p.as_ref().map_or(1.0, |p| p.applications / assumed);
             let (ratio, source) = blend(
-                prior,
+                (prior, PILOT_RESULTS),
                 measured(Some(key.clone())),
                 "the pilot's factor",
                 "group",
@@ -342,7 +349,7 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
              \"The standard study\")"
                 .to_string(),
         ),
-        done => blend(1.0, done, "1×", "study"),
+        done => blend((1.0, PRIOR_RESULTS), done, "1×", "study"),
     };
     Calibration {
         grids,
@@ -353,14 +360,20 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
 }
 
 /// A prior factor averaged with the finished results' (`done`: factor and
-/// results counted), the prior counting as [`PRIOR_RESULTS`] results.
-fn blend(prior: f64, done: Option<(f64, usize)>, prior_name: &str, whose: &str) -> (f64, String) {
+/// results counted), the prior (`factor`, `weight`) counting as `weight`
+/// results.
+fn blend(
+    (prior, weight): (f64, f64),
+    done: Option<(f64, usize)>,
+    prior_name: &str,
+    whose: &str,
+) -> (f64, String) {
     match done {
         Some((r, files)) => (
-            (PRIOR_RESULTS * prior + files as f64 * r) / (PRIOR_RESULTS + files as f64),
+            (weight * prior + files as f64 * r) / (weight + files as f64),
             format!(
                 "the {files} finished result(s) of this {whose} needed {r:.2}× the assumed \
-                 rates, averaged with {prior_name} counted as {PRIOR_RESULTS} results"
+                 rates, averaged with {prior_name} counted as {weight} result(s)"
             ),
         ),
         None => (prior, format!("{prior_name}, no finished result yet")),

@@ -22,11 +22,13 @@
 //!
 //! Shared by the packers and the statistics: `cells` (the one cell grid and
 //! its storages), `periodic` (wrapping and nearest periodic images) and
-//! `vec3` (3-vector helpers).
+//! `vec3` (3-vector helpers). `normal`: the standard normal deviate every
+//! stage draws.
 
 mod cells;
 mod dynamics;
 pub mod mc;
+pub mod normal;
 mod periodic;
 mod rsa;
 mod shapes;

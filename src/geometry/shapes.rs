@@ -296,9 +296,7 @@ impl SizeDistribution {
             SizeDistribution::Normal { sigma } | SizeDistribution::LogNormal { sigma } => sigma,
         };
         let z = loop {
-            let u1: f64 = 1.0 - rng.gen::<f64>(); // (0, 1]
-            let u2: f64 = rng.gen();
-            let z = (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos();
+            let z = super::normal::standard_normal(rng);
             if z.abs() <= Self::TRUNCATION {
                 break z;
             }

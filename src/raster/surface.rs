@@ -18,9 +18,10 @@
 //!   spectrum of the correlation `σ² e^{−r²/ℓ²}`, then shifted to zero mean
 //!   and scaled to RMS `σ` exactly, heights limited to `±ROUGH_LIMIT σ`.
 
+use crate::geometry::normal::standard_normal;
 use ndarray::{Array2, Array3};
 use num_complex::Complex64;
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rustfft::FftPlanner;
 
@@ -95,16 +96,9 @@ pub fn rough(grid: &Grid, rms_nm: f64, correlation_nm: f64, seed: u64) -> Array2
     let (nx, ny) = (grid.nx, grid.ny);
     let [lx, ly, _] = grid.size_nm;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-    // White noise, Box–Muller.
+    // White noise.
     let mut field: Vec<Complex64> = (0..nx * ny)
-        .map(|_| {
-            let u: f64 = 1.0 - rng.gen::<f64>();
-            let v: f64 = rng.gen();
-            Complex64::new(
-                (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos(),
-                0.0,
-            )
-        })
+        .map(|_| Complex64::new(standard_normal(&mut rng), 0.0))
         .collect();
     let mut planner = FftPlanner::new();
     let (fx, fy) = (planner.plan_fft_forward(nx), planner.plan_fft_forward(ny));

@@ -13,9 +13,10 @@
 //! the difference, for one at the target about the noise's own size in
 //! ΔE00.
 
+use crate::geometry::normal::standard_normal as normal;
 use std::time::Instant;
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use crate::optics::colour::delta_e2000;
@@ -129,13 +130,6 @@ pub fn run(spec: &EffectSpec, progress: &dyn Fn(&str)) -> Result<EffectReport, M
         evaluations: outcome.evaluations,
         seconds: start.elapsed().as_secs_f64(),
     })
-}
-
-/// A standard normal draw (Box–Muller, one of the pair).
-fn normal(rng: &mut Xoshiro256PlusPlus) -> f64 {
-    let u: f64 = rng.gen_range(f64::EPSILON..1.0);
-    let v: f64 = rng.gen();
-    (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
 }
 
 /// The standard error of ΔE00 from `lab` to a target `target` measured

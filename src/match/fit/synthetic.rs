@@ -6,7 +6,8 @@
 //! the example (configs/fit-red.toml): a fit of such spectra must give the
 //! material's constants back within their standard errors.
 
-use rand::{Rng, SeedableRng};
+use crate::geometry::normal::standard_normal as gaussian;
+use rand::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -19,13 +20,6 @@ use super::super::config::read_text;
 use super::super::MatchError;
 use super::config::FitSpec;
 use super::model::DrawdownModel;
-
-/// A standard normal deviate (Box–Muller).
-fn gaussian(rng: &mut impl Rng) -> f64 {
-    let u: f64 = 1.0 - rng.gen::<f64>();
-    let v: f64 = rng.gen();
-    (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
-}
 
 /// The spectrum files the fit file `path` names (relative to it), in
 /// drawdown order.

@@ -14,6 +14,7 @@
 //! row order: the same seed gives the same texture.
 
 use super::montecarlo::poisson;
+use crate::geometry::normal::standard_normal as normal;
 use rand::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::f64::consts::PI;
@@ -65,13 +66,6 @@ pub fn glint_factor(
     let flux = flake_um2 * 1e-6 * (0.5 * theta_t).cos() / theta_t.cos();
     let cone = lacquer * lacquer * PI * (2.0 * acceptance_rad).powi(2);
     PI * transmission * flux / (cone * cell_mm2)
-}
-
-/// A normal draw by Box–Muller (one of the pair).
-fn normal(rng: &mut impl Rng) -> f64 {
-    let u: f64 = 1.0 - rng.gen::<f64>();
-    let v: f64 = rng.gen();
-    (-2.0 * u.ln()).sqrt() * (2.0 * PI * v).cos()
 }
 
 /// A diameter of the population, redrawn until positive.

@@ -443,6 +443,14 @@ fn command_writes_recipes() {
         "{stderr}"
     );
     let csv = std::fs::read_to_string(out.join("match-red-tint-recipes.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .contains(",de00 d/8 SCI,de00_se d/8 SCI,L* d/8 SCI,"),
+        "{csv}"
+    );
+    assert!(stdout.contains(" ± "), "{stdout}");
     let row = csv.lines().nth(1).unwrap();
     assert!(row.starts_with("1,2,1,\"red "), "{row}");
     assert!(row.contains("; rutile "), "{row}");

@@ -46,6 +46,9 @@ def test_recipes_on_their_axes(match):
     r = match.recipes
     assert r["pvc"].dims == ("recipe", "pigment")
     assert r["de00"].dims == ("recipe", "geometry")
+    # Each ΔE00 with its standard error from the target's noise (0.05 per L*, a*, b*).
+    assert r["de00_se"].dims == ("recipe", "geometry")
+    assert np.all((r["de00_se"].values > 0.0) & (r["de00_se"].values < 0.2))
     assert list(r["geometry"].values) == list(match.target["geometry"].values)
     assert r["thickness_nm"].attrs["units"] == "nm"
     assert len(match) == r.sizes["recipe"]

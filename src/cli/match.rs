@@ -147,8 +147,8 @@ fn print_report(spec: &MatchSpec, r: &MatchReport) {
         let de: Vec<String> = r
             .target_lab
             .iter()
-            .zip(&x.candidate.fit.de00)
-            .map(|((m, _), d)| format!("{d:.3} ΔE00 at {}", m.name()))
+            .zip(x.candidate.fit.de00.iter().zip(&x.de00_se))
+            .map(|((m, _), (d, se))| format!("{d:.3} ± {se:.3} ΔE00 at {}", m.name()))
             .collect();
         let mi: Vec<String> = x
             .metamerism

@@ -78,7 +78,7 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
     s += &format!(
         "<p>{}. Colours are CIELAB under {} (the target's \
          conditions); patches in sRGB, a <b>*</b> marks a colour outside the sRGB gamut drawn \
-         at its edge with the same L* and hue. Tolerance {} ΔE00; fast model {}; objective {}.</p>\n",
+         at its edge with the same L* and hue. ΔE00 ± its standard error from the target's noise (the fast recipes) or from the realisations (the wave colours). Tolerance {} ΔE00; fast model {}; objective {}.</p>\n",
         if r.reached() {
             "The best recipe is within the tolerance on the fast model".to_string()
         } else {
@@ -123,7 +123,7 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
             s += &patch(
                 &obs,
                 x.candidate.fit.lab[g],
-                Some((x.candidate.fit.de00[g], None)),
+                Some((x.candidate.fit.de00[g], Some(x.de00_se[g]))),
             );
         }
         for v in &r.verified {

@@ -22,7 +22,7 @@ use super::config::MatchSpec;
 use super::forward::{FastModel, Recipe};
 use super::problem::Problem;
 use super::search::{search, Candidate};
-use super::uncertainty::{uncertainty, Uncertainty};
+use super::uncertainty::{de00_se, uncertainty, Uncertainty};
 use super::verify::{self, Verification};
 use super::MatchError;
 
@@ -42,6 +42,9 @@ pub struct RecipeReport {
     pub metamerism: Vec<(TestSource, Metamerism)>,
     /// Reflectance factor in the target's first geometry, on the grid.
     pub factor: Vec<f64>,
+    /// Standard error of each geometry's ΔE00 from the target's noise
+    /// ([`super::uncertainty::de00_se`]).
+    pub de00_se: Vec<f64>,
 }
 
 impl RecipeReport {
@@ -233,8 +236,17 @@ fn recipe_report(
         }
         None => Vec::new(),
     };
+    let target = problem.target_stack();
+    let de00_se = c
+        .fit
+        .lab
+        .iter()
+        .zip(target.chunks(3))
+        .map(|(l, t)| de00_se(*l, [t[0], t[1], t[2]], problem.noise_lab))
+        .collect();
     Ok(RecipeReport {
         rank,
+        de00_se,
         uncertainty: uncertainty(problem, &c.subset, &c.x, &unknowns),
         reached: c.reaches(spec.search.tolerance_de00),
         candidate: c.clone(),

@@ -16,6 +16,20 @@
 //! correlation matrix (1-norm), free of the unknowns' units. The first-order
 //! propagation ignores the bounds: an unknown at a bound is reported as
 //! such.
+//!
+//! **ΔE00's standard error.** The same noise makes the ΔE00 between a
+//! recipe's colour and the measured target uncertain. Its standard error
+//! per geometry ([`de00_se`]) is the standard deviation of ΔE00 from the
+//! recipe's colour to the target drawn with that noise ([`DE00_DRAWS`]
+//! normal draws of a fixed seed): for a recipe far from the target about
+//! the noise projected on the difference, for one at the target about the
+//! noise's own size in ΔE00.
+
+use rand::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use crate::geometry::normal::standard_normal;
+use crate::optics::colour::delta_e2000;
 
 use super::problem::Inverse;
 use super::solve::{inverse, jacobian, normal_matrix, Bounds};
@@ -24,6 +38,23 @@ use super::solve::{inverse, jacobian, normal_matrix, Bounds};
 pub const MAX_CORRELATION: f64 = 0.95;
 /// Relative standard error beyond which an unknown is not pinned down.
 pub const MAX_RELATIVE_SE: f64 = 0.5;
+
+/// Draws of the target's noise behind each ΔE00's standard error.
+pub const DE00_DRAWS: usize = 512;
+
+/// The standard error of ΔE00 from `lab` to a target `target` measured
+/// with noise `sigma` (module docs).
+pub fn de00_se(lab: [f64; 3], target: [f64; 3], sigma: [f64; 3]) -> f64 {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x0de0_0e5e);
+    let d: Vec<f64> = (0..DE00_DRAWS)
+        .map(|_| {
+            let t = [0, 1, 2].map(|c| target[c] + sigma[c] * standard_normal(&mut rng));
+            delta_e2000(lab, t)
+        })
+        .collect();
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (d.len() - 1) as f64).sqrt()
+}
 
 /// The uncertainty of one recipe's unknowns.
 #[derive(Debug, Clone)]
@@ -117,4 +148,24 @@ fn one_norm(m: &crate::optics::baseline::matrix::Matrix, n: usize) -> f64 {
     (0..n)
         .map(|c| (0..n).map(|r| m[(r, c)].abs()).sum::<f64>())
         .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without noise ΔE00 is exact; for a lightness difference alone, noise
+    /// in L* moves ΔE00 = ΔL*/S_L by σ/S_L (CIEDE2000's S_L at the mean
+    /// L* of 55: 1 + 0.015·25/√45), and noise across the difference hardly
+    /// at all.
+    #[test]
+    fn de00_standard_error_follows_the_noise_along_the_difference() {
+        let (lab, target) = ([60.0, 0.0, 0.0], [50.0, 0.0, 0.0]);
+        assert!(de00_se(lab, target, [0.0; 3]) < 1e-12);
+        let s_l = 1.0 + 0.015 * 25.0 / 45f64.sqrt();
+        let along = de00_se(lab, target, [0.5, 0.0, 0.0]);
+        assert!((along / (0.5 / s_l) - 1.0).abs() < 0.1, "{along}");
+        let across = de00_se(lab, target, [0.0, 0.5, 0.5]);
+        assert!(across < 0.1 * along, "{across} {along}");
+    }
 }

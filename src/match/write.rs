@@ -211,6 +211,8 @@ fn write_h5(spec: &MatchSpec, r: &MatchReport, path: &Path) -> hdf5::Result<()> 
             &[RECIPE, GEOMETRY],
         ),
     )?;
+    let se = Array2::from_shape_fn((n, geoms.len()), |(i, k)| r.recipes[i].de00_se[k]);
+    sc.write(&g, "de00_se", se.view(), about("1", "standard error of each ΔE00 from the target's measurement noise (docs/MATCH.md); recipe × geometry", &[RECIPE, GEOMETRY]))?;
     let reached: Vec<u8> = r.recipes.iter().map(|x| u8::from(x.reached)).collect();
     sc.write(&g, "reached", &reached[..], about("1", "1 where every geometry is within the tolerance, 0 where the recipe is only the closest reachable; recipe", &[RECIPE]))?;
     for x in &r.recipes {
@@ -315,7 +317,7 @@ pub fn recipes_csv(spec: &MatchSpec, r: &MatchReport) -> String {
     let geoms: Vec<&str> = r.target_lab.iter().map(|(m, _)| m.name()).collect();
     s.push_str("rank,colourants,reached,composition,thickness_nm");
     for g in &geoms {
-        let _ = write!(s, ",de00 {g},L* {g},a* {g},b* {g}");
+        let _ = write!(s, ",de00 {g},de00_se {g},L* {g},a* {g},b* {g}");
     }
     s.push_str(",spectral_rms");
     for t in super::report::TEST_SOURCES {
@@ -350,8 +352,8 @@ pub fn recipes_csv(spec: &MatchSpec, r: &MatchReport) -> String {
             let l = x.candidate.fit.lab[k];
             let _ = write!(
                 s,
-                ",{:.4},{:.3},{:.3},{:.3}",
-                x.candidate.fit.de00[k], l[0], l[1], l[2]
+                ",{:.4},{:.4},{:.3},{:.3},{:.3}",
+                x.candidate.fit.de00[k], x.de00_se[k], l[0], l[1], l[2]
             );
         }
         match x.candidate.fit.spectral_rms {

@@ -55,9 +55,10 @@ class MatchResult:
     - ``target``: the target's CIELAB per geometry and its noise;
     - ``palette``: the pigments and their PVC bounds;
     - ``recipes``: every recipe's PVC per pigment, thickness and ΔE00 per
-      geometry, on a ``recipe`` axis (0 the best); for an effect paint
+      geometry with its standard error from the target's noise
+      (``de00_se``), on a ``recipe`` axis (0 the best); for an effect paint
       (``attrs["kind"] == "effect"``) its flake ``concentration`` and
-      ``coating_nm`` per ``flake_layer``, ``de00_se`` and ``flop_index``,
+      ``coating_nm`` per ``flake_layer`` and ``flop_index``,
       with the target's ``flop_index`` in ``target.attrs``;
     - ``recipe(i)``: recipe ``i``'s unknowns with standard errors,
       correlations and flags, its CIELAB and reflectance factor;

@@ -4,33 +4,19 @@
 //! geometry with the standard error of each ΔE00, and its multi-angle
 //! colours and flop index.
 //!
-//! **ΔE00's standard error.** The target's L*, a*, b* carry independent
-//! noise σ (`target.noise_lab`), so the ΔE00 between a recipe's colour and
-//! the measured target is itself uncertain. Its standard error per
-//! geometry is the standard deviation of ΔE00 from the recipe's colour to
-//! the target drawn with that noise ([`DE00_DRAWS`] normal draws of a fixed
-//! seed): for a recipe far from the target about the noise projected on
-//! the difference, for one at the target about the noise's own size in
-//! ΔE00.
+//! Each ΔE00's standard error is the scene match's
+//! ([`super::super::uncertainty::de00_se`]).
 
-use crate::geometry::normal::standard_normal as normal;
 use std::time::Instant;
 
-use rand::SeedableRng;
-use rand_xoshiro::Xoshiro256PlusPlus;
-
-use crate::optics::colour::delta_e2000;
 use crate::optics::flakes::multiangle::{self, AngleColour, Geometry};
 
 use super::super::problem::Inverse;
 use super::super::search::{search, Candidate};
-use super::super::uncertainty::{uncertainty, Uncertainty};
+use super::super::uncertainty::{de00_se, uncertainty, Uncertainty};
 use super::super::MatchError;
 use super::config::EffectSpec;
 use super::problem::EffectProblem;
-
-/// Draws of the target's noise behind each ΔE00's standard error.
-pub const DE00_DRAWS: usize = 512;
 
 /// One reported recipe of an effect match.
 #[derive(Debug, Clone)]
@@ -130,20 +116,6 @@ pub fn run(spec: &EffectSpec, progress: &dyn Fn(&str)) -> Result<EffectReport, M
         evaluations: outcome.evaluations,
         seconds: start.elapsed().as_secs_f64(),
     })
-}
-
-/// The standard error of ΔE00 from `lab` to a target `target` measured
-/// with noise `sigma` (module docs).
-pub fn de00_se(lab: [f64; 3], target: [f64; 3], sigma: [f64; 3]) -> f64 {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(0x0de0_0e5e);
-    let d: Vec<f64> = (0..DE00_DRAWS)
-        .map(|_| {
-            let t = [0, 1, 2].map(|c| target[c] + sigma[c] * normal(&mut rng));
-            delta_e2000(lab, t)
-        })
-        .collect();
-    let mean = d.iter().sum::<f64>() / d.len() as f64;
-    (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (d.len() - 1) as f64).sqrt()
 }
 
 fn recipe_report(

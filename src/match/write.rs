@@ -86,7 +86,7 @@ pub fn write_outputs(
     })
 }
 
-fn strings(xs: &[String]) -> hdf5::Result<Vec<VarLenUnicode>> {
+pub(crate) fn strings(xs: &[String]) -> hdf5::Result<Vec<VarLenUnicode>> {
     xs.iter().map(|s| vlu(s)).collect()
 }
 
@@ -223,30 +223,48 @@ fn write_h5(spec: &MatchSpec, r: &MatchReport, path: &Path) -> hdf5::Result<()> 
     Ok(())
 }
 
-fn write_recipe(sc: &mut Scales, g: &Group, x: &super::report::RecipeReport) -> hdf5::Result<()> {
+/// What [`write_unknowns`] writes of a recipe, whatever its problem.
+pub(crate) struct RecipeUnknowns<'a> {
+    pub rank: usize,
+    pub reached: bool,
+    pub candidate: &'a super::search::Candidate,
+    pub unknowns: &'a [String],
+    pub uncertainty: &'a super::uncertainty::Uncertainty,
+}
+
+/// A recipe's group in the result file, as both kinds of match write it:
+/// its rank, whether it reached the tolerance, its objective and condition
+/// number (attributes); its unknowns (coordinate), their values, standard
+/// errors, correlation and flags; its CIELAB per target geometry. The
+/// `descriptions` of the unknowns, the values, the standard errors and the
+/// CIELAB name the problem's own unknowns and model.
+pub(crate) fn write_unknowns(
+    sc: &mut Scales,
+    g: &Group,
+    x: &RecipeUnknowns,
+    [unknowns, values, errors, lab]: [&str; 4],
+) -> hdf5::Result<()> {
     write_scalar_attr(g, "rank", x.rank as u64)?;
     write_scalar_attr(g, "reached", u8::from(x.reached))?;
     write_scalar_attr(g, "objective", x.candidate.objective)?;
-    if let Some(s) = x.candidate.fit.spectral_rms {
-        write_scalar_attr(g, "spectral_rms", s)?;
-    }
     if let Some(c) = x.uncertainty.condition {
         write_scalar_attr(g, "condition_number", c)?;
     }
     sc.forget(UNKNOWN);
-    sc.coordinate(g, "unknown", &strings(&x.unknowns)?, about("", "the recipe's unknowns: its pigments' volume fractions, then `thickness` (nm) when free; unknown", &[UNKNOWN]))?;
+    sc.coordinate(
+        g,
+        "unknown",
+        &strings(x.unknowns)?,
+        about("", unknowns, &[UNKNOWN]),
+    )?;
     sc.write(
         g,
         "value",
         &x.candidate.x[..],
-        about(
-            "",
-            "each unknown's value: volume fraction (1) or thickness (nm); unknown",
-            &[UNKNOWN],
-        ),
+        about("", values, &[UNKNOWN]),
     )?;
     if let (Some(se), Some(corr)) = (&x.uncertainty.se, &x.uncertainty.correlation) {
-        sc.write(g, "standard_error", &se[..], about("", "standard error of each unknown from the target's measurement noise (first-order propagation through the fast model's Jacobian), units of the unknown; unknown", &[UNKNOWN]))?;
+        sc.write(g, "standard_error", &se[..], about("", errors, &[UNKNOWN]))?;
         let k = corr.len();
         let c = Array2::from_shape_fn((k, k), |(a, b)| corr[a][b]);
         sc.write(
@@ -270,18 +288,37 @@ fn write_recipe(sc: &mut Scales, g: &Group, x: &super::report::RecipeReport) -> 
             &[UNKNOWN],
         ),
     )?;
-    let lab = Array2::from_shape_fn((x.candidate.fit.lab.len(), 3), |(a, b)| {
-        x.candidate.fit.lab[a][b]
-    });
+    let fit = &x.candidate.fit.lab;
+    let lab_of = Array2::from_shape_fn((fit.len(), 3), |(a, b)| fit[a][b]);
     sc.write(
         g,
         "lab",
-        lab.view(),
-        about(
-            "1",
+        lab_of.view(),
+        about("1", lab, &[GEOMETRY, dim::LAB]),
+    )?;
+    Ok(())
+}
+
+fn write_recipe(sc: &mut Scales, g: &Group, x: &super::report::RecipeReport) -> hdf5::Result<()> {
+    if let Some(s) = x.candidate.fit.spectral_rms {
+        write_scalar_attr(g, "spectral_rms", s)?;
+    }
+    write_unknowns(
+        sc,
+        g,
+        &RecipeUnknowns {
+            rank: x.rank,
+            reached: x.reached,
+            candidate: &x.candidate,
+            unknowns: &x.unknowns,
+            uncertainty: &x.uncertainty,
+        },
+        [
+            "the recipe's unknowns: its pigments' volume fractions, then `thickness` (nm) when free; unknown",
+            "each unknown's value: volume fraction (1) or thickness (nm); unknown",
+            "standard error of each unknown from the target's measurement noise (first-order propagation through the fast model's Jacobian), units of the unknown; unknown",
             "the recipe's CIELAB on the fast model; geometry × lab",
-            &[GEOMETRY, dim::LAB],
-        ),
+        ],
     )?;
     sc.write(
         g,

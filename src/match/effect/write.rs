@@ -9,15 +9,15 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use hdf5::types::VarLenUnicode;
 use hdf5::Group;
 use ndarray::Array2;
 
 use crate::optics::flakes::multiangle;
 use crate::output::atomic::{write_atomic, write_atomic_with};
-use crate::output::h5::{about, dim, vlu, write_scalar_attr, write_str_attr, IoError, Scales};
+use crate::output::h5::{about, dim, write_scalar_attr, write_str_attr, IoError, Scales};
 use crate::output::lock::OutputLock;
 
+use super::super::write::{strings, write_unknowns, RecipeUnknowns};
 use super::super::MatchError;
 use super::config::EffectSpec;
 use super::report::{EffectRecipe, EffectReport};
@@ -27,7 +27,6 @@ const GEOMETRY: &str = "geometry";
 const ANGLE: &str = "multi_angle_geometry";
 const PIGMENT: &str = "pigment";
 const FLAKES: &str = "flake_layer";
-const UNKNOWN: &str = "unknown";
 const BOUND: &str = "bound";
 
 /// The files written.
@@ -58,10 +57,6 @@ pub fn write_outputs(
     write_atomic(&page, super::page::html(spec, report).as_bytes())?;
     drop(lock);
     Ok(Written { h5, csv, page })
-}
-
-fn strings(xs: &[String]) -> hdf5::Result<Vec<VarLenUnicode>> {
-    xs.iter().map(|s| vlu(s)).collect()
 }
 
 fn write_h5(spec: &EffectSpec, r: &EffectReport, path: &Path) -> hdf5::Result<()> {
@@ -258,64 +253,25 @@ fn write_h5(spec: &EffectSpec, r: &EffectReport, path: &Path) -> hdf5::Result<()
 }
 
 fn write_recipe(sc: &mut Scales, g: &Group, x: &EffectRecipe) -> hdf5::Result<()> {
-    write_scalar_attr(g, "rank", x.rank as u64)?;
-    write_scalar_attr(g, "reached", u8::from(x.reached))?;
-    write_scalar_attr(g, "objective", x.candidate.objective)?;
-    if let Some(c) = x.uncertainty.condition {
-        write_scalar_attr(g, "condition_number", c)?;
-    }
     if let Some(fi) = x.flop_index {
         write_scalar_attr(g, "flop_index", fi)?;
     }
-    sc.forget(UNKNOWN);
-    sc.coordinate(g, "unknown", &strings(&x.unknowns)?, about("", "the recipe's unknowns: optional pigments' volume fractions (<layer>.<pigment> pvc), then per varied layer its flake concentration and coating thickness (nm); unknown", &[UNKNOWN]))?;
-    sc.write(
+    write_unknowns(
+        sc,
         g,
-        "value",
-        &x.candidate.x[..],
-        about(
-            "",
+        &RecipeUnknowns {
+            rank: x.rank,
+            reached: x.reached,
+            candidate: &x.candidate,
+            unknowns: &x.unknowns,
+            uncertainty: &x.uncertainty,
+        },
+        [
+            "the recipe's unknowns: optional pigments' volume fractions (<layer>.<pigment> pvc), then per varied layer its flake concentration and coating thickness (nm); unknown",
             "each unknown's value: volume fraction (1) or coating thickness (nm); unknown",
-            &[UNKNOWN],
-        ),
-    )?;
-    if let (Some(se), Some(corr)) = (&x.uncertainty.se, &x.uncertainty.correlation) {
-        sc.write(g, "standard_error", &se[..], about("", "standard error of each unknown from the target's measurement noise (first-order propagation through the fast flake model's Jacobian), units of the unknown; unknown", &[UNKNOWN]))?;
-        let k = corr.len();
-        let c = Array2::from_shape_fn((k, k), |(a, b)| corr[a][b]);
-        sc.write(
-            g,
-            "correlation",
-            c.view(),
-            about(
-                "1",
-                "correlation of the unknowns' errors; unknown × unknown",
-                &[UNKNOWN, UNKNOWN],
-            ),
-        )?;
-    }
-    sc.write(
-        g,
-        "flags",
-        &strings(&x.uncertainty.flags)?[..],
-        about(
-            "",
-            "why an unknown is not determined by the target (empty: it is); unknown",
-            &[UNKNOWN],
-        ),
-    )?;
-    let lab = Array2::from_shape_fn((x.candidate.fit.lab.len(), 3), |(a, b)| {
-        x.candidate.fit.lab[a][b]
-    });
-    sc.write(
-        g,
-        "lab",
-        lab.view(),
-        about(
-            "1",
+            "standard error of each unknown from the target's measurement noise (first-order propagation through the fast flake model's Jacobian), units of the unknown; unknown",
             "the recipe's CIELAB in each target geometry on the fast flake model; geometry × lab",
-            &[GEOMETRY, dim::LAB],
-        ),
+        ],
     )?;
     let all = Array2::from_shape_fn((x.colours.len(), 3), |(a, b)| x.colours[a].lab[b]);
     sc.write(

@@ -107,6 +107,32 @@ pub fn run(
 
 /// A number with four significant digits or so: fixed between 0.01 and
 /// 10⁵, scientific otherwise.
+/// The line above the recipes: whether the best one is within the
+/// tolerance, under the target's `conditions`.
+pub(super) fn print_heading(reached: bool, tolerance_de00: f64, conditions: &str) {
+    if reached {
+        println!("within {tolerance_de00} ΔE00 ({conditions}):");
+    } else {
+        println!(
+            "no recipe within {tolerance_de00} ΔE00; the closest reachable colour is recipe 1 ({conditions}):"
+        );
+    }
+}
+
+/// `name value ± se` of each unknown of a recipe (without `± se` where the
+/// standard errors are not known).
+pub(super) fn composition(unknowns: &[String], x: &[f64], se: Option<&[f64]>) -> Vec<String> {
+    unknowns
+        .iter()
+        .zip(x)
+        .enumerate()
+        .map(|(k, (n, &v))| match se {
+            Some(se) => format!("{n} {} ± {}", num(v), num(se[k])),
+            None => format!("{n} {}", num(v)),
+        })
+        .collect()
+}
+
 pub(super) fn num(v: f64) -> String {
     if v == 0.0 {
         "0".into()
@@ -123,27 +149,9 @@ fn print_report(spec: &MatchSpec, r: &MatchReport) {
         spec.target.illuminant.name(),
         spec.target.observer.name()
     );
-    if r.reached() {
-        println!("within {} ΔE00 ({conditions}):", spec.search.tolerance_de00);
-    } else {
-        println!(
-            "no recipe within {} ΔE00; the closest reachable colour is recipe 1 ({conditions}):",
-            spec.search.tolerance_de00
-        );
-    }
+    print_heading(r.reached(), spec.search.tolerance_de00, &conditions);
     for x in &r.recipes {
-        let parts: Vec<String> = x
-            .unknowns
-            .iter()
-            .enumerate()
-            .map(|(k, n)| {
-                let v = x.candidate.x[k];
-                match x.uncertainty.se.as_ref() {
-                    Some(se) => format!("{n} {} ± {}", num(v), num(se[k])),
-                    None => format!("{n} {}", num(v)),
-                }
-            })
-            .collect();
+        let parts = composition(&x.unknowns, &x.candidate.x, x.uncertainty.se.as_deref());
         let de: Vec<String> = r
             .target_lab
             .iter()

@@ -6,7 +6,7 @@ use anyhow::Result;
 use inksim::r#match::effect::{self, write, EffectReport, EffectSpec};
 use std::path::PathBuf;
 
-use super::r#match::{num, say};
+use super::r#match::{composition, print_heading, say};
 use super::ConfigFile;
 
 /// The checked effect match file.
@@ -101,28 +101,10 @@ fn print_report(spec: &EffectSpec, r: &EffectReport) {
         spec.target.illuminant.name(),
         spec.target.observer.name()
     );
-    if r.reached() {
-        println!("within {} ΔE00 ({conditions}):", spec.search.tolerance_de00);
-    } else {
-        println!(
-            "no recipe within {} ΔE00; the closest reachable colour is recipe 1 ({conditions}):",
-            spec.search.tolerance_de00
-        );
-    }
+    print_heading(r.reached(), spec.search.tolerance_de00, &conditions);
     println!("  target flop index {}", flop(r.target_flop_index));
     for x in &r.recipes {
-        let parts: Vec<String> = x
-            .unknowns
-            .iter()
-            .enumerate()
-            .map(|(k, n)| {
-                let v = x.candidate.x[k];
-                match x.uncertainty.se.as_ref() {
-                    Some(se) => format!("{n} {} ± {}", num(v), num(se[k])),
-                    None => format!("{n} {}", num(v)),
-                }
-            })
-            .collect();
+        let parts = composition(&x.unknowns, &x.candidate.x, x.uncertainty.se.as_deref());
         let de: Vec<String> = r
             .target
             .iter()

@@ -21,6 +21,17 @@ const PANEL: PanelSize = PanelSize { w: 560, h: 320 };
 
 /// A volume fraction as the page prints it: four decimals, or three
 /// significant digits below 0.001 (so a trace is not shown as 0.0000).
+/// A recipe's unknowns as `name value, …` (HTML-escaped), for its column's
+/// heading.
+pub(crate) fn unknowns_html(unknowns: &[String], x: &[f64]) -> String {
+    let parts: Vec<String> = unknowns
+        .iter()
+        .zip(x)
+        .map(|(n, v)| format!("{} {}", esc(n), frac(*v)))
+        .collect();
+    parts.join(", ")
+}
+
 pub(crate) fn frac(v: f64) -> String {
     if v != 0.0 && v.abs() < 1e-3 {
         format!("{v:.2e}")
@@ -93,16 +104,10 @@ pub fn html(spec: &MatchSpec, r: &MatchReport, spectra: Option<&str>) -> String 
     );
     s += "<h2>Target and recipes</h2>\n<table><tr><th>geometry</th><th>target</th>";
     for x in &r.recipes {
-        let parts: Vec<String> = x
-            .unknowns
-            .iter()
-            .zip(&x.candidate.x)
-            .map(|(n, v)| format!("{} {}", esc(n), frac(*v)))
-            .collect();
         s += &format!(
             "<th>recipe {} (fast model)<br><small>{}</small></th>",
             x.rank,
-            parts.join(", ")
+            unknowns_html(&x.unknowns, &x.candidate.x)
         );
     }
     for v in &r.verified {

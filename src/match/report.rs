@@ -50,12 +50,7 @@ pub struct RecipeReport {
 impl RecipeReport {
     /// `name: why` for every unknown the target does not determine.
     pub fn not_determined(&self) -> Vec<String> {
-        self.unknowns
-            .iter()
-            .zip(&self.uncertainty.flags)
-            .filter(|(_, f)| !f.is_empty())
-            .map(|(n, f)| format!("{n}: {f}"))
-            .collect()
+        self.uncertainty.not_determined(&self.unknowns)
     }
 }
 

@@ -70,6 +70,19 @@ pub struct Uncertainty {
     pub flags: Vec<String>,
 }
 
+impl Uncertainty {
+    /// `name: why` for every unknown (named by `unknowns`, in order) the
+    /// target does not determine.
+    pub fn not_determined(&self, unknowns: &[String]) -> Vec<String> {
+        unknowns
+            .iter()
+            .zip(&self.flags)
+            .filter(|(_, f)| !f.is_empty())
+            .map(|(n, f)| format!("{n}: {f}"))
+            .collect()
+    }
+}
+
 /// The uncertainty of `subset`'s unknowns `x`; `names` names them.
 pub fn uncertainty<P: Inverse + ?Sized>(
     problem: &P,

@@ -8,7 +8,7 @@
 use crate::optics::colour::Observer;
 use crate::output::html::escape as esc;
 
-use super::super::page::{frac, head, patch};
+use super::super::page::{head, patch, unknowns_html};
 use super::config::EffectSpec;
 use super::report::EffectReport;
 
@@ -39,16 +39,10 @@ pub fn html(spec: &EffectSpec, r: &EffectReport) -> String {
     );
     s += "<h2>Target and recipes</h2>\n<table><tr><th>geometry</th><th>target</th>";
     for x in &r.recipes {
-        let parts: Vec<String> = x
-            .unknowns
-            .iter()
-            .zip(&x.candidate.x)
-            .map(|(n, v)| format!("{} {}", esc(n), frac(*v)))
-            .collect();
         s += &format!(
             "<th>recipe {}<br><small>{}</small></th>",
             x.rank,
-            parts.join(", ")
+            unknowns_html(&x.unknowns, &x.candidate.x)
         );
     }
     s += "</tr>\n";

@@ -113,15 +113,7 @@ fn main() {
         let t = std::time::Instant::now();
         match method.run(&mut sys, &mut scr, &mut u, &ctl) {
             Ok(o) => {
-                let record = solver::SolveRecord {
-                    method: o.method,
-                    background: sys.background(),
-                    iterations: o.iterations,
-                    operator_applications: o.applications,
-                    residual: o.residual,
-                    seconds: t.elapsed().as_secs_f64(),
-                    note: o.note,
-                };
+                let record = o.record(sys.background(), t.elapsed().as_secs_f64());
                 let ff = efficiencies(&sys.into_solution(scr, u, record));
                 println!(
                     "| {label} | {margin} | {} | {} | {:.1} | {:.5} | {:.5} | {:.1e} |",

@@ -36,7 +36,7 @@ use inksim::raster::rasterize;
 use inksim::solver::methods::auto::Auto;
 use inksim::solver::methods::bicgstab::{BiCgStab, Shadow};
 use inksim::solver::methods::gmres::Gmres;
-use inksim::solver::{Controls, Field, Problem, ShiftParams, SolveRecord, Solver, System};
+use inksim::solver::{Controls, Field, Problem, ShiftParams, Solver, System};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::path::Path;
@@ -241,15 +241,7 @@ fn child(layer: &str, name: &str) {
                 .solver
                 .run(&mut sys, &mut scr, &mut u, &ctl)
                 .unwrap_or_else(|e| panic!("{layer} {name} {lambda} nm {polar}°: {e}"));
-            let record = SolveRecord {
-                method: o.method,
-                background: sys.background(),
-                iterations: o.iterations,
-                operator_applications: o.applications,
-                residual: o.residual,
-                seconds: 0.0,
-                note: o.note,
-            };
+            let record = o.record(sys.background(), 0.0);
             let f = efficiencies(&sys.into_solution(scr, u, record));
             println!(
                 "solve {lambda} {polar} {} {:e} {:e} {:e}",

@@ -75,7 +75,9 @@ pub use jones::Jones;
 pub use lattice::Lattice;
 pub use methods::{Outcome, Solver, Validity};
 pub use storage::{dot, Field, Storage};
-pub use system::{Scratch, ShiftParams, System, MEAN_LOSS_FLOOR, SHIFT_MARGIN};
+pub use system::{
+    Scratch, ShiftParams, System, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR, SHIFT_MARGIN,
+};
 
 /// What every solve records, stored beside its result.
 #[derive(Debug, Clone)]

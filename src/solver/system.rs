@@ -30,13 +30,26 @@ use num_complex::Complex64 as C64;
 /// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
 pub const SHIFT_MARGIN: f64 = 1.05;
 
-/// The mean background's loss floor: `Im ε_bg ≥ MEAN_LOSS_FLOOR · max|ε − ⟨ε⟩|²`.
+/// The mean background's loss floor in the scalar equation:
+/// `Im ε_bg ≥ MEAN_LOSS_FLOOR · max|ε − ⟨ε⟩|²`.
 /// A lossless mean slab has sharp guided resonances that Krylov methods
 /// resolve slowly; a loss growing with the square of the contrast (as the
 /// scattering loss of the coherent wave does) damps them where scattering is
 /// strong and leaves weak layers alone. 0.1 was the best of 0–0.25 on the
 /// layers of docs/PERFORMANCE.md ("The mean background").
 pub const MEAN_LOSS_FLOOR: f64 = 0.1;
+
+/// In Maxwell's equations the floor grows at most linearly with the
+/// contrast: `Im ε_bg ≥ min(MEAN_LOSS_FLOOR · r², MEAN_LOSS_CAP_MAXWELL · r)`,
+/// `r = max|ε − ⟨ε⟩|`. A grain's polarisability saturates there as its
+/// index grows (the local-field factor (ε − ε_m)/(ε + 2ε_m) tends to 1),
+/// so high-index grains damp the coherent wave far less than the square of
+/// the contrast says, and the scalar rule over-damps the background: on
+/// rutile layers the applications are 1.2–2.3× fewer at the cap than
+/// at `0.1 r²`, while layers of contrast below 1.5 (stand-ins, air
+/// under a relief) keep the scalar floor, which suits them
+/// (docs/PERFORMANCE.md, "High contrast: rutile in binder").
+pub const MEAN_LOSS_CAP_MAXWELL: f64 = 0.15;
 
 /// How the shifted form's background is chosen.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,15 +59,32 @@ pub struct ShiftParams {
     pub margin: f64,
     /// Mean: the loss floor factor, in [0, 100].
     pub mean_loss_floor: f64,
+    /// Mean: the floor is at most this times `max|ε − ⟨ε⟩|`, in [0, ∞]
+    /// (∞: no cap, the scalar equation's default).
+    pub mean_loss_cap: f64,
 }
 
 impl ShiftParams {
-    /// The defaults for `background`.
+    /// The defaults for `background` in the scalar equation.
     pub const fn of(background: Background) -> ShiftParams {
         ShiftParams {
             background,
             margin: SHIFT_MARGIN,
             mean_loss_floor: MEAN_LOSS_FLOOR,
+            mean_loss_cap: f64::INFINITY,
+        }
+    }
+
+    /// The defaults for `background` in the equation `wave` is solved in
+    /// (Maxwell's caps the loss floor: [`MEAN_LOSS_CAP_MAXWELL`]).
+    pub const fn for_wave(background: Background, wave: &Wave) -> ShiftParams {
+        let mean_loss_cap = match wave {
+            Wave::Scalar => f64::INFINITY,
+            Wave::Vector { .. } => MEAN_LOSS_CAP_MAXWELL,
+        };
+        ShiftParams {
+            mean_loss_cap,
+            ..ShiftParams::of(background)
         }
     }
 }
@@ -192,9 +222,10 @@ fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64) -> f64 {
 }
 
 impl<'a> System<'a> {
-    /// The system of `p` with the Krylov methods' background `bg`.
+    /// The system of `p` with the Krylov methods' background `bg` and the
+    /// defaults of its equation ([`ShiftParams::for_wave`]).
     pub fn new(p: &Problem<'a>, bg: Background) -> Result<Self, SolveError> {
-        Self::with_params(p, ShiftParams::of(bg))
+        Self::with_params(p, ShiftParams::for_wave(bg, &p.wave))
     }
 
     /// As [`System::new`] with other shift parameters: the CBS shift
@@ -211,6 +242,12 @@ impl<'a> System<'a> {
         if !(0.0..=100.0).contains(&floor) {
             return Err(SolveError::Invalid(format!(
                 "mean background loss floor must be in [0, 100], got {floor}"
+            )));
+        }
+        if params.mean_loss_cap.is_nan() || params.mean_loss_cap < 0.0 {
+            return Err(SolveError::Invalid(format!(
+                "mean background loss cap must be in [0, ∞], got {}",
+                params.mean_loss_cap
             )));
         }
         let lat = p.lattice;
@@ -669,7 +706,13 @@ impl Shift {
                     .fold(0.0, f64::max)
                     .sqrt()
                     .max(spread(eps, tensor, m));
-                let floor = params.mean_loss_floor * rad * rad;
+                // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
+                let cap = if rad > 0.0 {
+                    params.mean_loss_cap * rad
+                } else {
+                    0.0
+                };
+                let floor = (params.mean_loss_floor * rad * rad).min(cap);
                 (C64::new(m.re, m.im.max(floor).max(1e-9)), None)
             }
         };

@@ -41,7 +41,7 @@ use run_in_field_storage;
 use super::storage::Field;
 use super::system::{Scratch, System};
 use super::{Controls, Problem, Solution, SolveError, SolveRecord};
-use crate::config::{Method, Precision};
+use crate::config::{Background, Method, Precision};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::time::Instant;
@@ -80,6 +80,21 @@ pub struct Outcome {
     pub applications: usize,
     pub residual: f64,
     pub note: String,
+}
+
+impl Outcome {
+    /// The solve record of this outcome on `background`, `seconds` long.
+    pub fn record(&self, background: Background, seconds: f64) -> SolveRecord {
+        SolveRecord {
+            method: self.method,
+            background,
+            iterations: self.iterations,
+            operator_applications: self.applications,
+            residual: self.residual,
+            seconds,
+            note: self.note.clone(),
+        }
+    }
 }
 
 /// A solution method.
@@ -143,19 +158,10 @@ pub trait Solver: Sync {
             _ => sys.set_start_field(&mut u),
         }
         let out = self.run(&mut sys, &mut scr, &mut u, ctl)?;
-        let mut note = out.note;
+        let mut record = out.record(sys.background(), start.elapsed().as_secs_f64());
         if ctl.precision == Precision::F32 {
-            note.push_str("; f32 field storage");
+            record.note.push_str("; f32 field storage");
         }
-        let record = SolveRecord {
-            method: out.method,
-            background: sys.background(),
-            iterations: out.iterations,
-            operator_applications: out.applications,
-            residual: out.residual,
-            seconds: start.elapsed().as_secs_f64(),
-            note,
-        };
         Ok(sys.into_solution(scr, u, record))
     }
 }

@@ -169,8 +169,8 @@ pub(super) fn draw_grid(
             tiles.push(line);
         }
         let subtitle = format!(
-            "rows: {}, columns: {}; cells: {CARD_GEOMETRY} colour ± s.e.; \
-             corner mark: outside sRGB (C*ab reduced for display)",
+            "rows: {}, columns: {}; cells: colour ± s.e. at {CARD_GEOMETRY} (else the \
+             geometry each cell names); corner mark: outside sRGB (C*ab reduced for display)",
             pic.rows_axis, pic.cols_axis
         );
         let canvas = compose(&pic.title, &subtitle, &pic.rows, &pic.cols, &tiles);
@@ -179,7 +179,8 @@ pub(super) fn draw_grid(
     Ok(out)
 }
 
-/// The measurement geometry a grid cell shows.
+/// The measurement geometry a grid cell shows where the study measures it
+/// (else its first geometry, which the cell names).
 const CARD_GEOMETRY: &str = "45/0";
 const CARD_W: usize = 190;
 const PATCH_H: usize = 80;

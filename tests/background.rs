@@ -253,3 +253,80 @@ fn maxwell_caps_the_loss_floor_and_it_pays_on_high_index_grains() {
     let want = C64::new(m.re, solver::MEAN_LOSS_FLOOR * rad * rad);
     assert!((sys.background_eps() - want).norm() < 1e-12);
 }
+
+/// A relief's air: the grains of [`four_grains`] under a binder surface
+/// that undulates 10–90 nm below the top face, the grains' caps standing
+/// in the air above it (as `layer.relief_fraction` makes them).
+fn relief(eps_grain: C64) -> (Array3<C64>, [f64; 3]) {
+    let (mut eps, size) = four_grains(eps_grain);
+    let (nz, ny, nx) = eps.dim();
+    let tau = 2.0 * std::f64::consts::PI;
+    for ((k, j, i), e) in eps.indexed_iter_mut() {
+        let (x, y) = ((i as f64 + 0.5) / nx as f64, (j as f64 + 0.5) / ny as f64);
+        let z = (k as f64 + 0.5) * size[2] / nz as f64;
+        let surface = 50.0 + 40.0 * (tau * x).sin() * (tau * y).cos();
+        if z < surface && *e == C64::new(EPS_B, 0.0) {
+            *e = C64::new(1.0, 0.0);
+        }
+    }
+    (eps, size)
+}
+
+/// The cells holding air at a face take their own lateral mean as the
+/// background (`ShiftParams::layered_air`): the same solution as the binder
+/// background to solver tolerance in both equations, with the air on top
+/// and (a layer lit from below, solved upside down) at the bottom, in fewer
+/// applications than one mean for every cell.
+#[test]
+fn a_reliefs_air_takes_its_own_mean_and_it_pays() {
+    use inksim::config::Linear;
+    use inksim::solver::{air_cells, Wave};
+    let (top, size) = relief(C64::new(1.96, 1.2));
+    let mut bottom = top.clone();
+    bottom.invert_axis(ndarray::Axis(0));
+    let bottom = bottom.as_standard_layout().to_owned();
+    assert_eq!(air_cells(&top), (4, 0));
+    assert_eq!(air_cells(&bottom), (0, 4));
+    let vector = Wave::Vector {
+        polarisation: Linear::P.into(),
+        azimuth_deg: 0.0,
+    };
+    let lat = Problem::lattice([20, 20, 30], size, 450.0, 30.0, 0.0);
+    for (eps, face) in [(&top, "top"), (&bottom, "bottom")] {
+        for wave in [Wave::Scalar, vector] {
+            let p = Problem {
+                wave,
+                ..in_binder(lat, eps)
+            };
+            let binder = solver::solve(&p, Method::BiCgStab, &tight(Background::Binder)).unwrap();
+            let params = ShiftParams::for_wave(Background::Mean, &wave);
+            let sys = System::with_params(&p, params).unwrap();
+            assert!(
+                sys.describe_background()
+                    .contains(&format!("layered at the {face} over 4 cells holding air")),
+                "{}",
+                sys.describe_background()
+            );
+            let (layered, a) = applications_with(&p, params, 1e-10);
+            let one = ShiftParams {
+                layered_air: false,
+                ..params
+            };
+            let (uniform, b) = applications_with(&p, one, 1e-10);
+            let amp = amplitude_difference(&a, &binder).max(amplitude_difference(&b, &binder));
+            let (fa, fb) = (efficiencies(&a), efficiencies(&binder));
+            eprintln!(
+                "air at the {face}, {wave:?}: {layered} applications layered, {uniform} with one \
+                 mean; amplitudes within {amp:.1e} of the binder background's, |ΔA| {:.1e}",
+                (fa.absorption - fb.absorption).abs()
+            );
+            assert!(amp < 1e-8, "{amp}");
+            assert!((fa.absorption - fb.absorption).abs() < 1e-8);
+            assert!(fa.energy_balance.abs() < 1e-8, "{}", fa.energy_balance);
+            assert!(
+                (layered as f64) < 0.8 * uniform as f64,
+                "{layered} vs {uniform}"
+            );
+        }
+    }
+}

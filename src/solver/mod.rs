@@ -76,7 +76,7 @@ pub use lattice::Lattice;
 pub use methods::{Outcome, Solver, Validity};
 pub use storage::{dot, Field, Storage};
 pub use system::{
-    Scratch, ShiftParams, System, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR, SHIFT_MARGIN,
+    air_cells, Scratch, ShiftParams, System, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR, SHIFT_MARGIN,
 };
 
 /// What every solve records, stored beside its result.

@@ -62,6 +62,9 @@ pub struct ShiftParams {
     /// Mean: the floor is at most this times `max|ε − ⟨ε⟩|`, in [0, ∞]
     /// (∞: no cap, the scalar equation's default).
     pub mean_loss_cap: f64,
+    /// Mean: the cells holding air at either face take their own lateral
+    /// mean ([`air_cells`]; the default); `false`: one mean for every cell.
+    pub layered_air: bool,
 }
 
 impl ShiftParams {
@@ -72,6 +75,7 @@ impl ShiftParams {
             margin: SHIFT_MARGIN,
             mean_loss_floor: MEAN_LOSS_FLOOR,
             mean_loss_cap: f64::INFINITY,
+            layered_air: true,
         }
     }
 
@@ -146,17 +150,23 @@ enum BackgroundOperator {
 /// only, per z cell) and, for the CBS shift, its preconditioner.
 struct Shift {
     kind: Background,
+    /// ε_s of the bulk: every cell but the layered zones'.
     eps: C64,
+    /// The layered zones of the mean background: ε_s of each of their
+    /// cells, the top's and the bottom's (empty where both faces are flat).
+    top: Vec<C64>,
+    bottom: Vec<C64>,
     /// CBS: real centre ε_r and ε_s of `γ = 1 + i(ε − ε_r)/ε_s`; `None` for
     /// the unpreconditioned mean background.
     cbs: Option<(f64, f64)>,
-    c: C64,
+    /// `c_j = k0²(ε_s,j − ε_b)` per z cell.
+    c: Vec<C64>,
     /// The row sweeps' tables of the shifted operator.
     table: ShiftTables,
     /// u_s per row of the unknowns.
     us: Vec<C64>,
     us_norm: f64,
-    /// Boundary amplitudes of `G_b u_s` (harmonic 00): `[s, p]` (Maxwell)
+    /// Boundary amplitudes of `G_b C u_s` (harmonic 00): `[s, p]` (Maxwell)
     /// or `[u, 0]`.
     us_top: [C64; 2],
     us_bottom: [C64; 2],
@@ -164,8 +174,8 @@ struct Shift {
 
 /// The shifted operator's tables of either equation.
 enum ShiftTables {
-    Scalar(ShiftTable),
-    Vector(VectorShift),
+    Scalar(Box<ShiftTable>),
+    Vector(Box<VectorShift>),
 }
 
 /// Working memory of a [`System`]'s operations, sized for its lattice.
@@ -403,7 +413,21 @@ impl<'a> System<'a> {
             Some((er, es)) => format!("ε_r = {er:.4}, ε_s = {es:.4}"),
             None => {
                 let e = self.shift.eps;
-                format!("mean background ⟨ε⟩ = {:.4}{:+.4}i", e.re, e.im)
+                let mut d = format!("mean background ⟨ε⟩ = {:.4}{:+.4}i", e.re, e.im);
+                for (zone, face) in [(&self.shift.top, "top"), (&self.shift.bottom, "bottom")] {
+                    if let (Some(a), Some(b)) = (zone.first(), zone.last()) {
+                        d += &format!(
+                            ", layered at the {face} over {} cells holding air (each its own \
+                             mean, {:.4}{:+.4}i to {:.4}{:+.4}i)",
+                            zone.len(),
+                            a.re,
+                            a.im,
+                            b.re,
+                            b.im
+                        );
+                    }
+                }
+                d
             }
         }
     }
@@ -438,15 +462,36 @@ impl<'a> System<'a> {
         }
     }
 
-    /// `scr.field ← (V − shift) x` with `V = k0²(ε − ε_b)` (ε a tensor
-    /// where [`System::tensor`] has terms).
-    fn load_scaled<S: Storage>(&self, scr: &mut Scratch, x: &Array3<S>, shift: C64) {
+    /// `scr.field ← (V − C) x` with `V = k0²(ε − ε_b)` (ε a tensor
+    /// where [`System::tensor`] has terms) and `C` the shift of each z cell
+    /// (`None`: no shift).
+    fn load_scaled<S: Storage>(&self, scr: &mut Scratch, x: &Array3<S>, shift: Option<&[C64]>) {
         let (k2, eb) = (self.k2, self.eps_binder);
-        for c in 0..self.components() {
-            Zip::from(scr.field.slice_mut(self.block(c)))
-                .and(x.slice(self.block(c)))
-                .and(self.eps)
-                .par_for_each(|t, x, e| *t = (k2 * (e - eb) - shift) * x.load());
+        let one = match shift {
+            None => Some(C64::new(0.0, 0.0)),
+            Some(c) if c.iter().all(|&v| v == c[0]) => Some(c[0]),
+            Some(_) => None,
+        };
+        for comp in 0..self.components() {
+            match (one, shift) {
+                (Some(c), _) => Zip::from(scr.field.slice_mut(self.block(comp)))
+                    .and(x.slice(self.block(comp)))
+                    .and(self.eps)
+                    .par_for_each(|t, x, e| *t = (k2 * (e - eb) - c) * x.load()),
+                (None, Some(cells)) => {
+                    Zip::from(scr.field.slice_mut(self.block(comp)).outer_iter_mut())
+                        .and(x.slice(self.block(comp)).outer_iter())
+                        .and(self.eps.outer_iter())
+                        .and(ndarray::ArrayView1::from(cells))
+                        .par_for_each(|mut t, x, e, &c| {
+                            Zip::from(&mut t)
+                                .and(&x)
+                                .and(&e)
+                                .for_each(|t, x, e| *t = (k2 * (e - eb) - c) * x.load())
+                        })
+                }
+                (None, None) => unreachable!("no shift is one shift"),
+            }
         }
         if let Some(a) = self.tensor {
             tensor::add_contrast(a, k2, x, &mut scr.field);
@@ -489,7 +534,7 @@ impl<'a> System<'a> {
         u: &Array3<S>,
         out: &mut Array3<S>,
     ) -> f64 {
-        self.load_scaled(scr, u, C64::new(0.0, 0.0));
+        self.load_scaled(scr, u, None);
         let lat = self.lat;
         let eb = self.eps_binder;
         match (&mut self.op, &mut scr.op) {
@@ -548,7 +593,7 @@ impl<'a> System<'a> {
         u: &Array3<S>,
         out: &mut Array3<S>,
     ) -> f64 {
-        self.load_scaled(scr, u, self.shift.c);
+        self.load_scaled(scr, u, Some(&self.shift.c));
         self.apply_shifted(scr);
         self.finish_residual(scr, &self.shift.us, u, out);
         self.norm(out) * self.ubg_norm / self.shift.us_norm
@@ -561,7 +606,7 @@ impl<'a> System<'a> {
         x: &Array3<S>,
         out: &mut Array3<S>,
     ) {
-        self.load_scaled(scr, x, self.shift.c);
+        self.load_scaled(scr, x, Some(&self.shift.c));
         self.apply_shifted(scr);
         Zip::from(&mut *out)
             .and(x)
@@ -635,10 +680,10 @@ impl<'a> System<'a> {
         let z = || Array2::zeros((lat.nx, lat.ny));
         let mut r = [z(), z()];
         let mut t = [z(), z()];
-        // G_b V u = G_b(V' u + c u) = w + c G_b(u − G_s V' u), and at the
+        // G_b V u = G_b(V' u + C u) = w + G_b C(u − G_s V' u), and at the
         // solution u − G_s V' u = u_s (harmonic 00 only): boundary values of
-        // w from the shifted sweep, of G_b u_s precomputed with the shift.
-        self.load_scaled(scr, u, self.shift.c);
+        // w from the shifted sweep, of G_b C u_s precomputed with the shift.
+        self.load_scaled(scr, u, Some(&self.shift.c));
         match (&self.op, &mut scr.op, &self.shift.table) {
             (
                 BackgroundOperator::Scalar { op, .. },
@@ -650,14 +695,13 @@ impl<'a> System<'a> {
                 op.shifted_boundary(table, &mut scr.field, ws, r0, t0);
             }
             (BackgroundOperator::Vector { op, .. }, OpWorkspace::Vector(ws), _) => {
-                op.boundary_amplitudes(self.shift.c, &mut scr.field, ws, &mut r, &mut t);
+                op.boundary_amplitudes(&self.shift.c, &mut scr.field, ws, &mut r, &mut t);
             }
             _ => unreachable!("a system's scratch is made by the system"),
         }
-        let c = self.shift.c;
         for k in 0..2 {
-            r[k][[0, 0]] += self.r_bg[k] + c * self.shift.us_top[k];
-            t[k][[0, 0]] += self.t_bg[k] + c * self.shift.us_bottom[k];
+            r[k][[0, 0]] += self.r_bg[k] + self.shift.us_top[k];
+            t[k][[0, 0]] += self.t_bg[k] + self.shift.us_bottom[k];
         }
         let dz = lat.size_nm[2] / lat.nz as f64;
         let s: f64 = (0..self.components())
@@ -678,6 +722,85 @@ pub fn mean_eps(eps: &Array3<C64>) -> C64 {
     eps.iter().sum::<C64>() / eps.len() as f64
 }
 
+/// The layered zones of the mean background, `(top, bottom)` cells: from
+/// the top face down to the deepest cell of the upper half that holds air
+/// (a voxel of ε = 1: a relief above the binder, the air over a conformal
+/// film or a rough surface), and likewise from the bottom face up (a layer
+/// lit from below is solved upside down); 0 where a face is flat.
+pub fn air_cells(eps: &Array3<C64>) -> (usize, usize) {
+    let air = C64::new(1.0, 0.0);
+    let nz = eps.dim().0;
+    let has_air: Vec<bool> = eps
+        .outer_iter()
+        .map(|s| s.iter().any(|&e| e == air))
+        .collect();
+    let half = nz / 2;
+    let top = (0..half).rev().find(|&j| has_air[j]).map_or(0, |j| j + 1);
+    let bottom = (half..nz).find(|&j| has_air[j]).map_or(0, |j| nz - j);
+    (top, bottom)
+}
+
+/// The mean background's permittivity per z cell: the mean of the cells
+/// between the layered zones ([`air_cells`]), and in each cell of a zone its
+/// own lateral mean (the tensor voxels add a third of their trace), each
+/// with the loss floor of the largest contrast left, `r = max|ε − ε̄_j|`.
+fn mean_profile(eps: &Array3<C64>, tensor: Option<&Anisotropy>, params: ShiftParams) -> Vec<C64> {
+    let (nz, ny, nx) = eps.dim();
+    // Air in every cell (a porous layer, voids in an explicit structure)
+    // leaves no bulk: one mean then.
+    let (top, bottom) = match air_cells(eps) {
+        (t, b) if params.layered_air && t + b < nz => (t, b),
+        _ => (0, 0),
+    };
+    let plane = (ny * nx) as f64;
+    // Per cell: the sum of ε and of a third of the tensor traces.
+    let sums: Vec<C64> = (0..nz)
+        .map(|j| {
+            eps.index_axis(ndarray::Axis(0), j).sum()
+                + tensor.map_or(C64::new(0.0, 0.0), |a| {
+                    a.slice(j).iter().map(|t| t.delta).sum::<C64>() / 3.0
+                })
+        })
+        .collect();
+    let inner = top..nz - bottom;
+    let bulk = if inner.len() == nz {
+        // Flat faces: the mean over every voxel, summed as always.
+        mean_eps(eps)
+            + tensor.map_or(C64::new(0.0, 0.0), |a| {
+                a.terms.iter().map(|t| t.delta).sum::<C64>() / (3.0 * eps.len() as f64)
+            })
+    } else {
+        sums[inner.clone()].iter().sum::<C64>() / (plane * inner.len() as f64)
+    };
+    let means: Vec<C64> = (0..nz)
+        .map(|j| {
+            if inner.contains(&j) {
+                bulk
+            } else {
+                sums[j] / plane
+            }
+        })
+        .collect();
+    let rad = eps
+        .outer_iter()
+        .zip(&means)
+        .map(|(s, m)| s.iter().map(|e| (e - m).norm_sqr()).fold(0.0, f64::max))
+        .fold(0.0, f64::max)
+        .sqrt()
+        .max(spread(eps, tensor, bulk));
+    // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
+    let cap = if rad > 0.0 {
+        params.mean_loss_cap * rad
+    } else {
+        0.0
+    };
+    let floor = (params.mean_loss_floor * rad * rad).min(cap);
+    means
+        .iter()
+        .map(|m| C64::new(m.re, m.im.max(floor).max(1e-9)))
+        .collect()
+}
+
 impl Shift {
     fn new(
         op: &BackgroundOperator,
@@ -688,63 +811,73 @@ impl Shift {
         params: ShiftParams,
     ) -> Shift {
         let kind = params.background;
-        let (bg, cbs) = match kind {
+        let nz = lat.nz;
+        let (profile, cbs) = match kind {
             Background::Binder => {
                 let (er, rad) = shift_of(eps, tensor, eps_binder);
                 let es = (params.margin * rad).max(1e-9);
-                (C64::new(er, es), Some((er, es)))
+                (vec![C64::new(er, es); nz], Some((er, es)))
             }
-            Background::Mean => {
-                // The tensor voxels add a third of their trace to the mean.
-                let m = mean_eps(eps)
-                    + tensor.map_or(C64::new(0.0, 0.0), |a| {
-                        a.terms.iter().map(|t| t.delta).sum::<C64>() / (3.0 * eps.len() as f64)
-                    });
-                let rad = eps
-                    .iter()
-                    .map(|e| (e - m).norm_sqr())
-                    .fold(0.0, f64::max)
-                    .sqrt()
-                    .max(spread(eps, tensor, m));
-                // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
-                let cap = if rad > 0.0 {
-                    params.mean_loss_cap * rad
-                } else {
-                    0.0
-                };
-                let floor = (params.mean_loss_floor * rad * rad).min(cap);
-                (C64::new(m.re, m.im.max(floor).max(1e-9)), None)
-            }
+            Background::Mean => (mean_profile(eps, tensor, params), None),
         };
         let k2 = lat.k0 * lat.k0;
-        let c = k2 * (bg - eps_binder);
-        let zero = C64::new(0.0, 0.0);
+        let c: Vec<C64> = profile.iter().map(|e| k2 * (e - eps_binder)).collect();
+        let zero = vec![C64::new(0.0, 0.0); nz];
+        // u_s = (I − G_b C)⁻¹ u_bg = u_bg + G_s C u_bg, and the boundary
+        // values of G_b C u_s (C acts on each component's z cell; one shift
+        // is applied after the operator, as `c G_s u_bg` and `c G_b u_s`).
+        let one = c.iter().all(|&v| v == c[0]);
+        let times_c = |rows: &[C64]| -> Vec<C64> {
+            if one {
+                rows.to_vec()
+            } else {
+                rows.iter()
+                    .enumerate()
+                    .map(|(j, v)| c[j % nz] * v)
+                    .collect()
+            }
+        };
+        let after = |v: C64| if one { c[0] * v } else { v };
         let (table, us, us_top, us_bottom) = match op {
             BackgroundOperator::Scalar {
                 top00, bottom00, ..
             } => {
-                let table = ShiftTable::new(lat, eps_binder, c);
+                let table = ShiftTable::layered(lat, eps_binder, &c);
                 let mut scr = BandScratch::new(lat.nz);
                 scr.column().copy_from_slice(ubg);
                 table.solve_column(0, &mut scr);
                 let us = scr.column().to_vec();
-                let top: C64 = top00.iter().zip(&us).map(|(w, u)| w * u).sum();
-                let bottom: C64 = bottom00.iter().zip(&us).map(|(w, u)| w * u).sum();
-                (ShiftTables::Scalar(table), us, [top, zero], [bottom, zero])
+                let cus = times_c(&us);
+                let top = after(top00.iter().zip(&cus).map(|(w, u)| w * u).sum());
+                let bottom = after(bottom00.iter().zip(&cus).map(|(w, u)| w * u).sum());
+                (
+                    ShiftTables::Scalar(Box::new(table)),
+                    us,
+                    [top, zero[0]],
+                    [bottom, zero[0]],
+                )
             }
             BackgroundOperator::Vector { op, .. } => {
-                // u_s = (I − c G_b)⁻¹ u_bg = u_bg + c G_s u_bg.
-                let (gs, _, _) = op.harmonic00(c, ubg);
-                let us: Vec<C64> = ubg.iter().zip(&gs).map(|(u, g)| u + c * g).collect();
-                let (_, top, bottom) = op.harmonic00(zero, &us);
-                (ShiftTables::Vector(op.shift_tables(c)), us, top, bottom)
+                let (gs, _, _) = op.harmonic00(&c, &times_c(ubg));
+                let us: Vec<C64> = ubg.iter().zip(&gs).map(|(u, g)| u + after(*g)).collect();
+                let (_, top, bottom) = op.harmonic00(&zero, &times_c(&us));
+                let (top, bottom) = (top.map(after), bottom.map(after));
+                (
+                    ShiftTables::Vector(Box::new(op.layered_shift_tables(&c))),
+                    us,
+                    top,
+                    bottom,
+                )
             }
         };
         let us_norm =
             (us.iter().map(|c| c.norm_sqr()).sum::<f64>() * lat.harmonics() as f64).sqrt();
+        let (b0, b1) = super::settle::bulk_run(&profile);
         Shift {
             kind,
-            eps: bg,
+            eps: profile[b0],
+            top: profile[..b0].to_vec(),
+            bottom: profile[b1..].to_vec(),
             cbs,
             c,
             table,

@@ -122,13 +122,13 @@ impl ColumnScratch {
     }
 }
 
-/// Solve one column: `w = G_s b` with shift `c` (`c = 0`: `G_b b`), plus the
-/// field of `incident`. Returns `(F(0), F(H))` of the continuous field,
-/// incident wave included.
+/// Solve one column: `w = G_s b` with the shift `c[j]` of each z cell
+/// (`c = 0`: `G_b b`), plus the field of `incident`. Returns `(F(0), F(H))`
+/// of the continuous field, incident wave included.
 pub fn solve(
     h: &Harmonic,
     pol: Pol,
-    c: C64,
+    c: &[C64],
     incident: Incident,
     col: &mut Column,
     scr: &mut ColumnScratch,
@@ -167,6 +167,7 @@ pub fn solve(
 
 /// The cell coefficients of a harmonic at one γ² (see the module docs);
 /// the row sweeps of [`tm_sweep`](super::tm_sweep) take TM's from here.
+#[derive(Debug, Clone, Copy)]
 pub(super) struct Cell {
     pub(super) q: C64,
     pub(super) phi: C64,
@@ -244,62 +245,111 @@ fn at(band: &mut [C64], i: usize, j: usize) -> &mut C64 {
     &mut band[j * LD + (KL + KU + i - j)]
 }
 
+/// The cells' coefficients, recomputed only where the shift changes.
+struct Cells<'a> {
+    h: &'a Harmonic,
+    g2: C64,
+    pol: Pol,
+    c: &'a [C64],
+    incident: Incident,
+    at: C64,
+    k: Cell,
+}
+
+impl<'a> Cells<'a> {
+    fn new(h: &'a Harmonic, g2: C64, pol: Pol, c: &'a [C64], incident: Incident) -> Self {
+        Cells {
+            h,
+            g2,
+            pol,
+            c,
+            incident,
+            at: c[0],
+            k: cell(h, g2, pol, c[0], incident),
+        }
+    }
+
+    /// Cell j's coefficients.
+    fn of(&mut self, j: usize) -> Cell {
+        if self.c[j] != self.at {
+            self.at = self.c[j];
+            self.k = cell(self.h, self.g2, self.pol, self.at, self.incident);
+        }
+        self.k
+    }
+}
+
 fn solve_at(
     h: &Harmonic,
     g2: C64,
     pol: Pol,
-    c: C64,
+    c: &[C64],
     incident: Incident,
     col: &mut Column,
     scr: &mut ColumnScratch,
 ) -> (C64, C64) {
     let n = h.slab.nz;
     let m = 2 * n;
-    let k = cell(h, g2, pol, c, incident);
+    let mut cells = Cells::new(h, g2, pol, c, incident);
     let tm = pol == Pol::Tm;
     let bz = |j: usize| if tm { col.b_z[j] } else { ZERO };
     let band = &mut scr.band[..m * LD];
     band.iter_mut().for_each(|v| *v = ZERO);
     let rhs = &mut scr.rhs[..m];
-    let (q, ps, kd) = (k.q, k.ps, k.kd);
+    let k = cells.of(0);
+    let q = k.q;
     // Top: zin[(1+K) a0 − (Q+K) d0 + Kb] + zout[(ps+1) a0 + (ps+Q) d0 + pb b0] = rhs.
-    *at(band, 0, 0) = k.zin * (ONE + kd) + k.zout * (ps + ONE);
-    *at(band, 0, 1) = -k.zin * (q + kd) + k.zout * (ps + q);
+    *at(band, 0, 0) = k.zin * (ONE + k.kd) + k.zout * (k.ps + ONE);
+    *at(band, 0, 1) = -k.zin * (q + k.kd) + k.zout * (k.ps + q);
     rhs[0] = k.rhs_top - k.zin * k.kb * bz(0) - k.zout * k.pb * col.b_f[0];
     for j in 0..n - 1 {
+        // Cells j (above the interface) and j + 1 (below) may differ in shift.
+        let (k, l) = (cells.of(j), cells.of(j + 1));
         let (rf, rp) = (2 * j + 1, 2 * j + 2);
         let (a0, d0, a1, d1) = (2 * j, 2 * j + 1, 2 * j + 2, 2 * j + 3);
         // F continuous at z_{j+1}.
-        *at(band, rf, a0) = ps + q;
-        *at(band, rf, d0) = ps + ONE;
-        *at(band, rf, a1) = -(ps + ONE);
-        *at(band, rf, d1) = -(ps + q);
-        rhs[rf] = k.pb * (col.b_f[j + 1] - col.b_f[j]);
+        *at(band, rf, a0) = k.ps + q;
+        *at(band, rf, d0) = k.ps + ONE;
+        *at(band, rf, a1) = -(l.ps + ONE);
+        *at(band, rf, d1) = -(l.ps + q);
+        rhs[rf] = if l.pb == k.pb {
+            k.pb * (col.b_f[j + 1] - col.b_f[j])
+        } else {
+            l.pb * col.b_f[j + 1] - k.pb * col.b_f[j]
+        };
         // Normalised flux continuous.
-        *at(band, rp, a0) = q + kd;
-        *at(band, rp, d0) = -(ONE + kd);
-        *at(band, rp, a1) = -(ONE + kd);
-        *at(band, rp, d1) = q + kd;
-        rhs[rp] = k.kb * (bz(j + 1) - bz(j));
+        *at(band, rp, a0) = q + k.kd;
+        *at(band, rp, d0) = -(ONE + k.kd);
+        *at(band, rp, a1) = -(ONE + l.kd);
+        *at(band, rp, d1) = q + l.kd;
+        rhs[rp] = if l.kb == k.kb {
+            k.kb * (bz(j + 1) - bz(j))
+        } else {
+            l.kb * bz(j + 1) - k.kb * bz(j)
+        };
     }
     // Bottom: zin[(Q+K) a − (1+K) d + Kb] − zout[(ps+Q) a + (ps+1) d + pb b] = 0.
+    let k = cells.of(n - 1);
     let (a, d) = (m - 2, m - 1);
-    *at(band, m - 1, a) = k.zin * (q + kd) - k.zout * (ps + q);
-    *at(band, m - 1, d) = -k.zin * (ONE + kd) - k.zout * (ps + ONE);
+    *at(band, m - 1, a) = k.zin * (q + k.kd) - k.zout * (k.ps + q);
+    *at(band, m - 1, d) = -k.zin * (ONE + k.kd) - k.zout * (k.ps + ONE);
     rhs[m - 1] = -k.zin * k.kb * bz(n - 1) + k.zout * k.pb * col.b_f[n - 1];
     band_solve(band, rhs, m);
     for j in 0..n {
+        let k = cells.of(j);
         let (aj, dj) = (rhs[2 * j], rhs[2 * j + 1]);
-        let p = ps * (aj + dj) + k.pb * col.b_f[j];
+        let p = k.ps * (aj + dj) + k.pb * col.b_f[j];
         col.w_f[j] = p + k.phi * (aj + dj);
         if tm {
             col.w_z[j] = k.zd * (aj - dj) + k.zb * col.b_z[j];
         }
     }
+    let k = cells.of(0);
     let (a0, d0) = (rhs[0], rhs[1]);
-    let top = ps * (a0 + d0) + k.pb * col.b_f[0] + a0 + d0 * q;
+    let top = k.ps * (a0 + d0) + k.pb * col.b_f[0] + a0 + d0 * q;
+    let k = cells.of(n - 1);
     let (al, dl) = (rhs[m - 2], rhs[m - 1]);
-    let bottom = ps * (al + dl) + k.pb * col.b_f[n - 1] + al * q + dl;
+    let bottom = k.ps * (al + dl) + k.pb * col.b_f[n - 1] + al * q + dl;
     (top, bottom)
 }
 
@@ -362,6 +412,16 @@ mod tests {
         h: &Harmonic,
         pol: Pol,
         c: C64,
+        b_f: &[C64],
+        b_z: &[C64],
+    ) -> (Vec<C64>, Vec<C64>, C64, C64) {
+        run_layered(h, pol, &vec![c; h.slab.nz], b_f, b_z)
+    }
+
+    fn run_layered(
+        h: &Harmonic,
+        pol: Pol,
+        c: &[C64],
         b_f: &[C64],
         b_z: &[C64],
     ) -> (Vec<C64>, Vec<C64>, C64, C64) {
@@ -457,23 +517,33 @@ mod tests {
     }
 
     /// The shifted operator is the exact discrete shift of the plain one:
-    /// `G_s b − c G_b (G_s b) = G_b b`, both polarisations, propagating,
-    /// evanescent and near-grazing.
+    /// `G_s b − G_b C (G_s b) = G_b b`, both polarisations, propagating,
+    /// evanescent and near-grazing, with one shift `C = c` and with a
+    /// layered one (other shifts in the top cells, as a relief's air has).
     #[test]
     fn shift_is_exact_for_both_polarisations() {
         let (b_f, b_z) = sources();
-        let c = slab().k0.powi(2) * C64::new(-0.4, 0.9);
-        for kappa_rel in [0.0, 0.4, 1.3, 2.5, 1.558 * (1.0 + 1e-8)] {
-            let h = harmonic(kappa_rel);
-            for pol in [Pol::Te, Pol::Tm] {
-                let (ws_f, ws_z, _, _) = run(&h, pol, c, &b_f, &b_z);
-                let (gb_f, gb_z, _, _) = run(&h, pol, ZERO, &b_f, &b_z);
-                let (gw_f, gw_z, _, _) = run(&h, pol, ZERO, &ws_f, &ws_z);
-                let lhs: Vec<C64> = ws_f.iter().zip(&gw_f).map(|(w, g)| w - c * g).collect();
-                close(&lhs, &gb_f, 1e-8, &format!("{pol:?} F, κ/k0 = {kappa_rel}"));
-                if pol == Pol::Tm {
-                    let lhs: Vec<C64> = ws_z.iter().zip(&gw_z).map(|(w, g)| w - c * g).collect();
-                    close(&lhs, &gb_z, 1e-8, &format!("TM E_z, κ/k0 = {kappa_rel}"));
+        let k2 = slab().k0.powi(2);
+        let n = slab().nz;
+        let uniform = vec![k2 * C64::new(-0.4, 0.9); n];
+        let mut layered = uniform.clone();
+        layered[0] = k2 * C64::new(-1.3, 0.3);
+        layered[1] = k2 * C64::new(-0.9, 0.5);
+        layered[2] = k2 * C64::new(0.2, 0.1);
+        for c in [&uniform, &layered] {
+            for kappa_rel in [0.0, 0.4, 1.3, 2.5, 1.558 * (1.0 + 1e-8)] {
+                let h = harmonic(kappa_rel);
+                for pol in [Pol::Te, Pol::Tm] {
+                    let (ws_f, ws_z, _, _) = run_layered(&h, pol, c, &b_f, &b_z);
+                    let (gb_f, gb_z, _, _) = run(&h, pol, ZERO, &b_f, &b_z);
+                    let cw = |w: &[C64]| w.iter().zip(c).map(|(w, c)| c * w).collect::<Vec<_>>();
+                    let (gw_f, gw_z, _, _) = run(&h, pol, ZERO, &cw(&ws_f), &cw(&ws_z));
+                    let lhs: Vec<C64> = ws_f.iter().zip(&gw_f).map(|(w, g)| w - g).collect();
+                    close(&lhs, &gb_f, 1e-8, &format!("{pol:?} F, κ/k0 = {kappa_rel}"));
+                    if pol == Pol::Tm {
+                        let lhs: Vec<C64> = ws_z.iter().zip(&gw_z).map(|(w, g)| w - g).collect();
+                        close(&lhs, &gb_z, 1e-8, &format!("TM E_z, κ/k0 = {kappa_rel}"));
+                    }
                 }
             }
         }

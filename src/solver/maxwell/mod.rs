@@ -136,8 +136,9 @@ impl VectorOperator {
         (unit, h)
     }
 
-    /// `field ← G_s field` with shift `c` (`c = 0`: the binder's `G_b`).
-    pub fn apply(&self, c: C64, field: &mut Array3<C64>, ws: &mut VectorWorkspace) {
+    /// `field ← G_s field` with the shift `c[j]` of each z cell (`c = 0`:
+    /// the binder's `G_b`).
+    pub fn apply(&self, c: &[C64], field: &mut Array3<C64>, ws: &mut VectorWorkspace) {
         let (nx, ny) = (self.lat.nx, self.lat.ny);
         let norm = 1.0 / (nx * ny) as f64;
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
@@ -157,7 +158,7 @@ impl VectorOperator {
         ix: usize,
         iy: usize,
         at: usize,
-        c: C64,
+        c: &[C64],
         row: &mut ArrayViewMut2<C64>,
         scr: &mut HarmonicScratch,
         norm: f64,
@@ -210,12 +211,12 @@ impl VectorOperator {
         }
     }
 
-    /// Boundary values of the continuous field `G_b(x + c G_s x)` per
+    /// Boundary values of the continuous field `G_b(x + C G_s x)` per
     /// harmonic for a real-space source `x` (consumed as scratch), as order
     /// amplitudes in s and p: `r[0], t[0]` s, `r[1], t[1]` p, each (nx, ny).
     pub fn boundary_amplitudes(
         &self,
-        c: C64,
+        c: &[C64],
         source: &mut Array3<C64>,
         ws: &mut VectorWorkspace,
         r: &mut [Array2<C64>; 2],
@@ -288,7 +289,7 @@ impl VectorOperator {
         let (top, bottom) = column::solve(
             &h,
             p,
-            ZERO,
+            &zero,
             inc,
             &mut Column {
                 b_f: &zero,
@@ -324,9 +325,10 @@ impl VectorOperator {
     }
 
     /// `(G_s b, boundary)` for a harmonic-00 column `b` given as stacked
-    /// rows (3 nz): the cell averages of `G_s b` (shift `c`) and the s/p
-    /// amplitudes of the continuous `G_b(b + c G_s b)` at the boundaries.
-    pub fn harmonic00(&self, c: C64, rows: &[C64]) -> (Vec<C64>, [C64; 2], [C64; 2]) {
+    /// rows (3 nz): the cell averages of `G_s b` (shift `c[j]` per z cell)
+    /// and the s/p amplitudes of the continuous `G_b(b + C G_s b)` at the
+    /// boundaries.
+    pub fn harmonic00(&self, c: &[C64], rows: &[C64]) -> (Vec<C64>, [C64; 2], [C64; 2]) {
         let nz = self.lat.nz;
         // Harmonic 00's spectral row, one column wide.
         let mut row = Array2::from_shape_fn((3 * nz, 1), |(j, _)| rows[j]);

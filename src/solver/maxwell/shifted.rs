@@ -17,10 +17,10 @@ use crate::solver::shift::{RowScratch, ShiftTable};
 use ndarray::{s, Array2, Array3, ArrayViewMut2};
 use num_complex::Complex64 as C64;
 
-/// The tables of one shift `c` for both polarisations, and ê_κ per
-/// harmonic.
+/// The tables of one shift profile (`c[j]` per z cell) for both
+/// polarisations, and ê_κ per harmonic.
 pub struct VectorShift {
-    pub c: C64,
+    pub c: Vec<C64>,
     te: ShiftTable,
     tm: TmTable,
     /// ê_κ per spectral index ix·ny + iy.
@@ -51,16 +51,26 @@ impl VectorShift {
 }
 
 impl VectorOperator {
-    /// The row sweeps' tables for shift `c`.
+    /// The row sweeps' tables for the shift `c` in every cell.
     pub fn shift_tables(&self, c: C64) -> VectorShift {
+        self.layered_shift_tables(&vec![c; self.lat.nz])
+    }
+
+    /// The row sweeps' tables for the shift `c[j]` of each z cell.
+    pub fn layered_shift_tables(&self, c: &[C64]) -> VectorShift {
         let (nx, ny) = (self.lat.nx, self.lat.ny);
-        let te = ShiftTable::new(&self.lat, self.eps_b, c);
+        let te = ShiftTable::layered(&self.lat, self.eps_b, c);
         let tm = TmTable::new(&self.lat, self.eps_b, c);
         debug_assert!(te.dense_indices().eq(tm.dense_indices().iter().copied()));
         let units = (0..nx * ny)
             .map(|i| self.harmonic(i / ny, i % ny).0)
             .collect();
-        VectorShift { c, te, tm, units }
+        VectorShift {
+            c: c.to_vec(),
+            te,
+            tm,
+            units,
+        }
     }
 
     /// `field ← G_s field` for the shift of `tables`; equals
@@ -73,7 +83,7 @@ impl VectorOperator {
     ) {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let norm = 1.0 / (nx * ny) as f64;
-        let c = tables.c;
+        let c = &tables.c;
         self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         // Near-grazing harmonics: the column solve on their saved columns.
         let mut dense = std::mem::take(&mut ws.dense);
@@ -153,7 +163,7 @@ mod tests {
         let mut ws = op.workspace();
         let mut want = field(lat.nz, lat.ny, lat.nx);
         let mut got = want.clone();
-        op.apply(tables.c, &mut want, &mut ws);
+        op.apply(&tables.c, &mut want, &mut ws);
         op.apply_shifted(tables, &mut got, &mut ws);
         let scale = want.iter().map(|w| w.norm()).fold(0.0, f64::max);
         for (g, w) in got.iter().zip(want.iter()) {
@@ -163,7 +173,8 @@ mod tests {
 
     /// The row sweeps equal the column solves (band elimination with
     /// pivoting) for a lossy CBS-like shift, a nearly lossless
-    /// mean-background shift and no shift, at normal and oblique incidence.
+    /// mean-background shift, no shift and a layered top, at normal and
+    /// oblique incidence.
     #[test]
     fn row_path_equals_column_path() {
         let eps_b = 1.558f64.powi(2);
@@ -179,6 +190,20 @@ mod tests {
                 let c = lat.k0 * lat.k0 * (bg - eps_b);
                 paths_agree(&op, &op.shift_tables(c), &format!("{dims:?} {bg}"));
             }
+            // A layered top (air-like cells, then the mean below).
+            let mut layered = vec![lat.k0 * lat.k0 * (C64::new(2.3, 0.2) - eps_b); dims[2]];
+            layered[0] = lat.k0 * lat.k0 * (C64::new(1.05, 0.2) - eps_b);
+            layered[1] = lat.k0 * lat.k0 * (C64::new(1.6, 0.2) - eps_b);
+            let tables = op.layered_shift_tables(&layered);
+            assert_eq!(tables.tm.bulk, (2, dims[2]));
+            paths_agree(&op, &tables, &format!("{dims:?} layered"));
+            // ... and a layered bottom as well (a layer lit from below).
+            layered[dims[2] - 1] = lat.k0 * lat.k0 * (C64::new(1.1, 0.3) - eps_b);
+            let tables = op.layered_shift_tables(&layered);
+            if dims[2] > 5 {
+                assert_eq!(tables.tm.bulk, (2, dims[2] - 1));
+            }
+            paths_agree(&op, &tables, &format!("{dims:?} layered at both faces"));
         }
     }
 

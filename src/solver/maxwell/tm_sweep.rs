@@ -39,6 +39,9 @@ const ONE: C64 = C64 { re: 1.0, im: 0.0 };
 /// One cell's sweep coefficients (one harmonic).
 #[derive(Debug, Clone, Copy)]
 struct Step {
+    /// Output weights of `u_j`: the cell's `hf = ps + φ` and `zd`.
+    hf: C64,
+    zd: C64,
     /// Output weights of `d_j`: `(ps+φ)(1+t_j)` and `zd (t_j − 1)`.
     gf: C64,
     gz: C64,
@@ -55,6 +58,8 @@ struct Step {
 
 #[derive(Debug, Clone, Copy)]
 struct StepBlock {
+    hf: Cx,
+    zd: Cx,
     gf: Cx,
     gz: Cx,
     v: Cx,
@@ -66,9 +71,11 @@ struct StepBlock {
     wb: Cx,
 }
 
-/// Per-harmonic constants: `hf = ps + φ`, `pb`, `zd`, `zb` (outputs),
-/// `u_0 = tb b_0 + tz S_z,0` (top), `d_{N−1} = eb b + ez S_z + eu u`
-/// (bottom, last cell) and the last cell's output weights.
+/// Per-harmonic constants of the bottom cell: `hf = ps + φ`, `pb`, `zd`,
+/// `zb` (outputs), `u_0 = tb b_0 + tz S_z,0` (top), `d_{N−1} = eb b + ez S_z
+/// + eu u` (bottom, last cell) and the last cell's output weights. Inputs
+/// of a layered top zone are first scaled to the bottom cell's `pb`, `kb`
+/// ([`TmTable`]'s zone factors), so these serve every cell.
 #[derive(Debug, Clone, Copy)]
 struct Const {
     hf: C64,
@@ -99,10 +106,22 @@ struct ConstBlock {
     gzl: Cx,
 }
 
-/// The TM sweep coefficients of every harmonic of a lattice for one shift.
+/// The TM sweep coefficients of every harmonic of a lattice for one shift
+/// profile (`c_j` per z cell).
 pub struct TmTable {
     n: usize,
     nb: usize,
+    /// The bulk of the profile ([`settle::bulk_run`]): cells
+    /// `bulk.0..bulk.1` share one shift; the cells before and after are the
+    /// zone (a layered top and bottom).
+    pub(super) bulk: (usize, usize),
+    /// Per zone cell (the top's, then the bottom's):
+    /// `pb_j / pb_bulk = (k0² ε_b + c_bulk)/(k0² ε_b + c_j)` (the same for
+    /// every harmonic).
+    zone_f: Vec<Cx>,
+    /// Per block of `W` harmonics (layout (ix, block)) and zone cell:
+    /// `kb_j / kb_bulk = zb_j / zb_bulk = (γ² + c_bulk)/(γ² + c_j)`.
+    zone_z: Vec<Cx>,
     /// Spectral indices ix·ny + iy of the near-grazing harmonics.
     dense: Vec<usize>,
     steps: Packed<StepBlock>,
@@ -127,18 +146,30 @@ impl TmRowScratch {
 }
 
 impl TmTable {
-    /// Build for the binder `eps_b` and shift `c` (Im c > 0 for the table
-    /// to settle; any c is exact).
-    pub fn new(lat: &Lattice, eps_b: f64, c: C64) -> Self {
+    /// Build for the binder `eps_b` and the shift `c[j]` of each z cell
+    /// (Im c > 0 for the table to settle; any profile is exact).
+    pub fn new(lat: &Lattice, eps_b: f64, c: &[C64]) -> Self {
         let slab = lat.slab();
         let n = lat.nz;
+        assert_eq!(c.len(), n, "one shift per z cell");
         let (nx, ny) = (lat.nx, lat.ny);
         let nb = ny.div_ceil(W);
         let cells = n - 1;
+        let bulk = settle::bulk_run(c);
+        let cb = c[bulk.0];
+        let zone_cells: Vec<usize> = (0..bulk.0).chain(bulk.1..n).collect();
+        let zone = zone_cells.len();
+        let k2e = lat.k0 * lat.k0 * eps_b;
+        let zone_f = zone_cells
+            .iter()
+            .map(|&j| Cx::splat((k2e + cb) / (k2e + c[j])))
+            .collect();
+        let mut zone_z = vec![Cx::splat(ONE); nx * nb * zone];
         let mut dense = Vec::new();
         let mut harm = vec![ConstBlock::ZERO; nx * nb];
-        let mut steps = Packed::new(ny);
+        let mut steps = Packed::new(ny, n - bulk.1);
         let mut full = vec![Step::ZERO; ny * cells];
+        let mut ks = Vec::with_capacity(n);
         for ix in 0..nx {
             for iy in 0..ny {
                 let col = &mut full[iy * cells..(iy + 1) * cells];
@@ -149,9 +180,22 @@ impl TmTable {
                     col.fill(Step::ZERO);
                     continue;
                 }
-                let k = column::cell(&h, g2, Pol::Tm, c, Incident::None);
-                let hc = coefficients(&k, col);
-                harm[ix * nb + iy / W].set(iy % W, &hc);
+                ks.clear();
+                let kb = column::cell(&h, g2, Pol::Tm, cb, Incident::None);
+                ks.extend(c.iter().map(|&cj| {
+                    if cj == cb {
+                        kb
+                    } else {
+                        column::cell(&h, g2, Pol::Tm, cj, Incident::None)
+                    }
+                }));
+                let hc = coefficients(&ks, bulk, col);
+                let blk = ix * nb + iy / W;
+                harm[blk].set(iy % W, &hc);
+                let ratios = &mut zone_z[blk * zone..(blk + 1) * zone];
+                for (r, &j) in ratios.iter_mut().zip(&zone_cells) {
+                    r.set(iy % W, (g2 + cb) / (g2 + c[j]));
+                }
             }
             steps.push_row(
                 &full,
@@ -164,6 +208,9 @@ impl TmTable {
         TmTable {
             n,
             nb,
+            bulk,
+            zone_f,
+            zone_z,
             dense,
             steps,
             harm,
@@ -214,16 +261,24 @@ impl TmTable {
         let zcells = scr.z.gather(z, |_, x| x * s);
         let w = &mut scr.w;
         for (b, ((hb, xf), xz)) in hbs.iter().zip(fcells).zip(zcells).enumerate() {
-            let steps = self.steps.of(ix, b);
-            let last = steps.len().saturating_sub(1);
+            let steps = self.steps.of(ix, b, n - 1);
+            // A layered top and bottom: inputs to the bulk cell's pb, kb.
+            let zone = self.zone_f.len();
+            let i = ix * nb + b;
+            let zz = &self.zone_z[i * zone..(i + 1) * zone];
+            let cells = (0..self.bulk.0).chain(self.bulk.1..n);
+            for ((j, rf), rz) in cells.zip(&self.zone_f).zip(zz) {
+                xf[j] = xf[j] * *rf;
+                xz[j] = xz[j] * *rz;
+            }
             let (mut bf, mut bz) = (xf[0], xz[0]);
             let mut u = hb.tb * bf + hb.tz * bz;
             for j in 0..n - 1 {
-                let st = &steps[j.min(last)];
+                let st = steps.at(j);
                 let (nf, nz) = (xf[j + 1], xz[j + 1]);
                 let (df, dz) = (nf - bf, nz - bz);
-                xf[j] = hb.hf * u + hb.pb * bf;
-                xz[j] = hb.zd * u + hb.zb * bz;
+                xf[j] = st.hf * u + hb.pb * bf;
+                xz[j] = st.zd * u + hb.zb * bz;
                 w[j] = st.wab * df + st.waz * dz + st.wb * u;
                 u = st.uab * df + st.uaz * dz + st.ub * u;
                 bf = nf;
@@ -233,7 +288,7 @@ impl TmTable {
             xf[n - 1] = hb.gfl * d + (hb.hf * u + hb.pb * bf);
             xz[n - 1] = hb.gzl * d + (hb.zd * u + hb.zb * bz);
             for j in (0..n - 1).rev() {
-                let st = &steps[j.min(last)];
+                let st = steps.at(j);
                 d = st.v * d + w[j];
                 xf[j] = st.gf * d + xf[j];
                 xz[j] = st.gz * d + xz[j];
@@ -244,69 +299,100 @@ impl TmTable {
     }
 }
 
-/// The sweep coefficients of one harmonic (see the module docs): fills
-/// `steps` (N − 1 cells; once `t` has settled, later cells repeat) and
-/// returns the per-harmonic constants.
-fn coefficients(k: &column::Cell, steps: &mut [Step]) -> Const {
-    let (q, ps, pb, kd, kb) = (k.q, k.ps, k.pb, k.kd, k.kb);
-    let hf = ps + k.phi;
-    let (fa, fd) = (ps + q, ps + ONE);
-    let (ga, gd) = (q + kd, ONE + kd);
+/// The sweep coefficients of one harmonic (see the module docs) from the
+/// cells' coefficients `k` (one per z cell; from `zone` on all the bottom
+/// cell's): fills `steps` (N − 1 cells; once `t` has settled below the
+/// zone, later cells repeat) and returns the per-harmonic constants.
+///
+/// With cells j above and j + 1 below interface j, `M` takes `fa, fd, ga,
+/// gd` of cell j in its first column (with `t_j`) and of cell j + 1 in its
+/// second, `R1` those of cell j + 1, and `R0`'s `u_j` terms cell j's; the
+/// inputs are already scaled to the bottom cell's `pb`, `kb`.
+fn coefficients(k: &[column::Cell], bulk: (usize, usize), steps: &mut [Step]) -> Const {
+    let n = k.len();
+    let cells = steps.len();
+    // Steps from here on touch the layered bottom's cells.
+    let tail_start = cells - (n - bulk.1);
+    let kb = &k[bulk.0];
+    let (q, pb, kbz) = (kb.q, kb.pb, kb.kb);
+    // Per cell: (hf, fa, fd, ga, gd, zd).
+    let cell = |j: usize| {
+        let c = &k[j];
+        (
+            c.ps + c.phi,
+            c.ps + q,
+            c.ps + ONE,
+            q + c.kd,
+            ONE + c.kd,
+            c.zd,
+        )
+    };
+    let (_, fa0, fd0, ga0, gd0, _) = cell(0);
     // Top: ta a_0 + td d_0 = −zin kb S_z,0 − zout pb b_0.
-    let ta = k.zin * gd + k.zout * fd;
-    let td = -k.zin * ga + k.zout * fa;
+    let ta = kb.zin * gd0 + kb.zout * fd0;
+    let td = -kb.zin * ga0 + kb.zout * fa0;
     let mut t = -td / ta;
     let mut last_change = f64::INFINITY;
-    let mut settled_from = steps.len();
-    for (j, step) in steps.iter_mut().enumerate() {
+    let mut j = 0;
+    while j < cells {
+        let (hf, fa, fd, ga, gd, zd) = cell(j);
+        let (_, fan, fdn, gan, gdn, _) = cell(j + 1);
         let m00 = fa * t + fd;
-        let m01 = -fd;
+        let m01 = -fdn;
         let m10 = ga * t - gd;
-        let m11 = -gd;
+        let m11 = -gdn;
         let inv = ONE / (m00 * m11 - m01 * m10);
-        let (r10, r11) = (fa, -ga);
+        let (r10, r11) = (fan, -gan);
         let t_next = (m00 * r11 - m10 * r10) * inv;
-        *step = Step {
+        steps[j] = Step {
+            hf,
+            zd,
             gf: hf * (ONE + t),
-            gz: k.zd * (t - ONE),
+            gz: zd * (t - ONE),
             v: (m11 * r10 - m01 * r11) * inv,
             uab: -m10 * pb * inv,
-            uaz: m00 * kb * inv,
+            uaz: m00 * kbz * inv,
             ub: (m10 * fa - m00 * ga) * inv,
             wab: m11 * pb * inv,
-            waz: -m01 * kb * inv,
+            waz: -m01 * kbz * inv,
             wb: (m01 * ga - m11 * fa) * inv,
         };
         let change = (t_next - t).norm();
         t = t_next;
-        if settle::converged(change, last_change, t.norm()) {
-            settled_from = j + 1;
-            break;
+        if j >= bulk.0 && j + 1 < tail_start && settle::converged(change, last_change, t.norm()) {
+            let settled = steps[j];
+            steps[j + 1..tail_start].fill(settled);
+            j = tail_start;
+            last_change = f64::INFINITY;
+            continue;
         }
         last_change = change;
+        j += 1;
     }
-    settle::repeat_from(steps, settled_from);
     // Bottom: ba a + bd d = −zin kb S_z + zout pb b, with a = t d + u.
-    let ba = k.zin * ga - k.zout * fa;
-    let bd = -k.zin * gd - k.zout * fd;
+    let (hf, fa, fd, ga, gd, zd) = cell(n - 1);
+    let ba = kb.zin * ga - kb.zout * fa;
+    let bd = -kb.zin * gd - kb.zout * fd;
     let den = ba * t + bd;
     Const {
         hf,
         pb,
-        zd: k.zd,
-        zb: k.zb,
-        tb: -k.zout * pb / ta,
-        tz: -k.zin * kb / ta,
-        eb: k.zout * pb / den,
-        ez: -k.zin * kb / den,
+        zd,
+        zb: kb.zb,
+        tb: -kb.zout * pb / ta,
+        tz: -kb.zin * kbz / ta,
+        eb: kb.zout * pb / den,
+        ez: -kb.zin * kbz / den,
         eu: -ba / den,
         gfl: hf * (ONE + t),
-        gzl: k.zd * (t - ONE),
+        gzl: zd * (t - ONE),
     }
 }
 
 impl Step {
     const ZERO: Step = Step {
+        hf: ZERO,
+        zd: ZERO,
         gf: ZERO,
         gz: ZERO,
         v: ZERO,
@@ -318,15 +404,18 @@ impl Step {
         wb: ZERO,
     };
 
-    fn fields(&self) -> [C64; 9] {
+    fn fields(&self) -> [C64; 11] {
         [
-            self.gf, self.gz, self.v, self.uab, self.uaz, self.ub, self.wab, self.waz, self.wb,
+            self.hf, self.zd, self.gf, self.gz, self.v, self.uab, self.uaz, self.ub, self.wab,
+            self.waz, self.wb,
         ]
     }
 }
 
 impl StepBlock {
     const ZERO: StepBlock = StepBlock {
+        hf: Cx::ZERO,
+        zd: Cx::ZERO,
         gf: Cx::ZERO,
         gz: Cx::ZERO,
         v: Cx::ZERO,
@@ -339,6 +428,8 @@ impl StepBlock {
     };
 
     fn set(&mut self, k: usize, s: &Step) {
+        self.hf.set(k, s.hf);
+        self.zd.set(k, s.zd);
         self.gf.set(k, s.gf);
         self.gz.set(k, s.gz);
         self.v.set(k, s.v);

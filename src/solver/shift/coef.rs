@@ -9,6 +9,7 @@ use num_complex::Complex64 as C64;
 
 impl Step {
     pub(super) const ZERO: Step = Step {
+        g: ZERO,
         gt: ZERO,
         v: ZERO,
         ua: ZERO,
@@ -17,49 +18,71 @@ impl Step {
         wb: ZERO,
     };
 
-    pub(super) fn fields(&self) -> [C64; 6] {
-        [self.gt, self.v, self.ua, self.ub, self.wa, self.wb]
+    pub(super) fn fields(&self) -> [C64; 7] {
+        [self.g, self.gt, self.v, self.ua, self.ub, self.wa, self.wb]
     }
 }
 
 /// The right-hand-side-independent part of the down sweep (see
-/// [`ShiftTable::solve_column`]): fills `steps` (N − 1 cells) and returns
-/// `[top_u, t_0, t_{N−1}]` and the per-harmonic constants.
-pub(super) fn sweep_coefficients(hs: &HarmonicShift, steps: &mut [Step]) -> ([C64; 3], HarmConst) {
+/// [`ShiftTable::solve_column`]) for the shift `c[j]` of each cell: fills
+/// `steps` (N − 1 cells) and returns `[top_u, t_0, t_{N−1}]` and the
+/// per-harmonic constants. Cells from `zone` on share the bottom cell's
+/// shift, so the recursion may stop there once it has settled.
+///
+/// With `h_j = κ_j/2`, `κ_j = c_j φ1/(γ² + c_j)`, interface j reads
+/// `M (a_{j+1}, d_j)ᵀ = R0 + R1 d_{j+1}` with
+/// `M = [[1 − h_{j+1}, (h_j − q) t_j + h_j], [h_{j+1}, 1 − h_j (1 + t_j)]]`,
+/// `R1 = (h_{j+1}, q − h_{j+1})`, `R0 = Δ (−1/2, 1/2) + u_j (q − h_j, h_j)`.
+pub(super) fn sweep_coefficients(
+    hs: &HarmonicShift,
+    c: &[C64],
+    bulk: (usize, usize),
+    steps: &mut [Step],
+) -> ([C64; 3], HarmConst) {
     let HarmonicShift {
         gamma,
         gamma2,
-        inv_gs2,
         beta,
         q,
-        kappa,
         phi,
+        kappa_top,
+        kappa_bottom,
+        ..
     } = *hs;
-    let h = 0.5 * kappa;
-    let den = gamma + beta - beta * kappa;
-    let mut t = (gamma * q - beta * q + beta * kappa) / den;
+    let n = c.len();
+    let cells = steps.len();
+    // Steps from here on touch the layered bottom's cells.
+    let tail_start = cells - (n - bulk.1);
+    // Per cell: h_j = κ_j / 2 and the output weight g_j = γ² φ1 / (γ² + c_j).
+    let cell = |j: usize| {
+        let s = 1.0 / (gamma2 + c[j]);
+        (0.5 * c[j] * phi * s, gamma2 * phi * s)
+    };
+    let den = gamma + beta - beta * kappa_top;
+    let mut t = (gamma * q - beta * q + beta * kappa_top) / den;
     let t0 = t;
     let top_u = beta / den;
-    let g = gamma2 * phi * inv_gs2;
     // The recursion t → t_next is a contraction (the shifted background is
     // lossy): once t has reached its fixed point to rounding
-    // (settle::converged), every later cell repeats this one.
+    // (settle::converged) in the bulk, every step up to the layered bottom
+    // repeats this one, and the recursion goes on from there.
     let mut last_change = f64::INFINITY;
-    let mut settled_from = steps.len();
-    for (j, step) in steps.iter_mut().enumerate() {
-        // M (a_{j+1}, d_j)ᵀ = R0 + R1 d_{j+1}, R0 = (−Δ/2 − (h−q) u, Δ/2 + h u), R1 = (h, q − h).
-        let m00 = 1.0 - h;
+    let mut j = 0;
+    while j < cells {
+        let ((h, g), (hn, _)) = (cell(j), cell(j + 1));
+        let m00 = 1.0 - hn;
         let m01 = (h - q) * t + h;
-        let m10 = h;
+        let m10 = hn;
         let m11 = 1.0 - h - h * t;
         let inv = 1.0 / (m00 * m11 - m01 * m10);
-        let (r1a, r1b) = (h, q - h);
+        let (r1a, r1b) = (hn, q - hn);
         let t_next = (m11 * r1a - m01 * r1b) * inv;
         let v = (m00 * r1b - m10 * r1a) * inv;
         // R0 = Δ (−1/2, 1/2) + u (q − h, h)
         let (da, db) = (C64::new(-0.5, 0.0), C64::new(0.5, 0.0));
         let (ea, eb) = (q - h, h);
-        *step = Step {
+        steps[j] = Step {
+            g,
             gt: g * (1.0 + t),
             v,
             ua: (m11 * da - m01 * db) * inv,
@@ -69,19 +92,26 @@ pub(super) fn sweep_coefficients(hs: &HarmonicShift, steps: &mut [Step]) -> ([C6
         };
         let change = (t_next - t).norm_sqr().sqrt();
         t = t_next;
-        if settle::converged(change, last_change, t.norm_sqr().sqrt()) {
-            settled_from = j + 1;
-            break;
+        if j >= bulk.0
+            && j + 1 < tail_start
+            && settle::converged(change, last_change, t.norm_sqr().sqrt())
+        {
+            let settled = steps[j];
+            steps[j + 1..tail_start].fill(settled);
+            j = tail_start;
+            last_change = f64::INFINITY;
+            continue;
         }
         last_change = change;
+        j += 1;
     }
-    settle::repeat_from(steps, settled_from);
     // Bottom: outgoing at z = H, d = (−β x' − ca u)/(t ca + cd).
-    let ca = gamma * q - beta * q + beta * kappa;
-    let cd = -gamma - beta + beta * kappa;
+    let ca = gamma * q - beta * q + beta * kappa_bottom;
+    let cd = -gamma - beta + beta * kappa_bottom;
     let den_b = t * ca + cd;
+    let (_, g) = cell(n - 1);
     let hc = HarmConst {
-        s: inv_gs2,
+        s: 1.0 / (gamma2 + c[bulk.0]),
         top: top_u,
         eb: -beta / den_b,
         eu: -ca / den_b,
@@ -93,6 +123,7 @@ pub(super) fn sweep_coefficients(hs: &HarmonicShift, steps: &mut [Step]) -> ([C6
 
 impl StepBlock {
     pub(super) const ZERO: StepBlock = StepBlock {
+        g: Cx::ZERO,
         gt: Cx::ZERO,
         v: Cx::ZERO,
         ua: Cx::ZERO,
@@ -102,6 +133,7 @@ impl StepBlock {
     };
 
     pub(super) fn set(&mut self, k: usize, s: &Step) {
+        self.g.set(k, s.g);
         self.gt.set(k, s.gt);
         self.v.set(k, s.v);
         self.ua.set(k, s.ua);
@@ -133,14 +165,15 @@ impl HarmBlock {
     }
 }
 
-/// Dense `(I − c M)⁻¹` by Gauss–Jordan with partial pivoting.
-pub(super) fn dense_inverse_shift(m: &[C64], n: usize, c: C64) -> Vec<C64> {
+/// Dense `(I − M C)⁻¹` (`C = diag(c)`, one shift per cell; with one shift
+/// in every cell `(I − c M)⁻¹`) by Gauss–Jordan with partial pivoting.
+pub(super) fn dense_inverse_shift(m: &[C64], n: usize, c: &[C64]) -> Vec<C64> {
     let mut a: Vec<C64> = (0..n * n)
         .map(|i| {
             if i / n == i % n {
-                1.0 - c * m[i]
+                1.0 - m[i] * c[i % n]
             } else {
-                -c * m[i]
+                -m[i] * c[i % n]
             }
         })
         .collect();

@@ -39,16 +39,18 @@ use num_complex::Complex64 as C64;
 
 const ZERO: C64 = C64 { re: 0.0, im: 0.0 };
 
-/// Per-harmonic constants of the banded system.
+/// Per-harmonic constants of the banded system. The shift may differ per
+/// z cell (a layered background): `κ_j = c_j φ1 / (γ² + c_j)` of the top and
+/// bottom cells are kept for the boundary values.
 #[derive(Debug, Clone, Copy)]
 struct HarmonicShift {
     gamma: C64,
     gamma2: C64,
-    inv_gs2: C64,
     beta: C64,
     q: C64,
-    kappa: C64,
     phi: C64,
+    kappa_top: C64,
+    kappa_bottom: C64,
 }
 
 /// A near-grazing harmonic: dense `(I − c M)⁻¹`, `G_s = (I − c M)⁻¹ M` and
@@ -63,10 +65,12 @@ struct Dense {
 
 /// Down-sweep coefficients of cell j for `W` harmonics, independent of
 /// the right-hand side: `u_{j+1} = ua Δ_j + ub u_j`, `w_j = wa Δ_j + wb u_j`,
-/// `d_j = v d_{j+1} + w_j`, and `gt = g (1 + t_j)` the output weight of
-/// `d_j` (`G_s x` at cell j is `g σ_j − x'_j`, `σ_j = (1 + t_j) d_j + u_j`).
+/// `d_j = v d_{j+1} + w_j`, and `gt = g_j (1 + t_j)` the output weight of
+/// `d_j` (`G_s x` at cell j is `g_j σ_j − x'_j`, `σ_j = (1 + t_j) d_j + u_j`,
+/// `g_j = γ² φ1 / (γ² + c_j)`).
 #[derive(Debug, Clone, Copy)]
 struct StepBlock {
+    g: Cx,
     gt: Cx,
     v: Cx,
     ua: Cx,
@@ -76,10 +80,12 @@ struct StepBlock {
 }
 
 /// Per-harmonic constants of `W` harmonics of one spectral row: the input
-/// scale `s = 1/γ_s²` (and `sn = s/(nx ny)`, which also normalises the inverse
-/// FFT), the top relation `u_0 = top x'_0`, the bottom closure
-/// `d_{N−1} = eb x'_{N−1} + eu u_{N−1}`, the output weight `g = γ² φ1 s` and
-/// `gtl = g (1 + t_{N−1})`. Near-grazing (dense) harmonics have zeros.
+/// scale `s = 1/γ_s²` of the bottom cell (and `sn = s/(nx ny)`, which also
+/// normalises the inverse FFT; the cells of a layered top zone carry their
+/// own factor on top, [`ShiftTable::zone_ratio`]), the top relation
+/// `u_0 = top x'_0`, the bottom closure `d_{N−1} = eb x'_{N−1} + eu u_{N−1}`,
+/// the bottom cell's output weight `g = γ² φ1 s` and `gtl = g (1 + t_{N−1})`.
+/// Near-grazing (dense) harmonics have zeros.
 #[derive(Debug, Clone, Copy)]
 struct HarmBlock {
     s: Cx,
@@ -102,7 +108,16 @@ struct HarmBlock {
 /// instead of N, and the table stays in cache instead of streaming
 /// 96 bytes per voxel on every application.
 pub struct ShiftTable {
-    pub c: C64,
+    /// The shift per z cell, `c_j = k0²(ε_bg,j − ε_b)`.
+    pub c: Vec<C64>,
+    /// The bulk of the profile ([`settle::bulk_run`]): cells
+    /// `bulk.0..bulk.1` share one shift; the cells before (a layered top)
+    /// and after (a layered bottom) are the zone.
+    bulk: (usize, usize),
+    /// Per block of `W` harmonics (layout (ix, block)) and zone cell (the
+    /// top's, then the bottom's): the input scale of cell j relative to
+    /// `s`, `(γ² + c_bulk)/(γ² + c_j)`.
+    zone_ratio: Vec<Cx>,
     /// Spectral layout ix·ny + iy; `None` for dense (near-grazing) harmonics.
     h: Vec<Option<HarmonicShift>>,
     /// Per harmonic: `[top_u, t_0, t_{N−1}]` (for the boundary values).
@@ -120,6 +135,7 @@ pub struct ShiftTable {
 /// One cell's coefficients of one harmonic (scalar form of [`StepBlock`]).
 #[derive(Debug, Clone, Copy)]
 struct Step {
+    g: C64,
     gt: C64,
     v: C64,
     ua: C64,
@@ -139,14 +155,28 @@ struct HarmConst {
 }
 
 impl ShiftTable {
-    /// Build for background `eps_b` (real binder) and shift `c`.
+    /// Build for background `eps_b` (real binder) and one shift `c` in
+    /// every cell.
     pub fn new(lat: &Lattice, eps_b: f64, c: C64) -> Self {
+        Self::layered(lat, eps_b, &vec![c; lat.nz])
+    }
+
+    /// Build for background `eps_b` and the shift `c[j]` of each z cell
+    /// (a layered background `ε_b + c_j/k0²`; exact for any profile). The
+    /// tables settle in the profile's bulk ([`settle::bulk_run`]); the
+    /// zone's cells above and below it are stored one by one.
+    pub fn layered(lat: &Lattice, eps_b: f64, c: &[C64]) -> Self {
         let slab = lat.slab();
         let n = lat.nz;
+        assert_eq!(c.len(), n, "one shift per z cell");
         let dz = slab.dz();
         let (nx, ny) = (lat.nx, lat.ny);
         let nb = ny.div_ceil(W);
         let norm = 1.0 / (nx * ny) as f64;
+        let bulk = settle::bulk_run(c);
+        let cb = c[bulk.0];
+        let zone_cells: Vec<usize> = (0..bulk.0).chain(bulk.1..n).collect();
+        let zone = zone_cells.len();
         let mut h = Vec::with_capacity(lat.harmonics());
         let mut dense = Vec::new();
         for ix in 0..nx {
@@ -175,15 +205,16 @@ impl ShiftTable {
                 } else {
                     let gamma = green::sqrt_branch(g2);
                     let x = C64::i() * gamma * dz;
-                    let inv_gs2 = 1.0 / (g2 + c);
+                    let phi = green::phi1(x);
+                    let kappa = |c: C64| c * phi * (1.0 / (g2 + c));
                     h.push(Some(HarmonicShift {
                         gamma,
                         gamma2: g2,
-                        inv_gs2,
                         beta,
                         q: x.exp(),
-                        kappa: c * green::phi1(x) * inv_gs2,
-                        phi: green::phi1(x),
+                        phi,
+                        kappa_top: kappa(c[0]),
+                        kappa_bottom: kappa(c[n - 1]),
                     }));
                 }
             }
@@ -191,7 +222,8 @@ impl ShiftTable {
         let cells = n - 1;
         let mut ends = vec![[ZERO; 3]; h.len()];
         let mut harm = vec![HarmBlock::ZERO; nx * nb];
-        let mut steps = Packed::new(ny);
+        let mut zone_ratio = vec![Cx::splat(C64::new(1.0, 0.0)); nx * nb * zone];
+        let mut steps = Packed::new(ny, n - bulk.1);
         // One row's full columns, layout (iy, j).
         let mut full = vec![Step::ZERO; ny * cells];
         for ix in 0..nx {
@@ -202,9 +234,14 @@ impl ShiftTable {
                     col.fill(Step::ZERO);
                     continue;
                 };
-                let (e, hb) = sweep_coefficients(hs, col);
+                let (e, hb) = sweep_coefficients(hs, c, bulk, col);
                 ends[i] = e;
-                harm[ix * nb + iy / W].set(iy % W, &hb, norm);
+                let blk = ix * nb + iy / W;
+                harm[blk].set(iy % W, &hb, norm);
+                let ratios = &mut zone_ratio[blk * zone..(blk + 1) * zone];
+                for (r, &j) in ratios.iter_mut().zip(&zone_cells) {
+                    r.set(iy % W, (hs.gamma2 + cb) / (hs.gamma2 + c[j]));
+                }
             }
             steps.push_row(
                 &full,
@@ -215,7 +252,9 @@ impl ShiftTable {
             );
         }
         ShiftTable {
-            c,
+            c: c.to_vec(),
+            bulk,
+            zone_ratio,
             h,
             ends,
             dense,
@@ -224,6 +263,34 @@ impl ShiftTable {
             nb,
             steps,
             harm,
+        }
+    }
+
+    /// The zone cells' input factors of block `b` of row `ix`: the top's
+    /// and the bottom's.
+    #[inline(always)]
+    fn zone_of(&self, ix: usize, b: usize) -> (&[Cx], &[Cx]) {
+        let zone = self.bulk.0 + self.n - self.bulk.1;
+        let i = ix * self.nb + b;
+        self.zone_ratio[i * zone..(i + 1) * zone].split_at(self.bulk.0)
+    }
+
+    /// `x ← x · ratio` on the zone's cells of one block's cells.
+    #[inline(always)]
+    fn scale_zone(&self, ix: usize, b: usize, x: &mut [Cx]) {
+        let (top, bottom) = self.zone_of(ix, b);
+        let (head, tail) = x.split_at_mut(self.bulk.1);
+        for (x, r) in head.iter_mut().zip(top).chain(tail.iter_mut().zip(bottom)) {
+            *x = *x * *r;
+        }
+    }
+
+    /// The same on lane `k` of a column.
+    fn scale_zone_lane(&self, ix: usize, b: usize, k: usize, x: &mut [C64]) {
+        let (top, bottom) = self.zone_of(ix, b);
+        let (head, tail) = x.split_at_mut(self.bulk.1);
+        for (x, r) in head.iter_mut().zip(top).chain(tail.iter_mut().zip(bottom)) {
+            *x *= r.lane(k);
         }
     }
 
@@ -240,11 +307,10 @@ impl ShiftTable {
         self.steps.stored_cells()
     }
 
-    /// The stored cells of block `b` of row `ix` (the last one stands for
-    /// all later cells).
+    /// The stored cells of block `b` of row `ix`.
     #[inline(always)]
-    fn steps_of(&self, ix: usize, b: usize) -> &[StepBlock] {
-        self.steps.of(ix, b)
+    fn steps_of(&self, ix: usize, b: usize) -> settle::Steps<'_, StepBlock> {
+        self.steps.of(ix, b, self.n - 1)
     }
 
     /// Spectral indices of the near-grazing (dense) harmonics.

@@ -8,7 +8,7 @@ use crate::solver::simd::{self, Cx, W};
 use num_complex::Complex64 as C64;
 
 impl ShiftTable {
-    /// `col ← (I − c G_h)⁻¹ col` for harmonic `index` (column in `scr.col`).
+    /// `col ← (I − G_h C)⁻¹ col` for harmonic `index` (column in `scr.col`).
     ///
     /// With `h = κ/2` and `Δ_j = (b_j − b_{j+1})/γ_s²`, continuity at interface
     /// j reads `a_{j+1} = q a_j − s_j`, `d_j = q d_{j+1} + s_j`,
@@ -16,16 +16,30 @@ impl ShiftTable {
     /// reflection relation `a_j = t_j d_j + u_j` from the top boundary
     /// (|t_j| ≲ 1: a reflection coefficient, so the sweep is stable), the
     /// bottom boundary closes it, and an up sweep recovers every `d_j`, `a_j`.
-    /// Computed as `b + c G_s b` (`(I − c G_h)⁻¹ = I + c G_s`).
+    /// With a shift `C` that differs between cells the inverse is
+    /// `(I − G_h C)⁻¹ = I + G_s C` (what turns the incident field into the
+    /// shifted background's, `u_s`); with one shift both orders agree.
     pub fn solve_column(&self, index: usize, scr: &mut BandScratch) {
         if self.h[index].is_none() {
             self.dense_column(index, scr, Output::ShiftInverse);
             return;
         }
         let x = scr.col.clone();
+        if self.bulk == (0, self.n) {
+            // One shift: `b + c G_s b`.
+            let c = self.c[0];
+            self.shifted_green_column(index, scr);
+            for (y, x) in scr.col.iter_mut().zip(x) {
+                *y = x + c * *y;
+            }
+            return;
+        }
+        for (y, c) in scr.col.iter_mut().zip(&self.c) {
+            *y *= c;
+        }
         self.shifted_green_column(index, scr);
         for (y, x) in scr.col.iter_mut().zip(x) {
-            *y = x + self.c * *y;
+            *y += x;
         }
     }
 
@@ -57,15 +71,20 @@ impl ShiftTable {
         );
         let [_, t0, t_last] = self.ends[index];
         let col = &mut scr.col;
-        let x0 = col[0] * s;
+        // x' = x s, times the layered zone's own factor (as the row kernel).
+        for x in col.iter_mut() {
+            *x *= s;
+        }
+        self.scale_zone_lane(ix, b, k, col);
+        let x0 = col[0];
         let mut bp = x0;
         let mut u = top * bp;
         let u0 = u;
         for j in 0..n - 1 {
-            let st = &steps[j.min(steps.len() - 1)];
-            let bn = col[j + 1] * s;
+            let st = steps.at(j);
+            let bn = col[j + 1];
             let delta = bp - bn;
-            col[j] = g * u - bp;
+            col[j] = st.g.lane(k) * u - bp;
             scr.w[j] = st.wa.lane(k) * delta + st.wb.lane(k) * u;
             u = st.ua.lane(k) * delta + st.ub.lane(k) * u;
             bp = bn;
@@ -74,15 +93,15 @@ impl ShiftTable {
         col[n - 1] = gtl * d + (g * u - bp);
         // w(H) = p + a q + d with p = −x' − κ σ.
         let a = t_last * d + u;
-        let wh = -bp - hs.kappa * (a + d) + a * hs.q + d;
+        let wh = -bp - hs.kappa_bottom * (a + d) + a * hs.q + d;
         for j in (0..n - 1).rev() {
-            let st = &steps[j.min(steps.len() - 1)];
+            let st = steps.at(j);
             d = st.v.lane(k) * d + scr.w[j];
             col[j] = st.gt.lane(k) * d + col[j];
         }
         // w(0) = p_0 + a_0 + d_0 q.
         let a = t0 * d + u0;
-        let w0 = -x0 - hs.kappa * (a + d) + a + d * hs.q;
+        let w0 = -x0 - hs.kappa_top * (a + d) + a + d * hs.q;
         (w0, wh)
     }
 
@@ -102,7 +121,7 @@ impl ShiftTable {
         let (mut w0, mut wh) = (ZERO, ZERO);
         if out == Output::ShiftedGreen {
             for (k, (x, y)) in x.iter().zip(&scr.col).enumerate() {
-                let src = x + self.c * y;
+                let src = x + self.c[k] * y;
                 w0 += d.top[k] * src;
                 wh += d.bottom[k] * src;
             }
@@ -145,15 +164,15 @@ impl ShiftTable {
         let w = &mut scr.w;
         for (b, (hb, x)) in hbs.iter().zip(cells).enumerate() {
             let steps = self.steps_of(ix, b);
-            let last = steps.len().saturating_sub(1);
+            self.scale_zone(ix, b, x);
             // Down sweep: w_j to scratch, g u_j − x'_j in place.
             let mut bp = x[0];
             let mut u = hb.top * bp;
             for j in 0..n - 1 {
-                let st = &steps[j.min(last)];
+                let st = steps.at(j);
                 let bn = x[j + 1];
                 let delta = bp - bn;
-                x[j] = hb.g * u - bp;
+                x[j] = st.g * u - bp;
                 w[j] = st.wa * delta + st.wb * u;
                 u = st.ua * delta + st.ub * u;
                 bp = bn;
@@ -162,7 +181,7 @@ impl ShiftTable {
             let mut d = hb.eb * bp + hb.eu * u;
             x[n - 1] = hb.gtl * d + (hb.g * u - bp);
             for j in (0..n - 1).rev() {
-                let st = &steps[j.min(last)];
+                let st = steps.at(j);
                 d = st.v * d + w[j];
                 x[j] = st.gt * d + x[j];
             }
@@ -193,8 +212,27 @@ mod tests {
     use super::*;
     use crate::solver::green;
 
-    /// The sweep against a dense solve of (I − c G_h) y = b built from the
-    /// Galerkin entries, for propagating, evanescent and near-grazing harmonics.
+    /// A layered shift: air-like cells on top of a lossy mean, the mean,
+    /// and two other cells at the bottom.
+    fn layered(k0: f64, eps_b: f64, n: usize) -> Vec<C64> {
+        (0..n)
+            .map(|j| {
+                let e = match j {
+                    0 => C64::new(1.05, 0.3),
+                    1 => C64::new(1.4, 0.4),
+                    2 => C64::new(2.0, 0.2),
+                    j if j + 1 == n => C64::new(1.1, 0.3),
+                    j if j + 2 == n => C64::new(1.6, 0.5),
+                    _ => C64::new(1.9, 0.7),
+                };
+                k0 * k0 * (e - eps_b)
+            })
+            .collect()
+    }
+
+    /// The sweep against a dense solve of (I − C G_h) y = b built from the
+    /// Galerkin entries, for propagating, evanescent and near-grazing
+    /// harmonics, with one shift in every cell and with a layered top.
     #[test]
     fn sweep_matches_dense() {
         let n = 12;
@@ -202,10 +240,15 @@ mod tests {
         let k0 = 2.0 * std::f64::consts::PI / lambda;
         let eps_b = 1.558f64.powi(2);
         let size = [900.0, 900.0, 600.0];
-        for polar in [0.0, 30.0] {
+        let uniform = vec![k0 * k0 * C64::new(1.9 - eps_b, 0.7); n];
+        for (polar, c) in [
+            (0.0, &uniform),
+            (30.0, &uniform),
+            (0.0, &layered(k0, eps_b, n)),
+            (30.0, &layered(k0, eps_b, n)),
+        ] {
             let lat = crate::solver::Problem::lattice([6, 6, n], size, lambda, polar, 0.0);
-            let c = k0 * k0 * C64::new(1.9 - eps_b, 0.7);
-            let table = ShiftTable::new(&lat, eps_b, c);
+            let table = ShiftTable::layered(&lat, eps_b, c);
             let slab = lat.slab();
             for ix in 0..6 {
                 for iy in 0..6 {
@@ -231,7 +274,7 @@ mod tests {
                                 .sum()
                         })
                         .collect();
-                    let src: Vec<C64> = (0..n).map(|k| b[k] + c * gs_b[k]).collect();
+                    let src: Vec<C64> = (0..n).map(|k| b[k] + c[k] * gs_b[k]).collect();
                     let w0: C64 = (0..n).map(|k| coef.top_weight(n, k) * src[k]).sum();
                     let wh: C64 = (0..n).map(|k| coef.bottom_weight(n, k) * src[k]).sum();
                     let mut scr = BandScratch::new(n);
@@ -267,7 +310,8 @@ mod tests {
         }
     }
 
-    /// The row-vectorised sweep equals the column sweep bit for bit.
+    /// The row-vectorised sweep equals the column sweep bit for bit, with
+    /// one shift and with a layered top.
     #[test]
     fn row_sweep_equals_column_sweep() {
         let n = 10;
@@ -275,22 +319,26 @@ mod tests {
             crate::solver::Problem::lattice([5, 7, n], [900.0, 700.0, 600.0], 480.0, 25.0, 10.0);
         let eps_b = 1.558f64.powi(2);
         let c = lat.k0 * lat.k0 * C64::new(1.7 - eps_b, 0.9);
-        let table = ShiftTable::new(&lat, eps_b, c);
-        for ix in 0..5 {
-            let mut row = ndarray::Array2::from_shape_fn((n, 7), |(j, iy)| {
-                C64::new((j * 7 + iy) as f64 * 0.1, (j as f64).cos())
-            });
-            let orig = row.clone();
-            let mut scr = RowScratch::new(n, 7);
-            table.shifted_green_row(ix, &mut row.view_mut(), &mut scr, false);
-            for iy in 0..7 {
-                let mut col = BandScratch::new(n);
-                for j in 0..n {
-                    col.column()[j] = orig[[j, iy]];
-                }
-                table.shifted_green_column(ix * 7 + iy, &mut col);
-                for j in 0..n {
-                    assert_eq!(row[[j, iy]], col.column()[j], "{ix} {iy} {j}");
+        for table in [
+            ShiftTable::new(&lat, eps_b, c),
+            ShiftTable::layered(&lat, eps_b, &layered(lat.k0, eps_b, n)),
+        ] {
+            for ix in 0..5 {
+                let mut row = ndarray::Array2::from_shape_fn((n, 7), |(j, iy)| {
+                    C64::new((j * 7 + iy) as f64 * 0.1, (j as f64).cos())
+                });
+                let orig = row.clone();
+                let mut scr = RowScratch::new(n, 7);
+                table.shifted_green_row(ix, &mut row.view_mut(), &mut scr, false);
+                for iy in 0..7 {
+                    let mut col = BandScratch::new(n);
+                    for j in 0..n {
+                        col.column()[j] = orig[[j, iy]];
+                    }
+                    table.shifted_green_column(ix * 7 + iy, &mut col);
+                    for j in 0..n {
+                        assert_eq!(row[[j, iy]], col.column()[j], "{ix} {iy} {j}");
+                    }
                 }
             }
         }

@@ -52,6 +52,7 @@
 //! find it through the registry.
 
 pub mod airy;
+pub mod background;
 pub mod fft;
 pub mod green;
 pub mod heartbeat;
@@ -71,13 +72,14 @@ use crate::config::{Background, Linear, Method, Precision};
 use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
+pub use background::{
+    air_cells, ShiftParams, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR, SHIFT_MARGIN,
+};
 pub use jones::Jones;
 pub use lattice::Lattice;
 pub use methods::{Outcome, Solver, Validity};
 pub use storage::{dot, Field, Storage};
-pub use system::{
-    air_cells, Scratch, ShiftParams, System, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR, SHIFT_MARGIN,
-};
+pub use system::{Scratch, System};
 
 /// What every solve records, stored beside its result.
 #[derive(Debug, Clone)]

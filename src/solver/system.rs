@@ -7,13 +7,15 @@
 //! backgrounds ([`Background`]): the convergent-Born-series shift
 //! `ε_r + iε_s` with its preconditioner (see
 //! [`marching`](super::methods::marching)), or the layer's mean permittivity
-//! `⟨ε⟩` with a loss floor ([`MEAN_LOSS_FLOOR`]) and no preconditioner
-//! (METHOD §4, "The mean background"). It is
+//! `⟨ε⟩` with a loss floor, per cell where a face holds air, and no
+//! preconditioner (METHOD §4, "The mean background"; chosen in
+//! [`background`](super::background)). It is
 //! built once per solve and read by the methods through its operations
 //! (residuals, the shifted operator, the preconditioner, the far field).
 //! [`Scratch`] is the working memory of those operations, owned by the caller
 //! and passed in, so no application allocates.
 
+use super::background::{mean_profile, shift_of, ShiftParams};
 use super::green;
 use super::lattice::Lattice;
 use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
@@ -26,72 +28,6 @@ use crate::config::Background;
 use crate::raster::Anisotropy;
 use ndarray::{s, Array2, Array3, Ix3, Zip};
 use num_complex::Complex64 as C64;
-
-/// ε_s = SHIFT_MARGIN · max|ε − ε_r| (1 makes CBS stall on the extreme voxels).
-pub const SHIFT_MARGIN: f64 = 1.05;
-
-/// The mean background's loss floor in the scalar equation:
-/// `Im ε_bg ≥ MEAN_LOSS_FLOOR · max|ε − ⟨ε⟩|²`.
-/// A lossless mean slab has sharp guided resonances that Krylov methods
-/// resolve slowly; a loss growing with the square of the contrast (as the
-/// scattering loss of the coherent wave does) damps them where scattering is
-/// strong and leaves weak layers alone. 0.1 was the best of 0–0.25 on the
-/// layers of docs/PERFORMANCE.md ("The mean background").
-pub const MEAN_LOSS_FLOOR: f64 = 0.1;
-
-/// In Maxwell's equations the floor grows at most linearly with the
-/// contrast: `Im ε_bg ≥ min(MEAN_LOSS_FLOOR · r², MEAN_LOSS_CAP_MAXWELL · r)`,
-/// `r = max|ε − ⟨ε⟩|`. A grain's polarisability saturates there as its
-/// index grows (the local-field factor (ε − ε_m)/(ε + 2ε_m) tends to 1),
-/// so high-index grains damp the coherent wave far less than the square of
-/// the contrast says, and the scalar rule over-damps the background: on
-/// rutile layers the applications are 1.2–2.3× fewer at the cap than
-/// at `0.1 r²`, while layers of contrast below 1.5 (stand-ins, air
-/// under a relief) keep the scalar floor, which suits them
-/// (docs/PERFORMANCE.md, "High contrast: rutile in binder").
-pub const MEAN_LOSS_CAP_MAXWELL: f64 = 0.15;
-
-/// How the shifted form's background is chosen.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ShiftParams {
-    pub background: Background,
-    /// CBS: `ε_s = margin · max|ε − ε_r|`, in [1, 100].
-    pub margin: f64,
-    /// Mean: the loss floor factor, in [0, 100].
-    pub mean_loss_floor: f64,
-    /// Mean: the floor is at most this times `max|ε − ⟨ε⟩|`, in [0, ∞]
-    /// (∞: no cap, the scalar equation's default).
-    pub mean_loss_cap: f64,
-    /// Mean: the cells holding air at either face take their own lateral
-    /// mean ([`air_cells`]; the default); `false`: one mean for every cell.
-    pub layered_air: bool,
-}
-
-impl ShiftParams {
-    /// The defaults for `background` in the scalar equation.
-    pub const fn of(background: Background) -> ShiftParams {
-        ShiftParams {
-            background,
-            margin: SHIFT_MARGIN,
-            mean_loss_floor: MEAN_LOSS_FLOOR,
-            mean_loss_cap: f64::INFINITY,
-            layered_air: true,
-        }
-    }
-
-    /// The defaults for `background` in the equation `wave` is solved in
-    /// (Maxwell's caps the loss floor: [`MEAN_LOSS_CAP_MAXWELL`]).
-    pub const fn for_wave(background: Background, wave: &Wave) -> ShiftParams {
-        let mean_loss_cap = match wave {
-            Wave::Scalar => f64::INFINITY,
-            Wave::Vector { .. } => MEAN_LOSS_CAP_MAXWELL,
-        };
-        ShiftParams {
-            mean_loss_cap,
-            ..ShiftParams::of(background)
-        }
-    }
-}
 
 /// The discrete equation `u = u_bg + G_b V u` of one problem, in its plain
 /// and its shifted form.
@@ -193,44 +129,6 @@ enum OpWorkspace {
     Vector(VectorWorkspace),
 }
 
-/// Real centre and radius of the permittivity values: (ε_r, max|ε − ε_r|),
-/// the tensor voxels' spectra included ([`spread`]).
-pub fn shift_of(eps: &Array3<C64>, tensor: Option<&Anisotropy>, eps_binder: f64) -> (f64, f64) {
-    let (mut lo, mut hi) = (eps_binder, eps_binder);
-    for e in eps.iter() {
-        lo = lo.min(e.re);
-        hi = hi.max(e.re);
-    }
-    if let Some(a) = tensor {
-        for (e, sum, bound) in tensor::voxels(a, eps) {
-            lo = lo.min(e.re + sum.re.min(0.0) - (bound - sum.norm()));
-            hi = hi.max(e.re + sum.re.max(0.0) + (bound - sum.norm()));
-        }
-    }
-    let er = 0.5 * (lo + hi);
-    let rad = eps
-        .iter()
-        .map(|e| (e - er).norm())
-        .fold((eps_binder - er).abs(), f64::max);
-    (er, rad.max(spread(eps, tensor, C64::new(er, 0.0))))
-}
-
-/// The largest `‖ε_v − centre‖` over the tensor voxels: exact
-/// (`max(|ε_v − c|, |ε_v + δ − c|)`) for one axis per voxel, the triangle
-/// bound `|ε_v − c| + Σ|δ|` otherwise; 0 without a tensor part.
-fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64) -> f64 {
-    let Some(a) = tensor else { return 0.0 };
-    tensor::voxels(a, eps)
-        .map(|(e, sum, bound)| {
-            if bound - sum.norm() <= 1e-12 * bound {
-                (e - centre).norm().max((e + sum - centre).norm())
-            } else {
-                (e - centre).norm() + bound
-            }
-        })
-        .fold(0.0, f64::max)
-}
-
 impl<'a> System<'a> {
     /// The system of `p` with the Krylov methods' background `bg` and the
     /// defaults of its equation ([`ShiftParams::for_wave`]).
@@ -240,7 +138,7 @@ impl<'a> System<'a> {
 
     /// As [`System::new`] with other shift parameters: the CBS shift
     /// `ε_s = margin · max|ε − ε_r|` (margin ≥ 1; Osnabrugge et al. take 1,
-    /// [`SHIFT_MARGIN`] is the default) or the mean background's loss floor.
+    /// [`SHIFT_MARGIN`](super::SHIFT_MARGIN) is the default) or the mean background's loss floor.
     pub fn with_params(p: &Problem<'a>, params: ShiftParams) -> Result<Self, SolveError> {
         let margin = params.margin;
         if !(1.0..=100.0).contains(&margin) {
@@ -715,90 +613,6 @@ impl<'a> System<'a> {
         let absorption = lat.k0 * lat.k0 / beta00 * s * dz / lat.harmonics() as f64;
         (r, t, absorption)
     }
-}
-
-/// Mean of the permittivity over every voxel, the mean background.
-pub fn mean_eps(eps: &Array3<C64>) -> C64 {
-    eps.iter().sum::<C64>() / eps.len() as f64
-}
-
-/// The layered zones of the mean background, `(top, bottom)` cells: from
-/// the top face down to the deepest cell of the upper half that holds air
-/// (a voxel of ε = 1: a relief above the binder, the air over a conformal
-/// film or a rough surface), and likewise from the bottom face up (a layer
-/// lit from below is solved upside down); 0 where a face is flat.
-pub fn air_cells(eps: &Array3<C64>) -> (usize, usize) {
-    let air = C64::new(1.0, 0.0);
-    let nz = eps.dim().0;
-    let has_air: Vec<bool> = eps
-        .outer_iter()
-        .map(|s| s.iter().any(|&e| e == air))
-        .collect();
-    let half = nz / 2;
-    let top = (0..half).rev().find(|&j| has_air[j]).map_or(0, |j| j + 1);
-    let bottom = (half..nz).find(|&j| has_air[j]).map_or(0, |j| nz - j);
-    (top, bottom)
-}
-
-/// The mean background's permittivity per z cell: the mean of the cells
-/// between the layered zones ([`air_cells`]), and in each cell of a zone its
-/// own lateral mean (the tensor voxels add a third of their trace), each
-/// with the loss floor of the largest contrast left, `r = max|ε − ε̄_j|`.
-fn mean_profile(eps: &Array3<C64>, tensor: Option<&Anisotropy>, params: ShiftParams) -> Vec<C64> {
-    let (nz, ny, nx) = eps.dim();
-    // Air in every cell (a porous layer, voids in an explicit structure)
-    // leaves no bulk: one mean then.
-    let (top, bottom) = match air_cells(eps) {
-        (t, b) if params.layered_air && t + b < nz => (t, b),
-        _ => (0, 0),
-    };
-    let plane = (ny * nx) as f64;
-    // Per cell: the sum of ε and of a third of the tensor traces.
-    let sums: Vec<C64> = (0..nz)
-        .map(|j| {
-            eps.index_axis(ndarray::Axis(0), j).sum()
-                + tensor.map_or(C64::new(0.0, 0.0), |a| {
-                    a.slice(j).iter().map(|t| t.delta).sum::<C64>() / 3.0
-                })
-        })
-        .collect();
-    let inner = top..nz - bottom;
-    let bulk = if inner.len() == nz {
-        // Flat faces: the mean over every voxel, summed as always.
-        mean_eps(eps)
-            + tensor.map_or(C64::new(0.0, 0.0), |a| {
-                a.terms.iter().map(|t| t.delta).sum::<C64>() / (3.0 * eps.len() as f64)
-            })
-    } else {
-        sums[inner.clone()].iter().sum::<C64>() / (plane * inner.len() as f64)
-    };
-    let means: Vec<C64> = (0..nz)
-        .map(|j| {
-            if inner.contains(&j) {
-                bulk
-            } else {
-                sums[j] / plane
-            }
-        })
-        .collect();
-    let rad = eps
-        .outer_iter()
-        .zip(&means)
-        .map(|(s, m)| s.iter().map(|e| (e - m).norm_sqr()).fold(0.0, f64::max))
-        .fold(0.0, f64::max)
-        .sqrt()
-        .max(spread(eps, tensor, bulk));
-    // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
-    let cap = if rad > 0.0 {
-        params.mean_loss_cap * rad
-    } else {
-        0.0
-    };
-    let floor = (params.mean_loss_floor * rad * rad).min(cap);
-    means
-        .iter()
-        .map(|m| C64::new(m.re, m.im.max(floor).max(1e-9)))
-        .collect()
 }
 
 impl Shift {

@@ -326,7 +326,8 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     }
     let (ok, plan2, _) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
     // The finished results' applications against the rates assumed for
-    // them, averaged with 1 counted as 5 results.
+    // them, averaged with 1 counted as 5 results; per kind of top, so the
+    // flat results leave the surfaces' factor alone.
     let (mut measured, mut assumed) = (0.0, 0.0);
     for v in &three.variants {
         for e in &got[&v.name].entries {
@@ -338,8 +339,9 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     let blended = (5.0 + 4.0 * r) / 9.0;
     assert!(
         ok && plan2.contains(&format!(
-            "× {blended:.2}: the 4 finished result(s) of this study needed {r:.2}× the \
-             assumed rates, averaged with 1× counted as 5 result(s)"
+            "flat tops × {blended:.2}: the 4 finished result(s) of this kind needed {r:.2}× the \
+             assumed rates, averaged with 1× counted as 5 result(s); surfaces × 1.00: no \
+             finished result of this kind yet"
         )),
         "{plan2}"
     );

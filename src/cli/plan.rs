@@ -51,13 +51,15 @@ pub fn plan(
          natural light one random-phase solve for an ensemble, else two); applications per solve {:.0} under a \
          flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
          background; measured at a tolerance of 1e-4, 1e-6 on the binder, and scaled to each \
-         scene's as 2.5 + log10(1/tolerance)), × {:.2}: {}",
+         scene's as 2.5 + log10(1/tolerance)); flat tops × {:.2}: {}; surfaces × {:.2}: {}",
         plan::KRYLOV_OVERHEAD,
         plan::MEAN_APPLICATIONS,
         plan::MEAN_APPLICATIONS_SURFACE,
         plan::BINDER_APPLICATIONS,
         cal.ratio,
-        cal.applications_source
+        cal.applications_source,
+        cal.surface_ratio,
+        cal.surface_source
     );
     for (key, g) in &cal.groups {
         let pilot = match &g.pilot {

@@ -91,13 +91,19 @@ pub fn tolerance_factor(tol: f64, reference: f64) -> f64 {
 /// background, by whether its top is flat; scaled from the tolerance each
 /// rate was measured at to the scene's ([`tolerance_factor`]).
 pub fn default_applications(scene: &Scene) -> f64 {
-    let flat = scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat;
     let (rate, measured_at) = match scene.solver.background {
         Background::Binder => (BINDER_APPLICATIONS, BINDER_RATE_TOLERANCE),
-        Background::Mean if flat => (MEAN_APPLICATIONS, MEAN_RATE_TOLERANCE),
+        Background::Mean if flat_top(scene) => (MEAN_APPLICATIONS, MEAN_RATE_TOLERANCE),
         Background::Mean => (MEAN_APPLICATIONS_SURFACE, MEAN_RATE_TOLERANCE),
     };
     rate * tolerance_factor(scene.solver.tolerance, measured_at)
+}
+
+/// Whether a scene's top is a plane (no relief, conformal film or rough
+/// surface): the two kinds of layer whose rates are assumed, and scaled by
+/// the finished results, apart.
+pub fn flat_top(scene: &Scene) -> bool {
+    scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat
 }
 /// Wave solves per incidence: one (Helmholtz, and Maxwell's random-phase
 /// natural light), or one per polarisation solved (Maxwell; natural light
@@ -141,11 +147,17 @@ pub struct Calibration {
     /// Per distinct grid (nx, ny, nz) and equation → its timing, scaled to
     /// that grid.
     pub grids: BTreeMap<([usize; 3], Equation), GridTiming>,
-    /// Factor on every variant's assumed applications per solve
-    /// ([`default_applications`]) from the study's finished results.
+    /// Factor on the assumed applications per solve
+    /// ([`default_applications`]) of the variants under a flat top, from the
+    /// study's finished results of that kind.
     pub ratio: f64,
     /// Where `ratio` came from.
     pub applications_source: String,
+    /// The same for the variants under relief, a conformal film or a rough
+    /// surface ([`flat_top`]), from the finished results of that kind.
+    pub surface_ratio: f64,
+    /// Where `surface_ratio` came from.
+    pub surface_source: String,
     /// High-contrast groups ([`pilot::group`]) → their own factor, from a
     /// pilot solve and their finished results, in place of `ratio`.
     pub groups: BTreeMap<String, GroupRate>,
@@ -342,19 +354,35 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
             (key.clone(), rate)
         })
         .collect();
-    let (ratio, applications_source) = match measured(None) {
-        None => (
-            1.0,
-            "no finished result yet: the measured rates as assumed (docs/PERFORMANCE.md, \
-             \"The standard study\")"
-                .to_string(),
-        ),
-        done => blend((1.0, PRIOR_RESULTS), done, "1×", "study"),
+    // The ordinary layers' factor, per kind of top.
+    let kind = |flat: bool| {
+        let of_kind: Vec<Variant> = done
+            .get(&None)
+            .map(|f| {
+                f.iter()
+                    .filter(|v| flat_top(&v.scene) == flat)
+                    .cloned()
+                    .collect()
+            })
+            .unwrap_or_default();
+        match measured_ratio(&of_kind) {
+            None => (
+                1.0,
+                "no finished result of this kind yet: the measured rates as assumed \
+                 (docs/PERFORMANCE.md, \"The standard study\")"
+                    .to_string(),
+            ),
+            done => blend((1.0, PRIOR_RESULTS), done, "1×", "kind"),
+        }
     };
+    let (ratio, applications_source) = kind(true);
+    let (surface_ratio, surface_source) = kind(false);
     Calibration {
         grids,
         ratio,
         applications_source,
+        surface_ratio,
+        surface_source,
         groups,
     }
 }
@@ -393,9 +421,14 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
     } else {
         let key = (grid, scene.solver.equation);
         cal.grids.get(&key).map_or(f64::NAN, |t| {
-            let ratio = pilot::group(scene)
-                .and_then(|k| cal.groups.get(&k))
-                .map_or(cal.ratio, |g| g.ratio);
+            let ratio = pilot::group(scene).and_then(|k| cal.groups.get(&k)).map_or(
+                if flat_top(scene) {
+                    cal.ratio
+                } else {
+                    cal.surface_ratio
+                },
+                |g| g.ratio,
+            );
             let applications = default_applications(scene) * ratio;
             let waves = wave_solves(scene) as f64;
             solves as f64 * waves * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)

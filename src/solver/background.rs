@@ -149,10 +149,12 @@ pub(super) fn mean_profile(
     params: ShiftParams,
 ) -> Vec<C64> {
     let (nz, ny, nx) = eps.dim();
-    // Air in every cell (a porous layer, voids in an explicit structure)
-    // leaves no bulk: one mean then.
+    // The zones are a face's surface: at most a quarter of the cells
+    // (their sweep coefficients are stored cell by cell). Air deeper than
+    // that (a porous layer such as a conformal film over its grains, voids
+    // in an explicit structure) gets one mean.
     let (top, bottom) = match air_cells(eps) {
-        (t, b) if params.layered_air && t + b < nz => (t, b),
+        (t, b) if params.layered_air && t + b <= nz / 4 => (t, b),
         _ => (0, 0),
     };
     let plane = (ny * nx) as f64;

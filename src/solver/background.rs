@@ -158,15 +158,14 @@ pub(super) fn mean_profile(
         _ => (0, 0),
     };
     let plane = (ny * nx) as f64;
-    // Per cell: the sum of ε and of a third of the tensor traces.
-    let sums: Vec<C64> = (0..nz)
-        .map(|j| {
-            eps.index_axis(ndarray::Axis(0), j).sum()
-                + tensor.map_or(C64::new(0.0, 0.0), |a| {
-                    a.slice(j).iter().map(|t| t.delta).sum::<C64>() / 3.0
-                })
+    // A third of the tensor traces of cell j, summed.
+    let traces = |j: usize| {
+        tensor.map_or(C64::new(0.0, 0.0), |a| {
+            a.slice(j).iter().map(|t| t.delta).sum::<C64>() / 3.0
         })
-        .collect();
+    };
+    // The sum of ε and of the tensor term over cell j.
+    let cell_sum = |j: usize| eps.index_axis(ndarray::Axis(0), j).sum() + traces(j);
     let inner = top..nz - bottom;
     let bulk = if inner.len() == nz {
         // Flat faces: the mean over every voxel, summed as always.
@@ -175,14 +174,14 @@ pub(super) fn mean_profile(
                 a.terms.iter().map(|t| t.delta).sum::<C64>() / (3.0 * eps.len() as f64)
             })
     } else {
-        sums[inner.clone()].iter().sum::<C64>() / (plane * inner.len() as f64)
+        inner.clone().map(cell_sum).sum::<C64>() / (plane * inner.len() as f64)
     };
     let means: Vec<C64> = (0..nz)
         .map(|j| {
             if inner.contains(&j) {
                 bulk
             } else {
-                sums[j] / plane
+                cell_sum(j) / plane
             }
         })
         .collect();

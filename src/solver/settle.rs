@@ -51,6 +51,13 @@ pub fn bulk_run(c: &[C64]) -> (usize, usize) {
     best
 }
 
+/// The zone's cells of a profile of `n` cells whose bulk is `bulk`: the
+/// layered top's, then the layered bottom's, the order in which the tables
+/// keep their per-cell factors.
+pub fn zone_cells(bulk: (usize, usize), n: usize) -> impl Iterator<Item = usize> + Clone {
+    (0..bulk.0).chain(bulk.1..n)
+}
+
 /// Per block of `W` harmonics, layout (ix, block), its stored cells: the
 /// cells until the recursion settles, then the last `tail` cells (a
 /// layered bottom) one by one.

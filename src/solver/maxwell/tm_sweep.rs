@@ -157,12 +157,10 @@ impl TmTable {
         let cells = n - 1;
         let bulk = settle::bulk_run(c);
         let cb = c[bulk.0];
-        let zone_cells: Vec<usize> = (0..bulk.0).chain(bulk.1..n).collect();
-        let zone = zone_cells.len();
+        let zone = settle::zone_cells(bulk, n).count();
         let k2e = lat.k0 * lat.k0 * eps_b;
-        let zone_f = zone_cells
-            .iter()
-            .map(|&j| Cx::splat((k2e + cb) / (k2e + c[j])))
+        let zone_f = settle::zone_cells(bulk, n)
+            .map(|j| Cx::splat((k2e + cb) / (k2e + c[j])))
             .collect();
         let mut zone_z = vec![Cx::splat(ONE); nx * nb * zone];
         let mut dense = Vec::new();
@@ -193,7 +191,7 @@ impl TmTable {
                 let blk = ix * nb + iy / W;
                 harm[blk].set(iy % W, &hc);
                 let ratios = &mut zone_z[blk * zone..(blk + 1) * zone];
-                for (r, &j) in ratios.iter_mut().zip(&zone_cells) {
+                for (r, j) in ratios.iter_mut().zip(settle::zone_cells(bulk, n)) {
                     r.set(iy % W, (g2 + cb) / (g2 + c[j]));
                 }
             }
@@ -266,7 +264,7 @@ impl TmTable {
             let zone = self.zone_f.len();
             let i = ix * nb + b;
             let zz = &self.zone_z[i * zone..(i + 1) * zone];
-            let cells = (0..self.bulk.0).chain(self.bulk.1..n);
+            let cells = settle::zone_cells(self.bulk, n);
             for ((j, rf), rz) in cells.zip(&self.zone_f).zip(zz) {
                 xf[j] = xf[j] * *rf;
                 xz[j] = xz[j] * *rz;

@@ -68,8 +68,9 @@ pub(super) fn sweep_coefficients(
     // repeats this one, and the recursion goes on from there.
     let mut last_change = f64::INFINITY;
     let mut j = 0;
+    let (mut h, mut g) = cell(0);
     while j < cells {
-        let ((h, g), (hn, _)) = (cell(j), cell(j + 1));
+        let (hn, gn) = cell(j + 1);
         let m00 = 1.0 - hn;
         let m01 = (h - q) * t + h;
         let m10 = hn;
@@ -99,9 +100,11 @@ pub(super) fn sweep_coefficients(
             let settled = steps[j];
             steps[j + 1..tail_start].fill(settled);
             j = tail_start;
+            (h, g) = cell(j);
             last_change = f64::INFINITY;
             continue;
         }
+        (h, g) = (hn, gn);
         last_change = change;
         j += 1;
     }

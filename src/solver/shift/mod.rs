@@ -175,8 +175,7 @@ impl ShiftTable {
         let norm = 1.0 / (nx * ny) as f64;
         let bulk = settle::bulk_run(c);
         let cb = c[bulk.0];
-        let zone_cells: Vec<usize> = (0..bulk.0).chain(bulk.1..n).collect();
-        let zone = zone_cells.len();
+        let zone = settle::zone_cells(bulk, n).count();
         let mut h = Vec::with_capacity(lat.harmonics());
         let mut dense = Vec::new();
         for ix in 0..nx {
@@ -239,7 +238,7 @@ impl ShiftTable {
                 let blk = ix * nb + iy / W;
                 harm[blk].set(iy % W, &hb, norm);
                 let ratios = &mut zone_ratio[blk * zone..(blk + 1) * zone];
-                for (r, &j) in ratios.iter_mut().zip(&zone_cells) {
+                for (r, j) in ratios.iter_mut().zip(settle::zone_cells(bulk, n)) {
                     r.set(iy % W, (hs.gamma2 + cb) / (hs.gamma2 + c[j]));
                 }
             }
@@ -266,31 +265,27 @@ impl ShiftTable {
         }
     }
 
-    /// The zone cells' input factors of block `b` of row `ix`: the top's
-    /// and the bottom's.
+    /// The zone's cells with their input factors, block `b` of row `ix`.
     #[inline(always)]
-    fn zone_of(&self, ix: usize, b: usize) -> (&[Cx], &[Cx]) {
-        let zone = self.bulk.0 + self.n - self.bulk.1;
+    fn zone_of(&self, ix: usize, b: usize) -> impl Iterator<Item = (usize, &Cx)> {
+        let cells = settle::zone_cells(self.bulk, self.n);
+        let zone = cells.clone().count();
         let i = ix * self.nb + b;
-        self.zone_ratio[i * zone..(i + 1) * zone].split_at(self.bulk.0)
+        cells.zip(&self.zone_ratio[i * zone..(i + 1) * zone])
     }
 
     /// `x ← x · ratio` on the zone's cells of one block's cells.
     #[inline(always)]
     fn scale_zone(&self, ix: usize, b: usize, x: &mut [Cx]) {
-        let (top, bottom) = self.zone_of(ix, b);
-        let (head, tail) = x.split_at_mut(self.bulk.1);
-        for (x, r) in head.iter_mut().zip(top).chain(tail.iter_mut().zip(bottom)) {
-            *x = *x * *r;
+        for (j, r) in self.zone_of(ix, b) {
+            x[j] = x[j] * *r;
         }
     }
 
     /// The same on lane `k` of a column.
     fn scale_zone_lane(&self, ix: usize, b: usize, k: usize, x: &mut [C64]) {
-        let (top, bottom) = self.zone_of(ix, b);
-        let (head, tail) = x.split_at_mut(self.bulk.1);
-        for (x, r) in head.iter_mut().zip(top).chain(tail.iter_mut().zip(bottom)) {
-            *x *= r.lane(k);
+        for (j, r) in self.zone_of(ix, b) {
+            x[j] *= r.lane(k);
         }
     }
 

@@ -75,6 +75,7 @@ pub use plan::{plan_text, planned_solves, RunPlan};
 pub use result::RunReport;
 pub use run::{run, run_geometry, run_with, GeometryReport};
 pub use solve::{solve_analytic, solve_layer, solve_realisation, LayerEps};
+pub use surface::flat_top;
 
 /// The progress of a run of `total` solves, its plan's lines logged first;
 /// hidden when `quiet` (a study's variants report through its own bar).

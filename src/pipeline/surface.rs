@@ -5,6 +5,13 @@ use crate::config::{Scene, Surface};
 use crate::raster::surface::{self, ROUGH_LIMIT};
 use crate::raster::Raster;
 
+/// Whether a scene's top is a plane: no relief, conformal film or rough
+/// surface puts air into the grid (an explicit structure may still hold
+/// some).
+pub fn flat_top(scene: &Scene) -> bool {
+    scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat
+}
+
 /// Height above `z = 0` (nm) the binder surface may reach: the film over
 /// grains that reach `grains_top_nm` above the plane, or the rough
 /// surface's highest allowed peak; 0 for the plane.

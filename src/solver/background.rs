@@ -48,7 +48,8 @@ pub struct ShiftParams {
     /// (∞: no cap, the scalar equation's default).
     pub mean_loss_cap: f64,
     /// Mean: the cells holding air at either face take their own lateral
-    /// mean ([`air_cells`]; the default); `false`: one mean for every cell.
+    /// mean ([`zone_cells`]: at most a quarter of the cells per face; the
+    /// default); `false`: one mean for every cell.
     pub layered_air: bool,
 }
 
@@ -116,6 +117,35 @@ pub(super) fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64
         .fold(0.0, f64::max)
 }
 
+/// At most `nz / ZONE_CAP_DIVISOR` cells of a face take their own mean
+/// ([`zone_cells`]): their sweep coefficients are stored cell by cell, so
+/// the zones of both faces hold at most half the cells' coefficients
+/// (counted in the memory model, `pipeline::memory`).
+pub const ZONE_CAP_DIVISOR: usize = 4;
+
+/// Bytes the sweep tables hold per harmonic for each layered zone cell: the
+/// scalar (TE) table's, and in Maxwell's equations the TM table's beside it.
+pub fn zone_cell_bytes(vector: bool) -> usize {
+    super::shift::ZONE_CELL_BYTES
+        + if vector {
+            super::maxwell::TM_ZONE_CELL_BYTES
+        } else {
+            0
+        }
+}
+
+/// The layered zones `(top, bottom)` the mean background takes: each face's
+/// [`air_cells`], capped at a quarter of the cells. Where air reaches
+/// deeper (a porous layer such as a conformal film draped into the gaps
+/// between its grains, voids in an explicit structure), the outer quarter
+/// at each face, where the air's share changes fastest, is layered and the
+/// cells between share one mean.
+pub fn zone_cells(eps: &Array3<C64>) -> (usize, usize) {
+    let cap = eps.dim().0 / ZONE_CAP_DIVISOR;
+    let (top, bottom) = air_cells(eps);
+    (top.min(cap), bottom.min(cap))
+}
+
 /// Mean of the permittivity over every voxel, the mean background.
 pub fn mean_eps(eps: &Array3<C64>) -> C64 {
     eps.iter().sum::<C64>() / eps.len() as f64
@@ -140,7 +170,7 @@ pub fn air_cells(eps: &Array3<C64>) -> (usize, usize) {
 }
 
 /// The mean background's permittivity per z cell: the mean of the cells
-/// between the layered zones ([`air_cells`]), and in each cell of a zone its
+/// between the layered zones ([`zone_cells`]), and in each cell of a zone its
 /// own lateral mean (the tensor voxels add a third of their trace), each
 /// with the loss floor of the largest contrast left, `r = max|ε − ε̄_j|`.
 pub(super) fn mean_profile(
@@ -149,13 +179,10 @@ pub(super) fn mean_profile(
     params: ShiftParams,
 ) -> Vec<C64> {
     let (nz, ny, nx) = eps.dim();
-    // The zones are a face's surface: at most a quarter of the cells
-    // (their sweep coefficients are stored cell by cell). Air deeper than
-    // that (a porous layer such as a conformal film over its grains, voids
-    // in an explicit structure) gets one mean.
-    let (top, bottom) = match air_cells(eps) {
-        (t, b) if params.layered_air && t + b <= nz / 4 => (t, b),
-        _ => (0, 0),
+    let (top, bottom) = if params.layered_air {
+        zone_cells(eps)
+    } else {
+        (0, 0)
     };
     let plane = (ny * nx) as f64;
     // A third of the tensor traces of cell j, summed.

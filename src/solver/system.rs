@@ -15,7 +15,7 @@
 //! [`Scratch`] is the working memory of those operations, owned by the caller
 //! and passed in, so no application allocates.
 
-use super::background::{mean_profile, shift_of, ShiftParams};
+use super::background::{self, mean_profile, shift_of, ShiftParams};
 use super::green;
 use super::lattice::Lattice;
 use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
@@ -312,16 +312,21 @@ impl<'a> System<'a> {
             None => {
                 let e = self.shift.eps;
                 let mut d = format!("mean background ⟨ε⟩ = {:.4}{:+.4}i", e.re, e.im);
-                for (zone, face) in [(&self.shift.top, "top"), (&self.shift.bottom, "bottom")] {
+                let (air_top, air_bottom) = background::air_cells(self.eps);
+                for (zone, face, air) in [
+                    (&self.shift.top, "top", air_top),
+                    (&self.shift.bottom, "bottom", air_bottom),
+                ] {
                     if let (Some(a), Some(b)) = (zone.first(), zone.last()) {
+                        let cells = if air > zone.len() {
+                            format!("{} of the {air}", zone.len())
+                        } else {
+                            zone.len().to_string()
+                        };
                         d += &format!(
-                            ", layered at the {face} over {} cells holding air (each its own \
-                             mean, {:.4}{:+.4}i to {:.4}{:+.4}i)",
-                            zone.len(),
-                            a.re,
-                            a.im,
-                            b.re,
-                            b.im
+                            ", layered at the {face} over {cells} cells holding air (each its \
+                             own mean, {:.4}{:+.4}i to {:.4}{:+.4}i)",
+                            a.re, a.im, b.re, b.im
                         );
                     }
                 }

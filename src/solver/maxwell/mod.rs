@@ -20,6 +20,7 @@
 pub mod column;
 mod shifted;
 mod tm_sweep;
+pub(crate) use tm_sweep::ZONE_CELL_BYTES as TM_ZONE_CELL_BYTES;
 
 pub use shifted::VectorShift;
 

@@ -226,6 +226,39 @@ mod tests {
         paths_agree(&op, &tables, "settled");
     }
 
+    /// Layered zones of `t` and `b` cells store at most `t + b` cells more
+    /// per harmonic in each table than one shift does: what the memory
+    /// model counts for them (`solver::zone_cell_bytes`).
+    #[test]
+    fn layered_zones_store_their_own_cells_and_no_more() {
+        let eps_b = 1.558f64.powi(2);
+        let lat = Problem::lattice([12, 12, 40], [600.0, 600.0, 800.0], 400.0, 0.0, 0.0);
+        let op = VectorOperator::new(lat, eps_b, 0.0);
+        let k2 = lat.k0 * lat.k0;
+        let bulk = k2 * (C64::new(2.16, 0.19) - eps_b);
+        let uniform = op.shift_tables(bulk);
+        let (t, b) = (10, 10);
+        let mut c = vec![bulk; 40];
+        for (j, cj) in c.iter_mut().take(t).enumerate() {
+            *cj = k2 * (C64::new(1.02 + 0.1 * j as f64, 0.19) - eps_b);
+        }
+        for (j, cj) in c.iter_mut().rev().take(b).enumerate() {
+            *cj = k2 * (C64::new(2.2 + 0.01 * j as f64, 0.19) - eps_b);
+        }
+        let layered = op.layered_shift_tables(&c);
+        for (name, more) in [
+            ("TE", layered.te.stored_cells() - uniform.te.stored_cells()),
+            ("TM", layered.tm.stored_cells() - uniform.tm.stored_cells()),
+        ] {
+            // The cells after the top zone settle as one shift's first cells do.
+            assert!(
+                more > 0 && more <= lat.harmonics() * (t + b),
+                "{name}: {more} more cells"
+            );
+        }
+        paths_agree(&op, &layered, "zones of 10 cells at both faces");
+    }
+
     /// A harmonic grazing inside the binder takes the column path: the
     /// lattice is chosen so that order (1, 0) has κ = k0 n_b exactly.
     #[test]

@@ -71,6 +71,11 @@ struct StepBlock {
     wb: Cx,
 }
 
+/// Bytes the TM table holds per harmonic for each cell of a layered zone:
+/// its down-sweep coefficients and the scale of its `S_z` input.
+pub const ZONE_CELL_BYTES: usize =
+    (std::mem::size_of::<StepBlock>() + std::mem::size_of::<Cx>()) / W;
+
 /// Per-harmonic constants of the bottom cell: `hf = ps + φ`, `pb`, `zd`,
 /// `zb` (outputs), `u_0 = tb b_0 + tz S_z,0` (top), `d_{N−1} = eb b + ez S_z
 /// + eu u` (bottom, last cell) and the last cell's output weights. Inputs

@@ -97,6 +97,11 @@ struct HarmBlock {
     gtl: Cx,
 }
 
+/// Bytes the table holds per harmonic for each cell of a layered zone: its
+/// down-sweep coefficients and its input scale.
+pub const ZONE_CELL_BYTES: usize =
+    (std::mem::size_of::<StepBlock>() + std::mem::size_of::<Cx>()) / W;
+
 /// `(I − c G_h)⁻¹` for every harmonic of a lattice.
 ///
 /// **Storage.** The down-sweep recursion `t_{j+1} = f(t_j)` is a Möbius map

@@ -272,7 +272,10 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     let (ok, plan, err) = inksim_in(dir.path(), &["plan", ps, "--profile", "three"]);
     assert!(ok, "{err}");
     assert!(plan.contains("calibrated now on this machine"), "{plan}");
-    assert!(plan.contains("grid 8×8×4 (helmholtz): setup"), "{plan}");
+    assert!(
+        plan.contains("grid 8×8×4 (helmholtz, f64 fields): setup"),
+        "{plan}"
+    );
     // The fragment's statistics: 0.15 × 400³ nm³ holds 18.3 grains of
     // 100 nm and 5.43 of 150 nm, so s.e. ≤ 1 takes ⌈49 / 5.43⌉ = 10
     // realisations of the coarse variants (C = 7).

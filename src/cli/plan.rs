@@ -47,12 +47,15 @@ pub fn plan(
     let cal = plan::calibrate(&chosen.variants, &chosen.variants);
     println!(
         "time model (calibrated now on this machine, {nthreads} thread(s)): per solve = setup + \
-         applications × one operator application × {} (Maxwell: per polarisation solved, \
+         applications × one operator application with BiCGStab's vector work, timed as the \
+         difference of {} and {} iterations in the fields' precision (Maxwell: per polarisation \
+         solved, \
          natural light one random-phase solve for an ensemble, else two); applications per solve {:.0} under a \
          flat top, {:.0} under relief or a conformal or rough surface ({:.0} on the binder \
          background; measured at a tolerance of 1e-4, 1e-6 on the binder, and scaled to each \
          scene's as 2.5 + log10(1/tolerance)); flat tops × {:.2}: {}; surfaces × {:.2}: {}",
-        plan::KRYLOV_OVERHEAD,
+        plan::CALIBRATION_ITERATIONS[0],
+        plan::CALIBRATION_ITERATIONS[1],
         plan::MEAN_APPLICATIONS,
         plan::MEAN_APPLICATIONS_SURFACE,
         plan::BINDER_APPLICATIONS,
@@ -83,13 +86,20 @@ pub fn plan(
             g.source
         );
     }
-    for ((g, equation), t) in &cal.grids {
+    for (key, t) in &cal.grids {
+        let g = &key.grid;
         println!(
-            "  grid {}×{}×{} ({}): setup {:.1} ms, one application {:.2} ms{}",
+            "  grid {}×{}×{} ({}, {} fields{}): setup {:.1} ms, one application {:.2} ms{}",
             g[0],
             g[1],
             g[2],
-            equation.name(),
+            key.equation.name(),
+            key.precision,
+            if key.porous {
+                ", air deep at both faces: each layered over a quarter of the cells"
+            } else {
+                ""
+            },
             t.setup_s * 1e3,
             t.apply_s * 1e3,
             if t.timed != *g {

@@ -259,7 +259,7 @@ impl VoxelPermittivity {
 }
 
 /// How the solver stores its fields.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
 pub enum Precision {
     /// Complex f64 everywhere (default).
     #[default]

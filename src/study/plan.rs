@@ -7,9 +7,11 @@
 //! `run` hold a run to).
 //!
 //! Time model (one variant, all threads): per solve
-//! `t_setup + applications × t_apply × KRYLOV_OVERHEAD`, where `t_setup`
-//! (building the solver's system: shift, Green's tables) and `t_apply` (one
-//! application of the shifted operator `x − G_s V' x`) are **timed at plan
+//! `t_setup + applications × t_apply`, where `t_setup` (building the
+//! solver's system: shift, Green's tables; and what a BiCGStab run costs
+//! beyond its applications) and `t_apply` (one application of the shifted
+//! operator `x − G_s V' x` with BiCGStab's vector work, in the fields'
+//! precision, [`CALIBRATION_ITERATIONS`]) are **timed at plan
 //! time on this machine** — as the process's CPU time over its threads, so
 //! the estimate is the machine's when idle, whatever else shares it — for
 //! each distinct grid of the plan — on the grid
@@ -40,9 +42,10 @@ use super::cpu::process_cpu_s;
 use super::pilot;
 use super::run::{self, State};
 use super::sweep::Variant;
-use crate::config::{Background, Equation, Linear, Scene, Surface};
+use crate::config::{Background, Equation, Linear, Precision, Scene, Surface};
 use crate::pipeline;
-use crate::solver::{Problem, System, Wave};
+use crate::solver::methods::bicgstab::BiCgStab;
+use crate::solver::{Controls, Field, Problem, SolveError, Solver, System, Wave};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
@@ -99,12 +102,11 @@ pub fn default_applications(scene: &Scene) -> f64 {
     rate * tolerance_factor(scene.solver.tolerance, measured_at)
 }
 
-/// Whether a scene's top is a plane (no relief, conformal film or rough
-/// surface): the two kinds of layer whose rates are assumed, and scaled by
-/// the finished results, apart.
-pub fn flat_top(scene: &Scene) -> bool {
-    scene.layer.relief_fraction <= 0.0 && scene.layer.surface == Surface::Flat
-}
+/// Whether a scene's top is a plane ([`pipeline::flat_top`]): the
+/// two kinds of layer whose rates are assumed, and scaled by the finished
+/// results, apart.
+pub use pipeline::flat_top;
+
 /// Wave solves per incidence: one (Helmholtz, and Maxwell's random-phase
 /// natural light), or one per polarisation solved (Maxwell; natural light
 /// in two solves is an s and a p solve).
@@ -128,9 +130,13 @@ pub const PILOT_RESULTS: f64 = 1.0;
 /// in 0.3 s with its tile and colours.
 pub const ANALYTIC_SOLVE_S: f64 = 2e-3;
 
-/// Work per operator application beyond the timed operator (BiCGStab's
-/// vector updates and inner products), as a factor.
-pub const KRYLOV_OVERHEAD: f64 = 1.25;
+/// BiCGStab iterations of the two calibration runs (each iteration two
+/// applications with the vector updates and inner products between them,
+/// and a residual at each end): the difference of their times over the
+/// difference of their applications is one application's; what the shorter
+/// run takes beyond its applications (the Krylov fields' allocation, the
+/// shadow vector, the start) is part of a solve's setup.
+pub const CALIBRATION_ITERATIONS: [usize; 2] = [2, 6];
 
 /// Timings of one grid.
 #[derive(Debug, Clone, Copy)]
@@ -138,15 +144,18 @@ pub struct GridTiming {
     /// The grid timed (may be smaller than the one estimated).
     pub timed: [usize; 3],
     pub setup_s: f64,
+    /// One operator application with BiCGStab's vector work per
+    /// application, in the fields' precision.
     pub apply_s: f64,
 }
 
 /// The measured basis of the time model.
 #[derive(Debug, Clone)]
 pub struct Calibration {
-    /// Per distinct grid (nx, ny, nz) and equation → its timing, scaled to
-    /// that grid.
-    pub grids: BTreeMap<([usize; 3], Equation), GridTiming>,
+    /// Per distinct grid (nx, ny, nz), equation and kind of top (`true`:
+    /// under a surface, whose air the mean background layers) → its timing,
+    /// scaled to that grid.
+    pub grids: BTreeMap<GridKey, GridTiming>,
     /// Factor on the assumed applications per solve
     /// ([`default_applications`]) of the variants under a flat top, from the
     /// study's finished results of that kind.
@@ -193,10 +202,40 @@ fn grid_of(s: &Scene) -> [usize; 3] {
     [s.grid.nx, s.grid.ny, s.grid.nz]
 }
 
-/// Time setup and one application of `equation`'s operator on `grid`
-/// (reduced if large) and scale.
-pub fn time_grid(grid: [usize; 3], equation: Equation) -> GridTiming {
-    let [nx, ny, nz] = grid;
+/// What one operator timing stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct GridKey {
+    /// `[nx, ny, nz]`.
+    pub grid: [usize; 3],
+    pub equation: Equation,
+    /// The Krylov fields' storage (f32 halves their memory traffic).
+    pub precision: Precision,
+    /// Whether air reaches deep into the grid from both faces (a conformal
+    /// film draped into the gaps between its grains, or an explicit
+    /// structure, which may hold air anywhere), so that the mean
+    /// background's layered zones (`solver::zone_cells`) reach their cap and
+    /// add their sweep tables to every application. A relief's or a rough
+    /// surface's air takes a few cells at one face (4–6 of 50 in the
+    /// standard study), within the timing's scatter of a flat top.
+    pub porous: bool,
+}
+
+/// The timing key of a scene.
+pub fn grid_key(s: &Scene) -> GridKey {
+    GridKey {
+        grid: grid_of(s),
+        equation: s.solver.equation,
+        precision: s.solver.precision,
+        porous: matches!(s.layer.surface, Surface::Conformal { .. }) || s.structure.is_some(),
+    }
+}
+
+/// Time setup and one application of `key.equation`'s operator with
+/// BiCGStab's vector work on `key.grid` (reduced if large; porous: air at
+/// both faces deep enough for the layered zones to reach their cap) and
+/// scale.
+pub fn time_grid(key: GridKey) -> GridTiming {
+    let [nx, ny, nz] = key.grid;
     let (mut tx, mut ty) = (nx, ny);
     while tx * ty * nz > CALIBRATION_VOXELS && (tx > 4 || ty > 4) {
         if tx >= ty {
@@ -206,7 +245,7 @@ pub fn time_grid(grid: [usize; 3], equation: Equation) -> GridTiming {
         }
     }
     let timed = [tx, ty, nz];
-    let (setup, apply) = time_exact(timed, equation);
+    let (setup, apply) = time_exact(timed, key);
     let work = |x: usize, y: usize| (x * y * nz) as f64 * ((x * y) as f64).log2().max(1.0);
     let scale = work(nx, ny) / work(tx, ty);
     GridTiming {
@@ -216,17 +255,22 @@ pub fn time_grid(grid: [usize; 3], equation: Equation) -> GridTiming {
     }
 }
 
-/// Median of three timings of the system setup and of one shifted operator
-/// application on a layer with grains of index 1.4 + 0.3i in the binder
-/// (Maxwell: s polarisation; p costs the same).
-fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
+/// Median of three timings of a solve's setup (the system, and what a
+/// BiCGStab run costs beyond its applications) and of one operator
+/// application within BiCGStab (two runs of [`CALIBRATION_ITERATIONS`]
+/// iterations on fields of `key.precision`) on a
+/// layer with grains of index 1.4 + 0.3i in the binder (Maxwell: s
+/// polarisation; p costs the same); porous: air in every third voxel down
+/// to the middle from both faces (both layered zones at their cap).
+fn time_exact([nx, ny, nz]: [usize; 3], key: GridKey) -> (f64, f64) {
+    let (equation, zones) = (key.equation, key.porous);
     let eb = 1.558f64.powi(2);
     let ep = C64::new(1.4, 0.3).powi(2);
     let eps = Array3::from_shape_fn((nz, ny, nx), |(k, j, i)| {
-        if (i / 3 + j / 3 + k / 3) % 3 == 0 {
-            ep
-        } else {
-            C64::new(eb, 0.0)
+        match (i / 3 + j / 3 + k / 3) % 3 {
+            0 => ep,
+            1 if zones => C64::new(1.0, 0.0),
+            _ => C64::new(eb, 0.0),
         }
     });
     let lattice = Problem::lattice(
@@ -236,15 +280,12 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
         30.0,
         0.0,
     );
-    let (wave, components) = match equation {
-        Equation::Helmholtz => (Wave::Scalar, 1),
-        Equation::Maxwell => (
-            Wave::Vector {
-                polarisation: Linear::S.into(),
-                azimuth_deg: 0.0,
-            },
-            3,
-        ),
+    let wave = match equation {
+        Equation::Helmholtz => Wave::Scalar,
+        Equation::Maxwell => Wave::Vector {
+            polarisation: Linear::S.into(),
+            azimuth_deg: 0.0,
+        },
     };
     let p = Problem {
         tensor: None,
@@ -255,10 +296,12 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
     };
     let mut setups = vec![];
     let mut applies = vec![];
-    let x = Array3::from_shape_fn((components * nz, ny, nx), |(k, j, i)| {
-        C64::new(((i + 2 * j) as f64 * 0.01).cos(), (k as f64 * 0.1).sin())
-    });
-    let mut out = Array3::zeros((components * nz, ny, nx));
+    let ctl = |max_iterations| Controls {
+        tolerance: 1e-300,
+        max_iterations,
+        precision: key.precision,
+        background: Background::DEFAULT,
+    };
     // The process's CPU time over its threads: what the operator costs on
     // this machine idle. Other jobs sharing the cores stretch the wall
     // clock (by 2× and more on a loaded 2-core machine) but not this.
@@ -266,15 +309,30 @@ fn time_exact([nx, ny, nz]: [usize; 3], equation: Equation) -> (f64, f64) {
     let elapsed = |t0: f64| (process_cpu_s() - t0) / threads;
     for _ in 0..3 {
         let t = process_cpu_s();
-        let Ok(sys) = System::new(&p, Background::DEFAULT) else {
+        let Ok(mut sys) = System::new(&p, Background::DEFAULT) else {
             return (f64::NAN, f64::NAN);
         };
         let mut scr = sys.scratch();
-        setups.push(elapsed(t));
-        sys.apply_a_shifted(&mut scr, &x, &mut out);
-        let t = process_cpu_s();
-        sys.apply_a_shifted(&mut scr, &x, &mut out);
-        applies.push(elapsed(t));
+        let setup = elapsed(t);
+        let mut runs = [(0.0, 0usize); 2];
+        for (run, iterations) in runs.iter_mut().zip(CALIBRATION_ITERATIONS) {
+            let mut u = Field::zeros(key.precision, sys.unknown_dim());
+            let t = process_cpu_s();
+            sys.set_start_field(&mut u);
+            // No tolerance is reached: the run stops after its iterations,
+            // each two applications, with a residual at each end.
+            let applications =
+                match BiCgStab::DEFAULT.run(&mut sys, &mut scr, &mut u, &ctl(iterations)) {
+                    Err(SolveError::NotConverged { iterations, .. }) => 2 * iterations + 2,
+                    Ok(o) => o.applications,
+                    Err(_) => return (f64::NAN, f64::NAN),
+                };
+            *run = (elapsed(t), applications);
+        }
+        let [(t1, a1), (t2, a2)] = runs;
+        let apply = (t2 - t1) / (a2 as f64 - a1 as f64);
+        applies.push(apply);
+        setups.push(setup + (t1 - a1 as f64 * apply).max(0.0));
     }
     setups.sort_by(f64::total_cmp);
     applies.sort_by(f64::total_cmp);
@@ -314,8 +372,8 @@ pub fn measured_ratio(variants: &[Variant]) -> Option<(f64, usize)> {
 pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
     let mut grids = BTreeMap::new();
     for v in variants {
-        let key = (grid_of(&v.scene), v.scene.solver.equation);
-        grids.entry(key).or_insert_with(|| time_grid(key.0, key.1));
+        let key = grid_key(&v.scene);
+        grids.entry(key).or_insert_with(|| time_grid(key));
     }
     // Each variant's group, found once: None for the ordinary layers.
     let mut members: BTreeMap<String, Vec<&Variant>> = BTreeMap::new();
@@ -419,8 +477,7 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
     let seconds = if pipeline::RunPlan::of(scene).analytic {
         solves as f64 * ANALYTIC_SOLVE_S
     } else {
-        let key = (grid, scene.solver.equation);
-        cal.grids.get(&key).map_or(f64::NAN, |t| {
+        cal.grids.get(&grid_key(scene)).map_or(f64::NAN, |t| {
             let ratio = pilot::group(scene).and_then(|k| cal.groups.get(&k)).map_or(
                 if flat_top(scene) {
                     cal.ratio
@@ -431,7 +488,7 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
             );
             let applications = default_applications(scene) * ratio;
             let waves = wave_solves(scene) as f64;
-            solves as f64 * waves * (t.setup_s + applications * t.apply_s * KRYLOV_OVERHEAD)
+            solves as f64 * waves * (t.setup_s + applications * t.apply_s)
         })
     };
     let bytes = pipeline::memory::estimate_bytes(scene);
@@ -539,7 +596,12 @@ mod tests {
 
     #[test]
     fn large_grids_are_timed_reduced_and_scaled() {
-        let t = time_grid([64, 64, 200], Equation::Helmholtz);
+        let t = time_grid(GridKey {
+            grid: [64, 64, 200],
+            equation: Equation::Helmholtz,
+            precision: Precision::F64,
+            porous: false,
+        });
         assert!(t.timed[0] * t.timed[1] * t.timed[2] <= CALIBRATION_VOXELS);
         assert_eq!(t.timed[2], 200);
         assert!(t.apply_s > 0.0 && t.setup_s > 0.0);

@@ -152,9 +152,8 @@ pub struct GridTiming {
 /// The measured basis of the time model.
 #[derive(Debug, Clone)]
 pub struct Calibration {
-    /// Per distinct grid (nx, ny, nz), equation and kind of top (`true`:
-    /// under a surface, whose air the mean background layers) → its timing,
-    /// scaled to that grid.
+    /// Per distinct [`GridKey`] (grid, equation, field precision, porous
+    /// top) → its timing, scaled to that grid.
     pub grids: BTreeMap<GridKey, GridTiming>,
     /// Factor on the assumed applications per solve
     /// ([`default_applications`]) of the variants under a flat top, from the
@@ -260,8 +259,8 @@ pub fn time_grid(key: GridKey) -> GridTiming {
 /// application within BiCGStab (two runs of [`CALIBRATION_ITERATIONS`]
 /// iterations on fields of `key.precision`) on a
 /// layer with grains of index 1.4 + 0.3i in the binder (Maxwell: s
-/// polarisation; p costs the same); porous: air in every third voxel down
-/// to the middle from both faces (both layered zones at their cap).
+/// polarisation; p costs the same); porous: air in a third of the binder's
+/// voxels at every depth (both layered zones at their cap).
 fn time_exact([nx, ny, nz]: [usize; 3], key: GridKey) -> (f64, f64) {
     let (equation, zones) = (key.equation, key.porous);
     let eb = 1.558f64.powi(2);

@@ -93,7 +93,7 @@ fn main() {
         for inks in ["yellow", "blue", "yellow-over-blue", "blue-over-yellow"] {
             let name = format!("{inks}_coherent_{binder}");
             let path = dir.join("variants").join(format!("{name}.h5"));
-            let text = hdf5::File::open(&path)
+            let text = inksim::output::h5::open(&path)
                 .and_then(|f| {
                     f.dataset("config")?
                         .read_scalar::<hdf5::types::VarLenUnicode>()

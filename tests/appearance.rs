@@ -750,7 +750,7 @@ fn measurement_geometries_run_by_default_and_reach_the_result_file() {
         assert!(m.de00_se.unwrap() > 0.0);
         assert!(m.reflectance.mean.iter().all(|v| (0.0..=1.0).contains(v)));
     }
-    let f = hdf5::File::open(&rep.result_path).unwrap();
+    let f = inksim::output::h5::open(&rep.result_path).unwrap();
     let g = f.group("appearance").unwrap();
     let ill: hdf5::types::VarLenUnicode = g.attr("illuminant").unwrap().read_scalar().unwrap();
     assert_eq!(ill.as_str(), "D50");

@@ -253,7 +253,7 @@ fn dilute_weak_spheres_beside_the_wave_solution() {
         }
 
         // The result file holds the same, described.
-        let f = hdf5::File::open(&rep.result_path).unwrap();
+        let f = inksim::output::h5::open(&rep.result_path).unwrap();
         let g = f.group("appearance/baseline/kubelka-munk/45_0").unwrap();
         for name in [
             "lab",
@@ -651,7 +651,7 @@ fn the_equation_picks_the_grains_and_the_surfaces() {
             )
             .output_name(equation)
             .run(dir.path());
-        let f = hdf5::File::open(&rep.result_path).unwrap();
+        let f = inksim::output::h5::open(&rep.result_path).unwrap();
         for (model, surfaces) in [
             ("kubelka-munk", "unpolarised-fresnel"),
             ("adding-doubling", surfaces),

@@ -157,7 +157,7 @@ remove = ["paint.layer.clearcoat"]
     assert!(md.contains("Along `spread`, sd4 → sd20 (2 pair(s)"), "{md}");
     assert!(html.contains("Along <code>spread</code>, sd4 → sd20 (2 pair(s)"));
     assert!(!m.grids.is_empty() && m.grids.iter().all(|g| g.is_file()));
-    let f = hdf5::File::open(&m.summary_h5).unwrap();
+    let f = inksim::output::h5::open(&m.summary_h5).unwrap();
     let flop: Vec<f64> = f.dataset("flop_index").unwrap().read_raw().unwrap();
     assert_eq!(flop.len(), 4);
     let lch = f.dataset("lch").unwrap().read_dyn::<f64>().unwrap();

@@ -314,7 +314,7 @@ fn command_writes_material_and_result() {
     let text = std::fs::read_to_string(out.join("fit-red.csv")).unwrap();
     assert!(text.contains("# input sha256 "), "{text}");
     assert!(text.contains("# residuals: RMS "), "{text}");
-    let f = hdf5::File::open(out.join("fit-red.h5")).unwrap();
+    let f = inksim::output::h5::open(out.join("fit-red.h5")).unwrap();
     let kh = f.dataset("k").unwrap().read_1d::<f64>().unwrap();
     assert_eq!(kh.len(), 55);
     let units: hdf5::types::VarLenUnicode = f

@@ -56,7 +56,7 @@ fn str_attr(d: &Dataset, name: &str) -> Option<String> {
 /// Check every dataset of `file`; returns the paths seen and, per path, its
 /// dimension labels.
 fn check_file(file: &Path) -> Vec<(String, Vec<String>)> {
-    let f = hdf5::File::open(file).unwrap();
+    let f = inksim::output::h5::open(file).unwrap();
     let mut all = Vec::new();
     datasets(&f, "", &mut all);
     assert!(
@@ -166,7 +166,7 @@ fn every_dataset_of_a_scene_result_has_units_a_description_and_axes() {
         ["viewing_deg", "tile_column", "rgb"]
     );
     assert_eq!(labels(&seen, "/solves/0000/orders_mn"), ["order", "mn"]);
-    let f = hdf5::File::open(&report.result_path).unwrap();
+    let f = inksim::output::h5::open(&report.result_path).unwrap();
     let units = |p: &str| str_attr(&f.dataset(p).unwrap(), "units").unwrap();
     assert_eq!(units("/appearance/wavelengths_nm"), "nm");
     assert_eq!(units("/appearance/brdf_diffuse_se"), "sr-1");
@@ -234,7 +234,7 @@ fn every_dataset_of_a_study_summary_has_units_a_description_and_axes() {
         assert!(names.contains(&p), "{p} missing from {names:?}");
     }
     assert_eq!(labels(&seen, "/colour/45_0/lch"), ["variant", "lch"]);
-    let f = hdf5::File::open(&summary).unwrap();
+    let f = inksim::output::h5::open(&summary).unwrap();
     let units = |p: &str| str_attr(&f.dataset(p).unwrap(), "units").unwrap();
     assert_eq!(units("/values/d/pigment.*.diameter_nm"), "nm");
     assert_eq!(units("/mean_reflectance"), "1");

@@ -256,7 +256,7 @@ fn file_contents_round_trip_through_hdf5() {
     let png: Vec<u8> = (0..=255u8).chain([0, 0, 137]).collect();
     write_result(&path, &set(&g, &e, "h", Some(&png))).unwrap();
 
-    let f = hdf5::File::open(&path).unwrap();
+    let f = inksim::output::h5::open(&path).unwrap();
     let config: VarLenUnicode = f.dataset("config").unwrap().read_scalar().unwrap();
     assert_eq!(config.as_bytes(), CONFIG.as_bytes());
     let cpath: VarLenUnicode = f.attr("config_path").unwrap().read_scalar().unwrap();
@@ -437,7 +437,7 @@ fn empty_geometry_and_no_picture_are_fine() {
     write_result(&path, &set(&g, &[], "x", None)).unwrap();
     let s = read_summary(&path).unwrap();
     assert!(s.entries.is_empty());
-    let f = hdf5::File::open(&path).unwrap();
+    let f = inksim::output::h5::open(&path).unwrap();
     assert_eq!(
         f.dataset("geometry/centers_nm").unwrap().shape(),
         vec![0, 3]
@@ -560,7 +560,7 @@ fn reading_bad_files_names_the_path() {
 
     // A valid HDF5 file that is not a result file.
     let other = dir.path().join("other.h5");
-    hdf5::File::create(&other).unwrap().close().unwrap();
+    inksim::output::h5::create(&other).unwrap().close().unwrap();
     let err = read_summary(&other).unwrap_err();
     assert!(err.to_string().contains("other.h5"), "{err}");
 }

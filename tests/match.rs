@@ -454,7 +454,7 @@ fn command_writes_recipes() {
     let row = csv.lines().nth(1).unwrap();
     assert!(row.starts_with("1,2,1,\"red "), "{row}");
     assert!(row.contains("; rutile "), "{row}");
-    let f = hdf5::File::open(out.join("match-red-tint.h5")).unwrap();
+    let f = inksim::output::h5::open(out.join("match-red-tint.h5")).unwrap();
     let pvc = f.dataset("recipes/pvc").unwrap().read_2d::<f64>().unwrap();
     let (red, rutile) = (pvc[[0, 0]], pvc[[0, 4]]);
     assert!((red / rutile - 0.25).abs() < 0.01, "{red} {rutile}");
@@ -704,7 +704,7 @@ fn command_verifies_and_writes_the_steps() {
     let rows: Vec<&str> = csv.lines().collect();
     assert!(rows[0].starts_with("rank,step,verified,thickness_nm,pvc red,de00 45/0"));
     assert!(rows.len() >= 2, "{csv}");
-    let f = hdf5::File::open(out.join("m.h5")).unwrap();
+    let f = inksim::output::h5::open(out.join("m.h5")).unwrap();
     let g = f.group("verify/001").unwrap();
     let steps = g.dataset("de00").unwrap().read_2d::<f64>().unwrap();
     assert_eq!(steps.nrows(), rows.len() - 1);

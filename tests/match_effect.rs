@@ -281,7 +281,7 @@ fn the_forward_model_is_inksim_runs_own() {
     std::fs::write(dir.path().join("p.toml"), paint_file).unwrap();
     let (ok, _, err) = inksim_in(dir.path(), &["run", "p.toml", "--output-dir", "."]);
     assert!(ok, "{err}");
-    let f = hdf5::File::open(dir.path().join("p.h5")).unwrap();
+    let f = inksim::output::h5::open(dir.path().join("p.h5")).unwrap();
     let lab = f
         .dataset("paint/multiangle/lab")
         .unwrap()
@@ -335,7 +335,7 @@ fn command_writes_recipes_and_check_says_what_is_varied() {
     assert_eq!(csv.lines().count(), 2);
     let html = std::fs::read_to_string(o.join("fx.html")).unwrap();
     assert!(html.contains("45as110") && html.contains("flop index"));
-    let f = hdf5::File::open(o.join("fx.h5")).unwrap();
+    let f = inksim::output::h5::open(o.join("fx.h5")).unwrap();
     assert_eq!(
         f.dataset("recipes/de00").unwrap().shape(),
         vec![1, 3],

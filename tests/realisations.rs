@@ -32,7 +32,7 @@ fn check_error(dir: &Path, scene: &SceneToml) -> String {
 
 /// Seeds, the stored attributes of `/realisations` and the stored plan.
 fn stored(path: &Path) -> (usize, f64, f64, String, String) {
-    let f = hdf5::File::open(path).unwrap();
+    let f = inksim::output::h5::open(path).unwrap();
     let g = f.group("realisations").unwrap();
     let seeds = g.dataset("seed").unwrap().read_raw::<u64>().unwrap().len();
     let scalar = |n: &str| g.attr(n).unwrap().read_scalar::<f64>().unwrap();

@@ -42,7 +42,7 @@ fn stack(dir: &Path, layers: &[SceneToml], coupling: &str, name: &str) -> SceneT
 
 /// A dataset of a result file, read whole.
 fn read(path: &Path, name: &str) -> Vec<f64> {
-    let f = hdf5::File::open(path).unwrap();
+    let f = inksim::output::h5::open(path).unwrap();
     f.dataset(name).unwrap().read_raw::<f64>().unwrap()
 }
 
@@ -246,7 +246,7 @@ fn both_couplings_solve_the_same_fragments() {
     let together = stack(dir.path(), &layers, "coherent", "together").run(dir.path());
     // The whole stack's grid: 12 × 12 across, 6 + 4 cells of 50 nm.
     for p in [&apart.result_path, &together.result_path] {
-        let g: Vec<u64> = hdf5::File::open(p)
+        let g: Vec<u64> = inksim::output::h5::open(p)
             .and_then(|f| f.attr("grid")?.read_raw())
             .unwrap();
         assert_eq!(g, [12, 12, 10], "{}", p.display());
@@ -525,7 +525,7 @@ fn a_study_sweeps_stacks_and_merges_them() {
     run(&["merge", "dots.toml"]);
     let summary = std::fs::read_to_string(dir.path().join("dots/summary.md")).unwrap();
     assert!(summary.contains("cover0.5"), "{summary}");
-    let f = hdf5::File::open(dir.path().join("dots/variants/cover0.5.h5")).unwrap();
+    let f = inksim::output::h5::open(dir.path().join("dots/variants/cover0.5.h5")).unwrap();
     let c: Vec<f64> = f
         .dataset("stack/layer_coverage")
         .unwrap()

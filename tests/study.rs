@@ -364,7 +364,7 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     let c = inksim::output::render::canvas::Canvas::decode_png(&grid).unwrap();
     assert!(c.w > 100 && c.h > 100);
     // The summary file reaches every variant's file through its links.
-    let f = hdf5::File::open(sd.join("summary.h5")).unwrap();
+    let f = inksim::output::h5::open(sd.join("summary.h5")).unwrap();
     let names: Vec<hdf5::types::VarLenUnicode> = f.dataset("name").unwrap().read_raw().unwrap();
     assert_eq!(names.len(), 4);
     let r: Vec<f64> = f.dataset("mean_reflectance").unwrap().read_raw().unwrap();
@@ -873,7 +873,7 @@ fn only_runs_plans_and_merges_a_subset_with_the_full_studys_files() {
         page.contains("only pigment=red (a subset of the study)"),
         "{page}"
     );
-    let f = hdf5::File::open(dir.path().join("out/quick/summary.h5")).unwrap();
+    let f = inksim::output::h5::open(dir.path().join("out/quick/summary.h5")).unwrap();
     let sel: hdf5::types::VarLenUnicode = f.attr("selection").unwrap().read_scalar().unwrap();
     assert_eq!(sel.as_str(), "pigment=red");
     assert_eq!(f.dataset("name").unwrap().shape(), [2]);

@@ -552,7 +552,7 @@ fn a_studys_variants_are_chosen_by_their_axis_values() {
     let text =
         |xs: &[&str]| -> Vec<VarLenUnicode> { xs.iter().map(|s| s.parse().unwrap()).collect() };
     {
-        let f = hdf5::File::create(d.join("summary.h5")).unwrap();
+        let f = inksim::output::h5::create(d.join("summary.h5")).unwrap();
         f.new_dataset_builder()
             .with_data(&text(&names))
             .create("name")

@@ -11,6 +11,7 @@
 mod check;
 pub mod colour;
 pub mod ground;
+pub mod h5file;
 pub mod materials;
 mod method;
 pub mod paint;

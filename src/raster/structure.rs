@@ -285,7 +285,7 @@ impl EpsGrid {
             path: path.to_path_buf(),
             message,
         };
-        let file = hdf5::File::open(path).map_err(hdf)?;
+        let file = crate::config::h5file::open(path).map_err(hdf)?;
         let re: ndarray::ArrayD<f64> = file
             .dataset("eps_re")
             .and_then(|d| d.read_dyn())

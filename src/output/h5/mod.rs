@@ -20,8 +20,9 @@
 //! - `attrs`: scalar and string attribute helpers shared by all of them;
 //! - `described`: every dataset's `units`, `description` and axis names,
 //!   written with it; `scales`: the HDF5 dimension scales behind the axes;
-//! - `file`: [`create`] and [`open`], which every reader and writer uses, so
-//!   that no child process inherits an open file and its lock.
+//! - [`create`] and [`open`] (from `config::h5file`, where the scene's
+//!   inputs are read too), which every reader and writer uses, so that no
+//!   child process inherits an open file and none takes HDF5's own lock.
 //!
 //! # Layout
 //!
@@ -36,7 +37,6 @@ mod appearance_read;
 mod attrs;
 mod brdf_read;
 mod described;
-mod file;
 mod geometry;
 mod paint;
 mod result;
@@ -45,6 +45,7 @@ mod stack;
 mod study_labels;
 mod summary;
 
+pub use crate::config::h5file::{create, open};
 pub use crate::output::error::IoError;
 pub use appearance::hiding::{read_hiding, HidingRecord};
 pub use appearance_read::{
@@ -54,7 +55,6 @@ pub use appearance_read::{
 pub(crate) use attrs::{vlu, write_scalar_attr, write_str_attr};
 pub use brdf_read::{read_brdf_data, read_measured_spectra, read_tile_png, MeasuredSpectrum};
 pub(crate) use described::{about, dim, Scales};
-pub use file::{create, open};
 pub use geometry::GeometrySummary;
 pub use paint::{
     is_paint_result, read_paint, read_paint_config, write_paint, AngleRecord, PaintRecord,

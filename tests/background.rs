@@ -394,3 +394,56 @@ fn a_porous_layers_faces_take_their_own_means_up_to_a_quarter_of_the_cells() {
         layering_pays(&p, params, &binder, &format!("porous, {wave:?}"));
     }
 }
+
+/// Each layered cell takes the loss floor of the contrast left in it, and
+/// the cells between the zones that of theirs (`ShiftParams::floor_per_zone`):
+/// under a relief of weakly absorbing grains (the stand-ins at the edge of
+/// their bands) the air's contrast, about 1.4, no longer sets the bulk's
+/// loss. The same solution as the binder background's in both equations,
+/// a smaller loss in the bulk, and fewer applications than one floor from
+/// the largest contrast for every cell.
+#[test]
+fn a_reliefs_bulk_takes_the_loss_floor_of_its_own_contrast() {
+    use inksim::config::Linear;
+    use inksim::solver::Wave;
+    let (eps, size) = relief(C64::new(1.96, 0.02));
+    let vector = Wave::Vector {
+        polarisation: Linear::S.into(),
+        azimuth_deg: 0.0,
+    };
+    let lat = Problem::lattice([20, 20, 30], size, 400.0, 30.0, 0.0);
+    for wave in [Wave::Scalar, vector] {
+        let p = Problem {
+            wave,
+            ..in_binder(lat, &eps)
+        };
+        let binder = solver::solve(&p, Method::BiCgStab, &tight(Background::Binder)).unwrap();
+        let own = ShiftParams::for_wave(Background::Mean, &wave);
+        assert!(own.floor_per_zone, "the default");
+        let largest = ShiftParams {
+            floor_per_zone: false,
+            ..own
+        };
+        let bulk_loss = |params| System::with_params(&p, params).unwrap().background_eps().im;
+        let (own_loss, largest_loss) = (bulk_loss(own), bulk_loss(largest));
+        let (n_own, a) = applications_with(&p, own, 1e-10);
+        let (n_largest, b) = applications_with(&p, largest, 1e-10);
+        let amp = amplitude_difference(&a, &binder).max(amplitude_difference(&b, &binder));
+        eprintln!(
+            "{wave:?}: bulk loss {own_loss:.4} against {largest_loss:.4}; {n_own} applications \
+             against {n_largest}; amplitudes within {amp:.1e} of the binder background's"
+        );
+        assert!(
+            own_loss < 0.5 * largest_loss,
+            "{own_loss} vs {largest_loss}"
+        );
+        assert!(amp < 1e-8, "{amp}");
+        let (fa, fb) = (efficiencies(&a), efficiencies(&binder));
+        assert!((fa.absorption - fb.absorption).abs() < 1e-8);
+        assert!(fa.energy_balance.abs() < 1e-8, "{}", fa.energy_balance);
+        assert!(
+            (n_own as f64) < 0.8 * n_largest as f64,
+            "{n_own} vs {n_largest}"
+        );
+    }
+}

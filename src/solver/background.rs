@@ -51,6 +51,10 @@ pub struct ShiftParams {
     /// mean ([`zone_cells`]: at most a quarter of the cells per face; the
     /// default); `false`: one mean for every cell.
     pub layered_air: bool,
+    /// Mean: each layered cell takes the loss floor of the contrast left in
+    /// it, and the cells between the zones that of theirs (the default);
+    /// `false`: every cell the floor of the largest contrast in the grid.
+    pub floor_per_zone: bool,
 }
 
 impl ShiftParams {
@@ -62,6 +66,7 @@ impl ShiftParams {
             mean_loss_floor: MEAN_LOSS_FLOOR,
             mean_loss_cap: f64::INFINITY,
             layered_air: true,
+            floor_per_zone: true,
         }
     }
 
@@ -106,15 +111,33 @@ pub fn shift_of(eps: &Array3<C64>, tensor: Option<&Anisotropy>, eps_binder: f64)
 /// bound `|ε_v − c| + Σ|δ|` otherwise; 0 without a tensor part.
 pub(super) fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64) -> f64 {
     let Some(a) = tensor else { return 0.0 };
-    tensor::voxels(a, eps)
-        .map(|(e, sum, bound)| {
-            if bound - sum.norm() <= 1e-12 * bound {
-                (e - centre).norm().max((e + sum - centre).norm())
-            } else {
-                (e - centre).norm() + bound
-            }
-        })
+    spread_per_cell(a, eps, &vec![centre; a.nz()])
+        .into_iter()
         .fold(0.0, f64::max)
+}
+
+/// [`spread`] of each cell's tensor voxels, each cell against its own
+/// centre.
+fn spread_per_cell(a: &Anisotropy, eps: &Array3<C64>, centres: &[C64]) -> Vec<f64> {
+    let nx = a.plane.1;
+    (0..a.nz())
+        .map(|iz| {
+            let centre = centres[iz];
+            a.voxel_terms(iz)
+                .map(|terms| {
+                    let [iy, ix] = tensor::at(nx, terms[0].index);
+                    let e = eps[[iz, iy, ix]];
+                    let sum = terms.iter().map(|t| t.delta).sum::<C64>();
+                    let bound = terms.iter().map(|t| t.delta.norm()).sum::<f64>();
+                    if bound - sum.norm() <= 1e-12 * bound {
+                        (e - centre).norm().max((e + sum - centre).norm())
+                    } else {
+                        (e - centre).norm() + bound
+                    }
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect()
 }
 
 /// At most `nz / ZONE_CAP_DIVISOR` cells of a face take their own mean
@@ -171,8 +194,14 @@ pub fn air_cells(eps: &Array3<C64>) -> (usize, usize) {
 
 /// The mean background's permittivity per z cell: the mean of the cells
 /// between the layered zones ([`zone_cells`]), and in each cell of a zone its
-/// own lateral mean (the tensor voxels add a third of their trace), each
-/// with the loss floor of the largest contrast left, `r = max|ε − ε̄_j|`.
+/// own lateral mean (the tensor voxels add a third of their trace). Each
+/// takes the loss floor of the contrast left where it applies: a zone cell
+/// its own, `r_j = max|ε − ε̄_j|` over the cell, the cells between the
+/// largest of theirs ([`ShiftParams::floor_per_zone`]; a layer with flat
+/// faces has one mean and one floor, as before). One floor for every cell,
+/// from the largest contrast anywhere, let the air of a relief (r ≈ 1.2–1.4)
+/// damp the bulk below it, whose own contrast is a fraction of that, and
+/// the Krylov methods then spent their iterations undoing that loss.
 pub(super) fn mean_profile(
     eps: &Array3<C64>,
     tensor: Option<&Anisotropy>,
@@ -212,22 +241,47 @@ pub(super) fn mean_profile(
             }
         })
         .collect();
-    let rad = eps
+    // The contrast left in each cell, `r_j = max|ε − ε̄_j|` over its voxels
+    // (the tensor voxels' spread included).
+    let mut rad: Vec<f64> = eps
         .outer_iter()
         .zip(&means)
-        .map(|(s, m)| s.iter().map(|e| (e - m).norm_sqr()).fold(0.0, f64::max))
-        .fold(0.0, f64::max)
-        .sqrt()
-        .max(spread(eps, tensor, bulk));
-    // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
-    let cap = if rad > 0.0 {
-        params.mean_loss_cap * rad
-    } else {
-        0.0
+        .map(|(s, m)| {
+            s.iter()
+                .map(|e| (e - m).norm_sqr())
+                .fold(0.0, f64::max)
+                .sqrt()
+        })
+        .collect();
+    if let Some(a) = tensor {
+        for (r, spread) in rad.iter_mut().zip(spread_per_cell(a, eps, &means)) {
+            *r = r.max(spread);
+        }
+    }
+    let floor_of = |rad: f64| {
+        // (`rad` is 0 on a homogeneous layer, where ∞ · 0 is NaN.)
+        let cap = if rad > 0.0 {
+            params.mean_loss_cap * rad
+        } else {
+            0.0
+        };
+        (params.mean_loss_floor * rad * rad).min(cap)
     };
-    let floor = (params.mean_loss_floor * rad * rad).min(cap);
+    let largest = |cells: std::ops::Range<usize>| cells.map(|j| rad[j]).fold(0.0, f64::max);
+    let global = floor_of(largest(0..nz));
+    let inner_floor = floor_of(largest(inner.clone()));
     means
         .iter()
-        .map(|m| C64::new(m.re, m.im.max(floor).max(1e-9)))
+        .enumerate()
+        .map(|(j, m)| {
+            let floor = if !params.floor_per_zone {
+                global
+            } else if inner.contains(&j) {
+                inner_floor
+            } else {
+                floor_of(rad[j])
+            };
+            C64::new(m.re, m.im.max(floor).max(1e-9))
+        })
         .collect()
 }

@@ -50,7 +50,7 @@ fn per_slice<S: Send + Sync>(
 }
 
 #[inline]
-fn at(nx: usize, index: u32) -> [usize; 2] {
+pub(super) fn at(nx: usize, index: u32) -> [usize; 2] {
     let i = index as usize;
     [i / nx, i % nx]
 }

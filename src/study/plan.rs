@@ -20,7 +20,7 @@
 //! `N log₂(nx ny)` (the FFTs). `applications` is the measured rate of the
 //! variant's kind of layer ([`default_applications`]: its solver background
 //! and, on the mean background, whether its top is flat — relief, conformal
-//! films and rough surfaces need 3–6× more); once results of this study are
+//! films and rough surfaces need about 1.3× more); once results of this study are
 //! finished, every rate is scaled by what they needed against what was
 //! assumed for them (the operator applications each solve recorded), the
 //! assumption counting as
@@ -64,8 +64,11 @@ pub const BINDER_APPLICATIONS: f64 = 200.0;
 pub const MEAN_APPLICATIONS: f64 = 21.0;
 /// The same when the top is not a plane (relief, a conformal film or a
 /// rough surface): the binder–air interface crosses the grid's cells; the
-/// standard profile's 9 red variants of these kinds needed 56–260, mean 93.
-pub const MEAN_APPLICATIONS_SURFACE: f64 = 93.0;
+/// standard profile's 9 red variants of these kinds, with the air at each
+/// face on its own mean and loss floor, needed 18–46 per solve (the
+/// conformal films and the 15 % rough top the most), 26.7 over their 3344
+/// solves — docs/PERFORMANCE.md, "Air at a face".
+pub const MEAN_APPLICATIONS_SURFACE: f64 = 27.0;
 
 /// The tolerance the mean background's assumed rates were measured at
 /// ([`MEAN_APPLICATIONS`], [`MEAN_APPLICATIONS_SURFACE`]).

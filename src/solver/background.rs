@@ -119,16 +119,11 @@ pub(super) fn spread(eps: &Array3<C64>, tensor: Option<&Anisotropy>, centre: C64
 /// [`spread`] of each cell's tensor voxels, each cell against its own
 /// centre.
 fn spread_per_cell(a: &Anisotropy, eps: &Array3<C64>, centres: &[C64]) -> Vec<f64> {
-    let nx = a.plane.1;
     (0..a.nz())
         .map(|iz| {
             let centre = centres[iz];
-            a.voxel_terms(iz)
-                .map(|terms| {
-                    let [iy, ix] = tensor::at(nx, terms[0].index);
-                    let e = eps[[iz, iy, ix]];
-                    let sum = terms.iter().map(|t| t.delta).sum::<C64>();
-                    let bound = terms.iter().map(|t| t.delta.norm()).sum::<f64>();
+            tensor::slice_voxels(a, eps, iz)
+                .map(|(e, sum, bound)| {
                     if bound - sum.norm() <= 1e-12 * bound {
                         (e - centre).norm().max((e + sum - centre).norm())
                     } else {

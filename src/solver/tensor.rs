@@ -50,7 +50,7 @@ fn per_slice<S: Send + Sync>(
 }
 
 #[inline]
-pub(super) fn at(nx: usize, index: u32) -> [usize; 2] {
+fn at(nx: usize, index: u32) -> [usize; 2] {
     let i = index as usize;
     [i / nx, i % nx]
 }
@@ -152,14 +152,21 @@ pub fn voxels<'a>(
     a: &'a Anisotropy,
     eps: &'a Array3<C64>,
 ) -> impl Iterator<Item = (C64, C64, f64)> + 'a {
+    (0..a.nz()).flat_map(move |iz| slice_voxels(a, eps, iz))
+}
+
+/// [`voxels`] of slice `iz` alone.
+pub fn slice_voxels<'a>(
+    a: &'a Anisotropy,
+    eps: &'a Array3<C64>,
+    iz: usize,
+) -> impl Iterator<Item = (C64, C64, f64)> + 'a {
     let nx = a.plane.1;
-    (0..a.nz()).flat_map(move |iz| {
-        a.voxel_terms(iz).map(move |terms| {
-            let [iy, ix] = at(nx, terms[0].index);
-            let sum = terms.iter().map(|t| t.delta).sum::<C64>();
-            let bound = terms.iter().map(|t| t.delta.norm()).sum::<f64>();
-            (eps[[iz, iy, ix]], sum, bound)
-        })
+    a.voxel_terms(iz).map(move |terms| {
+        let [iy, ix] = at(nx, terms[0].index);
+        let sum = terms.iter().map(|t| t.delta).sum::<C64>();
+        let bound = terms.iter().map(|t| t.delta.norm()).sum::<f64>();
+        (eps[[iz, iy, ix]], sum, bound)
     })
 }
 

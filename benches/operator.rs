@@ -8,7 +8,9 @@
 //! `maxwell_system[_tensor]`: the whole shifted application a Krylov step
 //! makes (`V' x` and `G_s` of it) on a layer of 200 nm spheres at 30 % of
 //! the 60 × 60 × 50 grid (40 % by volume), with volume-averaged and with anisotropic cut
-//! voxels (their tensor terms).
+//! voxels (their tensor terms). `maxwell_step_parts` / `maxwell_step_fused`:
+//! what a BiCGStab step applies on the mean background (`P A x`, its norm
+//! and one inner product), step by step and fused into the transforms.
 //!
 //! `cargo bench --bench operator` (60 × 60 × 50, the standard profile's
 //! grid (1.4 µm fragments, 20 nm z cells), 256 × 256 × 64 and 512 × 512 × 96;
@@ -26,6 +28,7 @@ use inksim::solver::fft::Fft2;
 use inksim::solver::maxwell::VectorOperator;
 use inksim::solver::operator::{GreenTable, Operator};
 use inksim::solver::shift::ShiftTable;
+use inksim::solver::storage::{dot, norm_sqr};
 use inksim::solver::{Jones, Problem, System, Wave};
 use ndarray::Array3;
 use num_complex::Complex64 as C64;
@@ -168,6 +171,39 @@ fn system<M: Measurement>(g: &mut criterion::BenchmarkGroup<M>) {
             |b, _| b.iter(|| sys.apply_a_shifted(&mut scr, &x, &mut out)),
         );
     }
+    // What a BiCGStab step applies, on the mean background the study's
+    // solves take: `P A x` with `‖·‖²` and `⟨·, w⟩`, step by step against
+    // the fused application (`System::apply_pa_sums`).
+    let p = Problem {
+        lattice: lat,
+        eps: &eps,
+        tensor: Some(&tensor),
+        eps_binder: eb.re,
+        wave: Wave::Vector {
+            polarisation: Jones::from(inksim::config::Linear::P),
+            azimuth_deg: 0.0,
+        },
+    };
+    let sys = System::new(&p, Background::Mean).unwrap();
+    let mut scr = sys.scratch();
+    let (x, w) = (field(3 * nz, n, n), field(3 * nz, n, n).mapv(|v| v.conj()));
+    let mut out = Array3::<C64>::zeros(x.dim());
+    g.bench_with_input(
+        BenchmarkId::new("maxwell_step_parts", format!("{n}x{n}x{nz}")),
+        &(),
+        |b, _| {
+            b.iter(|| {
+                sys.apply_a_shifted(&mut scr, &x, &mut out);
+                sys.precondition(&mut out);
+                (norm_sqr(&out), dot(&out, &w))
+            })
+        },
+    );
+    g.bench_with_input(
+        BenchmarkId::new("maxwell_step_fused", format!("{n}x{n}x{nz}")),
+        &(),
+        |b, _| b.iter(|| sys.apply_pa_sums(&mut scr, &x, &mut out, &w)),
+    );
 }
 
 /// CPU time of every thread of this process (ns), from

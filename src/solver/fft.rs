@@ -6,7 +6,7 @@
 //! solve on a grid (all wavelengths, angles, realisations) reuses the same
 //! plans; per-slice scratch is owned by the caller's [`FftScratch`].
 
-use ndarray::Array3;
+use ndarray::{Array3, ArrayViewMut2, Axis};
 use num_complex::Complex64 as C64;
 use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
@@ -28,9 +28,11 @@ pub struct Fft2 {
     iy: Arc<dyn Fft<f64>>,
 }
 
-/// Per-slice scratch for the transforms.
+/// Per-slice scratch for the transforms, and per task one real-space
+/// plane for the transforms that fill and read slices through closures.
 pub struct FftScratch {
     bufs: Vec<Vec<C64>>,
+    planes: Vec<Vec<C64>>,
 }
 
 impl Fft2 {
@@ -56,8 +58,12 @@ impl Fft2 {
             .max()
             .unwrap_or(0)
             .max(1);
+        let tasks = nz.min(4 * rayon::current_num_threads()).max(1);
         FftScratch {
             bufs: (0..nz).map(|_| vec![C64::new(0.0, 0.0); len]).collect(),
+            planes: (0..tasks)
+                .map(|_| vec![C64::new(0.0, 0.0); self.nx * self.ny])
+                .collect(),
         }
     }
 
@@ -91,6 +97,74 @@ impl Fft2 {
                 transpose(ss, rs, nx, ny);
                 self.ix.process_with_scratch(rs, buf);
             });
+    }
+}
+
+impl Fft2 {
+    /// [`Fft2::forward`] of the slices `load(k, plane)` writes (plane `k`
+    /// of the field, (ny, nx)) into `spec (nslices, nx, ny)`: the field is
+    /// never stored whole, so a source made per voxel (the contrast times
+    /// the unknowns) costs no pass over memory of its own.
+    pub fn forward_from(
+        &self,
+        spec: &mut Array3<C64>,
+        scr: &mut FftScratch,
+        load: impl Fn(usize, &mut [C64]) + Sync,
+    ) {
+        let (nx, ny) = (self.nx, self.ny);
+        let slices = spec.dim().0;
+        let per = slices.div_ceil(scr.planes.len());
+        let s = spec.as_slice_mut().expect("contiguous spectrum");
+        s.par_chunks_mut(per * nx * ny)
+            .zip(scr.planes.par_iter_mut())
+            .zip(scr.bufs.par_iter_mut())
+            .enumerate()
+            .for_each(|(task, ((chunk, plane), buf))| {
+                for (i, ss) in chunk.chunks_mut(nx * ny).enumerate() {
+                    load(task * per + i, plane);
+                    self.fx.process_with_scratch(plane, buf);
+                    transpose(plane, ss, ny, nx);
+                    self.fy.process_with_scratch(ss, buf);
+                }
+            });
+    }
+
+    /// [`Fft2::inverse`] of `spec` (used as working space), handing each
+    /// real-space plane `k` (ny, nx) to `store(k, plane, out's slice k)`;
+    /// returns what `store` returns, in slice order.
+    pub fn inverse_into<S: Send + Sync, R: Send>(
+        &self,
+        spec: &mut Array3<C64>,
+        scr: &mut FftScratch,
+        out: &mut Array3<S>,
+        store: impl Fn(usize, &[C64], ArrayViewMut2<S>) -> R + Sync,
+    ) -> Vec<R> {
+        let (nx, ny) = (self.nx, self.ny);
+        let slices = spec.dim().0;
+        assert_eq!(out.dim().0, slices, "one output slice per spectral slice");
+        let per = slices.div_ceil(scr.planes.len());
+        let s = spec.as_slice_mut().expect("contiguous spectrum");
+        let parts: Vec<Vec<R>> = s
+            .par_chunks_mut(per * nx * ny)
+            .zip(out.axis_chunks_iter_mut(Axis(0), per).into_par_iter())
+            .zip(scr.planes.par_iter_mut())
+            .zip(scr.bufs.par_iter_mut())
+            .enumerate()
+            .map(|(task, (((chunk, mut outs), plane), buf))| {
+                chunk
+                    .chunks_mut(nx * ny)
+                    .zip(outs.outer_iter_mut())
+                    .enumerate()
+                    .map(|(i, (ss, o))| {
+                        self.iy.process_with_scratch(ss, buf);
+                        transpose(ss, plane, nx, ny);
+                        self.ix.process_with_scratch(plane, buf);
+                        store(task * per + i, plane, o)
+                    })
+                    .collect()
+            })
+            .collect();
+        parts.into_iter().flatten().collect()
     }
 }
 

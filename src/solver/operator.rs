@@ -221,9 +221,32 @@ impl Operator {
         field: &mut Array3<C64>,
         ws: &mut Workspace,
     ) {
+        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
+        self.shifted_spectral(table, ws);
+        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
+    }
+
+    /// [`Operator::apply_shifted_green`] of the source whose z-slices
+    /// `load(k, plane)` makes, each output slice handed to
+    /// `store(k, plane, out's slice k)`: no whole field is stored between
+    /// ([`Fft2::forward_from`]).
+    pub fn apply_shifted_green_with<S: Send + Sync, R: Send>(
+        &self,
+        table: &ShiftTable,
+        ws: &mut Workspace,
+        load: impl Fn(usize, &mut [C64]) + Sync,
+        out: &mut Array3<S>,
+        store: impl Fn(usize, &[C64], ArrayViewMut2<S>) -> R + Sync,
+    ) -> Vec<R> {
+        self.fft.forward_from(&mut ws.spec, &mut ws.fft, load);
+        self.shifted_spectral(table, ws);
+        self.fft.inverse_into(&mut ws.spec, &mut ws.fft, out, store)
+    }
+
+    /// `G_s` on the spectrum in `ws` (between the transforms).
+    fn shifted_spectral(&self, table: &ShiftTable, ws: &mut Workspace) {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let norm = 1.0 / (nx * ny) as f64;
-        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         // Near-grazing harmonics: dense path on their saved columns.
         let mut dense = std::mem::take(&mut ws.special_in);
         dense.clear();
@@ -246,7 +269,6 @@ impl Operator {
             }
         }
         ws.special_in = dense;
-        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 
     /// Boundary values `w(0)`, `w(H)` of `w = G_b(x + c G_s x)` per harmonic

@@ -21,12 +21,12 @@ use super::lattice::Lattice;
 use super::maxwell::{VectorOperator, VectorShift, VectorWorkspace};
 use super::operator::{GreenTable, Operator, Workspace};
 use super::shift::{BandScratch, ShiftTable};
-use super::storage::{norm_sqr, on_field, sum_slices, Field, Storage};
+use super::storage::{dot, norm_sqr, on_field, sum_slices, Field, Storage};
 use super::tensor;
 use super::{Jones, Problem, Solution, SolveError, SolveRecord, VectorAmplitudes, Wave};
 use crate::config::Background;
 use crate::raster::Anisotropy;
-use ndarray::{s, Array2, Array3, Ix3, Zip};
+use ndarray::{s, Array2, Array3, ArrayViewMut2, Ix3, Zip};
 use num_complex::Complex64 as C64;
 
 /// The discrete equation `u = u_bg + G_b V u` of one problem, in its plain
@@ -515,6 +515,83 @@ impl<'a> System<'a> {
             .and(x)
             .and(&scr.field)
             .par_for_each(|o, x, t| *o = S::store(x.load() - t));
+    }
+
+    /// `out ← P (x − G_s V' x)` (the preconditioned shifted operator, as
+    /// [`System::apply_a_shifted`] then [`System::precondition`]), returning
+    /// `(‖out‖², ⟨out, w⟩)` of the stored `out`. On the mean background (no
+    /// preconditioner) the source `(V − C) x` is made slice by slice as the
+    /// forward transform reads it, and the subtraction and both sums are
+    /// done slice by slice as the inverse transform writes: no whole field
+    /// is stored between, one pass over memory instead of five. The Krylov
+    /// methods' vector work is bound by memory traffic, not arithmetic
+    /// (docs/PERFORMANCE.md, "Maxwell").
+    /// Sums run per z-slice and then in a fixed order (thread-count
+    /// independent).
+    pub fn apply_pa_sums<S: Storage>(
+        &self,
+        scr: &mut Scratch,
+        x: &Array3<S>,
+        out: &mut Array3<S>,
+        w: &Array3<S>,
+    ) -> (f64, C64) {
+        let (k2, eb, nz) = (self.k2, self.eps_binder, self.eps.dim().0);
+        let plane = self.lat.nx * self.lat.ny;
+        let (c, tensor) = (&self.shift.c, self.tensor);
+        let (Some(eps), Some(xs), Some(ws), None) = (
+            self.eps.as_slice(),
+            x.as_slice(),
+            w.as_slice(),
+            self.shift.cbs,
+        ) else {
+            // A preconditioner, or a grid not in standard layout (a layer
+            // lit from below is a flipped view): the steps one by one.
+            self.apply_a_shifted(scr, x, out);
+            self.precondition(out);
+            return (norm_sqr(out), dot(out, w));
+        };
+        let row = |k: usize| k * plane..(k + 1) * plane;
+        // Row k of the source (V − C) x: component k / nz, z cell k % nz.
+        let load = |k: usize, p: &mut [C64]| {
+            let (comp, iz) = (k / nz, k % nz);
+            let cz = c[iz];
+            for ((p, e), x) in p.iter_mut().zip(&eps[row(iz)]).zip(&xs[row(k)]) {
+                *p = (k2 * (e - eb) - cz) * x.load();
+            }
+            if let Some(a) = tensor {
+                tensor::add_contrast_plane(a, k2, xs, comp, iz, p);
+            }
+        };
+        // out = x − G_s (V − C) x, with its sums.
+        let store = |k: usize, t: &[C64], mut o: ArrayViewMut2<S>| {
+            let o = o.as_slice_mut().expect("contiguous row");
+            let (mut nn, mut d) = (0.0, C64::new(0.0, 0.0));
+            for (((o, t), x), w) in o.iter_mut().zip(t).zip(&xs[row(k)]).zip(&ws[row(k)]) {
+                *o = S::store(x.load() - t);
+                let v = o.load();
+                nn += v.norm_sqr();
+                d += v.conj() * w.load();
+            }
+            (nn, d)
+        };
+        let parts = match (&self.op, &mut scr.op, &self.shift.table) {
+            (
+                BackgroundOperator::Scalar { op, .. },
+                OpWorkspace::Scalar(ws),
+                ShiftTables::Scalar(table),
+            ) => op.apply_shifted_green_with(table, ws, load, out, store),
+            (
+                BackgroundOperator::Vector { op, .. },
+                OpWorkspace::Vector(ws),
+                ShiftTables::Vector(table),
+            ) => op.apply_shifted_with(table, ws, load, out, store),
+            _ => unreachable!("a system's scratch is made by the system"),
+        };
+        parts
+            .iter()
+            .fold((0.0, C64::new(0.0, 0.0)), |(a, b), &(nn, d)| {
+                (a + nn, b + d)
+            })
     }
 
     /// `x ← γ x`, γ = 1 + i(ε − ε_r)/ε_s: the CBS preconditioner of the

@@ -81,10 +81,33 @@ impl VectorOperator {
         field: &mut Array3<C64>,
         ws: &mut VectorWorkspace,
     ) {
+        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
+        self.shifted_spectral(tables, ws);
+        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
+    }
+
+    /// [`VectorOperator::apply_shifted`] of the source whose rows
+    /// `load(k, plane)` makes (row `k` of the stacked unknowns, (ny, nx)),
+    /// each output row handed to `store(k, plane, out's row k)`: no
+    /// whole field is stored between ([`Fft2::forward_from`]).
+    pub fn apply_shifted_with<S: Send + Sync, R: Send>(
+        &self,
+        tables: &VectorShift,
+        ws: &mut VectorWorkspace,
+        load: impl Fn(usize, &mut [C64]) + Sync,
+        out: &mut Array3<S>,
+        store: impl Fn(usize, &[C64], ArrayViewMut2<S>) -> R + Sync,
+    ) -> Vec<R> {
+        self.fft.forward_from(&mut ws.spec, &mut ws.fft, load);
+        self.shifted_spectral(tables, ws);
+        self.fft.inverse_into(&mut ws.spec, &mut ws.fft, out, store)
+    }
+
+    /// `G_s` on the spectrum in `ws` (between the transforms).
+    fn shifted_spectral(&self, tables: &VectorShift, ws: &mut VectorWorkspace) {
         let (nx, ny, nz) = (self.lat.nx, self.lat.ny, self.lat.nz);
         let norm = 1.0 / (nx * ny) as f64;
         let c = &tables.c;
-        self.fft.forward(field, &mut ws.spec, &mut ws.fft);
         // Near-grazing harmonics: the column solve on their saved columns.
         let mut dense = std::mem::take(&mut ws.dense);
         dense.clear();
@@ -118,7 +141,6 @@ impl VectorOperator {
             }
         }
         ws.dense = dense;
-        self.fft.inverse(&mut ws.spec, field, &mut ws.fft);
     }
 }
 

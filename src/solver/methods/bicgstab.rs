@@ -13,6 +13,7 @@ use crate::solver::system::{Scratch, System};
 use crate::solver::{Controls, SolveError};
 use ndarray::{Array3, Zip};
 use num_complex::Complex64 as C64;
+use rayon::prelude::*;
 
 /// BiCGStab settings.
 #[derive(Debug, Clone, Copy)]
@@ -59,12 +60,6 @@ impl Solver for BiCgStab {
 }
 
 impl BiCgStab {
-    /// `out ← P A x`.
-    fn op<S: Storage>(sys: &System, scr: &mut Scratch, x: &Array3<S>, out: &mut Array3<S>) {
-        sys.apply_a_shifted(scr, x, out);
-        sys.precondition(out);
-    }
-
     fn iterate<S: Storage>(
         &self,
         sys: &System,
@@ -102,9 +97,11 @@ impl BiCgStab {
             p.fill(S::default());
             v.fill(S::default());
             let (mut rho, mut alpha, mut omega) = (one, one, one);
+            // ⟨r̂, r⟩ of the current residual; later iterations take it from
+            // the residual's update pass.
+            let mut rho_new = dot(&rh, &r);
             while iterations < ctl.max_iterations {
                 iterations += 1;
-                let rho_new = dot(&rh, &r);
                 if rho_new.norm() < 1e-30 * r0 * r0 {
                     break; // breakdown: restart
                 }
@@ -113,8 +110,8 @@ impl BiCgStab {
                 Zip::from(&mut p).and(&r).and(&v).par_for_each(|p, r, v| {
                     *p = S::store(r.load() + beta * (p.load() - omega * v.load()))
                 });
-                Self::op(sys, scr, &p, &mut v);
-                let rv = dot(&rh, &v);
+                // v = P A p with ⟨v, r̂⟩ in the same pass.
+                let rv = sys.apply_pa_sums(scr, &p, &mut v, &rh).1.conj();
                 if rv.norm() < 1e-30 * r0 * r0 {
                     break;
                 }
@@ -123,22 +120,17 @@ impl BiCgStab {
                     .and(&r)
                     .and(&v)
                     .par_for_each(|s, r, v| *s = S::store(r.load() - alpha * v.load()));
-                Self::op(sys, scr, &s, &mut t);
+                // t = P A s with ‖t‖² and ⟨t, s⟩ in the same pass.
+                let (tt, ts) = sys.apply_pa_sums(scr, &s, &mut t, &s);
                 applications += 2;
-                let tt = norm_sqr(&t);
                 omega = if tt > 0.0 {
-                    dot(&t, &s) / tt
+                    ts / tt
                 } else {
                     C64::new(0.0, 0.0)
                 };
-                Zip::from(&mut *u).and(&p).and(&s).par_for_each(|u, p, s| {
-                    *u = S::store(u.load() + alpha * p.load() + omega * s.load())
-                });
-                Zip::from(&mut r)
-                    .and(&s)
-                    .and(&t)
-                    .par_for_each(|r, s, t| *r = S::store(s.load() - omega * t.load()));
-                let rn = norm_sqr(&r).sqrt();
+                let (rr, rhr) = update(u, &mut r, [&p, &s, &t, &rh], alpha, omega);
+                rho_new = rhr;
+                let rn = rr.sqrt();
                 // The true residual scales with the preconditioned one
                 // from the restart, where `target` is half of tolerance's.
                 monitor.tick(iterations, 0.5 * ctl.tolerance * rn / target)?;
@@ -148,6 +140,50 @@ impl BiCgStab {
             }
         }
     }
+}
+
+/// The iteration's closing updates in one pass over the fields:
+/// `u ← u + α p + ω s`, `r ← s − ω t`, returning `(‖r‖², ⟨r̂, r⟩)` of the
+/// stored `r` (summed per z-slice, then in a fixed order). Separately they
+/// were two updates and two reductions, each a pass over memory.
+fn update<S: Storage>(
+    u: &mut Array3<S>,
+    r: &mut Array3<S>,
+    [p, s, t, rh]: [&Array3<S>; 4],
+    alpha: C64,
+    omega: C64,
+) -> (f64, C64) {
+    let zero = C64::new(0.0, 0.0);
+    let parts: Vec<(f64, C64)> = u
+        .outer_iter_mut()
+        .into_par_iter()
+        .zip(r.outer_iter_mut())
+        .zip(p.outer_iter())
+        .zip(s.outer_iter())
+        .zip(t.outer_iter())
+        .zip(rh.outer_iter())
+        .map(|(((((mut u, mut r), p), s), t), rh)| {
+            let (mut rr, mut d) = (0.0, zero);
+            Zip::from(&mut u)
+                .and(&mut r)
+                .and(&p)
+                .and(&s)
+                .and(&t)
+                .and(&rh)
+                .for_each(|u, r, p, s, t, rh| {
+                    let sv = s.load();
+                    *u = S::store(u.load() + alpha * p.load() + omega * sv);
+                    *r = S::store(sv - omega * t.load());
+                    let rv = r.load();
+                    rr += rv.norm_sqr();
+                    d += rh.load().conj() * rv;
+                });
+            (rr, d)
+        })
+        .collect();
+    parts
+        .iter()
+        .fold((0.0, zero), |(a, b), &(rr, d)| (a + rr, b + d))
 }
 
 /// Complex entries uniform in a square, from a fixed seed, scaled to norm

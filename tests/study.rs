@@ -331,14 +331,18 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
     // The finished results' applications against the rates assumed for
     // them, averaged with 1 counted as 5 results; per kind of top, so the
     // flat results leave the surfaces' factor alone.
-    let (mut measured, mut assumed) = (0.0, 0.0);
-    for v in &three.variants {
-        for e in &got[&v.name].entries {
-            measured += e.operator_applications.expect("recorded") as f64;
-            assumed += inksim::study::plan::default_applications(&v.scene);
+    // Applications recorded over assumed, over the variants named `prefix…`.
+    let rate_of = |prefix: &str| {
+        let (mut measured, mut assumed) = (0.0, 0.0);
+        for v in three.variants.iter().filter(|v| v.name.starts_with(prefix)) {
+            for e in &got[&v.name].entries {
+                measured += e.operator_applications.expect("recorded") as f64;
+                assumed += inksim::study::plan::default_applications(&v.scene);
+            }
         }
-    }
-    let r = measured / assumed;
+        measured / assumed
+    };
+    let r = rate_of("");
     let blended = (5.0 + 4.0 * r) / 9.0;
     assert!(
         ok && plan2.contains(&format!(
@@ -348,6 +352,41 @@ fn plan_figures_match_the_run_and_merge_needs_every_variant() {
         )),
         "{plan2}"
     );
+    // Each pigment's own results scale its own rates by the same rule.
+    for pigment in ["red", "yellow"] {
+        let r = rate_of(pigment);
+        let blended = (5.0 + 2.0 * r) / 7.0;
+        assert!(
+            plan2.contains(&format!(
+                "pigments {pigment}, flat tops × {blended:.2}: the 2 finished result(s) of this \
+                 pigment needed {r:.2}× the assumed rates, averaged with 1× counted as 5 \
+                 result(s)"
+            )),
+            "{plan2}"
+        );
+    }
+    // And a variant's estimate takes its pigment's factor, not another's.
+    {
+        use inksim::study::plan;
+        // (The run's output folder is relative to where it ran.)
+        let mut done = three.variants.clone();
+        for v in &mut done {
+            v.scene.output.dir = dir.path().join(&v.scene.output.dir);
+        }
+        let cal = plan::calibrate(&done, &done);
+        let mut doubled = cal.clone();
+        doubled
+            .pigments
+            .get_mut(&("red".to_string(), true))
+            .expect("red's own factor")
+            .0 *= 2.0;
+        let of = |name: &str, cal: &plan::Calibration| {
+            let v = done.iter().find(|v| v.name.starts_with(name));
+            plan::estimate(&v.unwrap().scene, cal).seconds
+        };
+        assert!(of("red", &doubled) > 1.5 * of("red", &cal));
+        assert_eq!(of("yellow", &doubled), of("yellow", &cal));
+    }
 
     let (ok, out, err) = inksim_in(dir.path(), &["merge", ps, "--profile", "three"]);
     assert!(ok, "{err}");

@@ -64,6 +64,10 @@ pub fn plan(
         cal.surface_ratio,
         cal.surface_source
     );
+    for ((pigments, flat), (ratio, source)) in &cal.pigments {
+        let kind = if *flat { "flat tops" } else { "surfaces" };
+        println!("  pigments {pigments}, {kind} × {ratio:.2}: {source}");
+    }
     for (key, g) in &cal.groups {
         let pilot = match &g.pilot {
             Ok(p) => format!(

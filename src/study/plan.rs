@@ -26,7 +26,10 @@
 //! assumption counting as
 //! [`PRIOR_RESULTS`] results: a study's axes often run from easy to hard
 //! (small grains first), so its first results are a biased sample (100 nm
-//! spheres take a third of the applications of 450 nm ones); closed-form
+//! spheres take a third of the applications of 450 nm ones). A pigment
+//! with finished results of a kind has its own factor by the same rule
+//! ([`pigments_key`]); the others take the kind's, pooled over every
+//! pigment's results; closed-form
 //! layers (no grid, [`ANALYTIC_SOLVE_S`] per solve) are left out of that
 //! ratio and out
 //! of the model. A high-contrast layer (white grains: real index more than
@@ -172,6 +175,24 @@ pub struct Calibration {
     /// High-contrast groups ([`pilot::group`]) → their own factor, from a
     /// pilot solve and their finished results, in place of `ratio`.
     pub groups: BTreeMap<String, GroupRate>,
+    /// Per pigments ([`pigments_key`]) and kind of top (`true`: flat) with
+    /// finished results: their own factor and where it came from, in place
+    /// of `ratio` or `surface_ratio` for that pigment's variants. Pigments
+    /// differ more than the prior allows (blue needs twice green's
+    /// applications per solve in Maxwell's equations), so one pigment's
+    /// results scale only its own rates; the others take the pooled factor.
+    pub pigments: BTreeMap<(String, bool), (f64, String)>,
+}
+
+/// The pigments whose finished results scale a variant's rates: its
+/// species' material names in order (`"yellow+blue"`).
+pub fn pigments_key(scene: &Scene) -> String {
+    scene
+        .species
+        .iter()
+        .map(|s| s.material.name.as_str())
+        .collect::<Vec<_>>()
+        .join("+")
 }
 
 /// The measured factor of one high-contrast group.
@@ -437,6 +458,23 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
     };
     let (ratio, applications_source) = kind(true);
     let (surface_ratio, surface_source) = kind(false);
+    // Per pigment and kind, the same rule on that pigment's results alone.
+    let mut by: BTreeMap<(String, bool), Vec<Variant>> = BTreeMap::new();
+    for v in done.get(&None).into_iter().flatten() {
+        by.entry((pigments_key(&v.scene), flat_top(&v.scene)))
+            .or_default()
+            .push(v.clone());
+    }
+    let pigments = by
+        .into_iter()
+        .filter_map(|(key, vs)| {
+            let done = measured_ratio(&vs)?;
+            Some((
+                key,
+                blend((1.0, PRIOR_RESULTS), Some(done), "1×", "pigment"),
+            ))
+        })
+        .collect();
     Calibration {
         grids,
         ratio,
@@ -444,6 +482,7 @@ pub fn calibrate(variants: &[Variant], finished: &[Variant]) -> Calibration {
         surface_ratio,
         surface_source,
         groups,
+        pigments,
     }
 }
 
@@ -480,14 +519,14 @@ pub fn estimate(scene: &Scene, cal: &Calibration) -> Estimate {
         solves as f64 * ANALYTIC_SOLVE_S
     } else {
         cal.grids.get(&grid_key(scene)).map_or(f64::NAN, |t| {
-            let ratio = pilot::group(scene).and_then(|k| cal.groups.get(&k)).map_or(
-                if flat_top(scene) {
-                    cal.ratio
-                } else {
-                    cal.surface_ratio
-                },
-                |g| g.ratio,
-            );
+            let flat = flat_top(scene);
+            let pooled = cal
+                .pigments
+                .get(&(pigments_key(scene), flat))
+                .map_or(if flat { cal.ratio } else { cal.surface_ratio }, |p| p.0);
+            let ratio = pilot::group(scene)
+                .and_then(|k| cal.groups.get(&k))
+                .map_or(pooled, |g| g.ratio);
             let applications = default_applications(scene) * ratio;
             let waves = wave_solves(scene) as f64;
             solves as f64 * waves * (t.setup_s + applications * t.apply_s)

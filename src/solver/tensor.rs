@@ -67,24 +67,14 @@ pub fn add_contrast<S: Storage + Sync>(
     x: &Array3<S>,
     field: &mut Array3<C64>,
 ) {
-    let nz = a.nz();
-    let (ny, nx) = a.plane;
-    let plane = ny * nx;
     // The system's arrays are in standard layout (made by `zeros` or
     // `default`): borrowed as they are, rows as contiguous slices.
     let x = x.as_standard_layout();
     let xs = x.as_slice().expect("standard layout");
-    per_slice(field, nz, |iz, f| {
-        let [fx, fy, fz] = f.map(|r| r.as_slice_mut().expect("contiguous row"));
-        let row = |c: usize| &xs[(c * nz + iz) * plane..(c * nz + iz + 1) * plane];
-        let (rx, ry, rz) = (row(0), row(1), row(2));
-        for t in a.slice(iz) {
-            let i = t.index as usize;
-            let v = [rx[i].load(), ry[i].load(), rz[i].load()];
-            let w = k2 * t.delta * project(t.axis, v);
-            fx[i] += w * t.axis[0];
-            fy[i] += w * t.axis[1];
-            fz[i] += w * t.axis[2];
+    per_slice(field, a.nz(), |iz, f| {
+        for (c, row) in f.into_iter().enumerate() {
+            let row = row.as_slice_mut().expect("contiguous row");
+            add_contrast_plane(a, k2, xs, c, iz, row);
         }
     });
 }

@@ -458,3 +458,92 @@ fn a_reliefs_bulk_takes_the_loss_floor_of_its_own_contrast() {
         );
     }
 }
+
+/// A dilute layer: one lossless grain of ε 7.3 (200 nm across, about 2 % of
+/// the 600 nm cube). The bulk's loss floor is scaled by its mean square
+/// contrast against [`solver::MEAN_LOSS_DILUTE`] times the largest
+/// contrast squared (closed form here: a grid of two values), and the
+/// smaller floor gives the same answer as the binder background in fewer
+/// applications than the whole floor, in both equations.
+#[test]
+fn a_dilute_layer_takes_the_share_of_the_loss_floor_its_grains_call_for() {
+    use inksim::config::Linear;
+    use inksim::solver::Wave;
+    let (four, size) = four_grains(C64::new(7.3, 0.0));
+    // Keep the first grain (centred at 150, 150, 150 nm) alone.
+    let eps = Array3::from_shape_fn(four.dim(), |(k, j, i)| {
+        if k < 15 && j < 10 && i < 10 {
+            four[[k, j, i]]
+        } else {
+            C64::new(EPS_B, 0.0)
+        }
+    });
+    let grain = eps.iter().filter(|e| e.re > 7.0).count();
+    assert!(grain > 100, "{grain} grain voxels");
+    let n = eps.len() as f64;
+    let m = eps.iter().sum::<C64>() / n;
+    let rad = eps.iter().map(|e| (e - m).norm()).fold(0.0, f64::max);
+    let square = eps.iter().map(|e| (e - m).norm_sqr()).sum::<f64>() / n;
+    let share = square / (solver::MEAN_LOSS_DILUTE * rad * rad);
+    eprintln!("grain fraction {:.4}, share {share:.3}", grain as f64 / n);
+    assert!(share < 0.5, "{share}");
+    let vector = Wave::Vector {
+        polarisation: Linear::S.into(),
+        azimuth_deg: 0.0,
+    };
+    let lat = Problem::lattice([20, 20, 30], size, 550.0, 8.0, 0.0);
+    for wave in [Wave::Scalar, vector] {
+        let p = Problem {
+            wave,
+            ..in_binder(lat, &eps)
+        };
+        let own = ShiftParams::for_wave(Background::Mean, &wave);
+        assert_eq!(own.mean_loss_dilute, solver::MEAN_LOSS_DILUTE);
+        let whole = ShiftParams {
+            mean_loss_dilute: 0.0,
+            ..own
+        };
+        let floor = (own.mean_loss_floor * rad * rad).min(own.mean_loss_cap * rad);
+        let loss = |params| System::with_params(&p, params).unwrap().background_eps();
+        assert!((loss(whole) - C64::new(m.re, floor)).norm() < 1e-12);
+        assert!((loss(own) - C64::new(m.re, share * floor)).norm() < 1e-12);
+        let binder = solver::solve(&p, Method::BiCgStab, &tight(Background::Binder)).unwrap();
+        let (n_own, a) = applications_with(&p, own, 1e-8);
+        let (n_whole, b) = applications_with(&p, whole, 1e-8);
+        let (da, db) = (
+            amplitude_difference(&a, &binder),
+            amplitude_difference(&b, &binder),
+        );
+        eprintln!(
+            "{wave:?}: {n_own} applications with the share, {n_whole} with the whole \
+             floor; amplitudes within {da:.1e} and {db:.1e} of the binder background's"
+        );
+        assert!(da < 1e-6 && db < 1e-6, "{da} {db}");
+        assert!(
+            (n_own as f64) < 0.7 * n_whole as f64,
+            "{n_own} vs {n_whole}"
+        );
+    }
+    // The same grain in bluer light is larger inside: at 300 nm (k0 n a ≈ 6,
+    // above 5) it keeps the whole floor, at 380 nm (4.7) part of it.
+    for wavelength in [300.0, 380.0] {
+        let lat = Problem::lattice([20, 20, 30], size, wavelength, 8.0, 0.0);
+        let p = in_binder(lat, &eps);
+        let own = ShiftParams::of(Background::Mean);
+        let whole = ShiftParams {
+            mean_loss_dilute: 0.0,
+            ..own
+        };
+        let loss = |params| System::with_params(&p, params).unwrap().background_eps().im;
+        let (got, full) = (loss(own), loss(whole));
+        eprintln!("{wavelength} nm: floor {got:.4} of the whole {full:.4}");
+        if wavelength < 350.0 {
+            assert!((got - full).abs() < 1e-12 * full, "{got} vs {full}");
+        } else {
+            assert!(
+                got > 1.2 * share * full && got < 0.9 * full,
+                "{got} vs {full}, share {share}"
+            );
+        }
+    }
+}

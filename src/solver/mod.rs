@@ -73,8 +73,8 @@ use ndarray::{Array2, Array3};
 use num_complex::Complex64 as C64;
 
 pub use background::{
-    air_cells, zone_cell_bytes, zone_cells, ShiftParams, MEAN_LOSS_CAP_MAXWELL, MEAN_LOSS_FLOOR,
-    SHIFT_MARGIN, ZONE_CAP_DIVISOR,
+    air_cells, zone_cell_bytes, zone_cells, ShiftParams, DILUTE_GRAIN_SIZE, MEAN_LOSS_CAP_MAXWELL,
+    MEAN_LOSS_DILUTE, MEAN_LOSS_FLOOR, SHIFT_MARGIN, ZONE_CAP_DIVISOR,
 };
 pub use jones::Jones;
 pub use lattice::Lattice;

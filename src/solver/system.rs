@@ -158,6 +158,12 @@ impl<'a> System<'a> {
                 params.mean_loss_cap
             )));
         }
+        if !(0.0..=1.0).contains(&params.mean_loss_dilute) {
+            return Err(SolveError::Invalid(format!(
+                "mean background dilute share must be in [0, 1], got {}",
+                params.mean_loss_dilute
+            )));
+        }
         let lat = p.lattice;
         if p.eps.dim() != (lat.nz, lat.ny, lat.nx) {
             return Err(SolveError::Invalid(format!(
@@ -714,7 +720,7 @@ impl Shift {
                 let es = (params.margin * rad).max(1e-9);
                 (vec![C64::new(er, es); nz], Some((er, es)))
             }
-            Background::Mean => (mean_profile(eps, tensor, params), None),
+            Background::Mean => (mean_profile(eps, tensor, lat, params), None),
         };
         let k2 = lat.k0 * lat.k0;
         let c: Vec<C64> = profile.iter().map(|e| k2 * (e - eps_binder)).collect();
